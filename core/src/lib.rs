@@ -1,0 +1,14 @@
+//! flexmech-core: rotations, cross-sections and geometrically exact
+//! (Reissner–Simo) beam element kernels, generic over the scalar so that
+//! automatic differentiation (num-dual) runs through every kernel.
+
+pub mod rotation;
+pub mod scalar;
+
+pub use scalar::{cst, Scalar};
+pub mod element;
+pub mod section;
+pub mod shape;
+
+pub use element::BeamElement;
+pub use section::Section;

@@ -1,0 +1,56 @@
+//! What a solver hands out after every converged step: a plain value that the
+//! HDF5 writer, charts and tests consume. Nothing here knows about files.
+
+/// Energies of the whole mechanism at the end of a step.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Energies {
+    /// Kinetic energy `T = ½∫(A_ρ ṙ·ṙ + W·J_ρ W) ds` (zero in statics).
+    pub kinetic: f64,
+    /// Strain energy `Π = ½∫(Γ·C_N Γ + K·C_M K) ds`.
+    pub strain: f64,
+    /// Potential of gravity and of dead external loads (`−Σ f·u`).
+    pub potential: f64,
+    /// `kinetic + strain + potential`.
+    pub total: f64,
+}
+
+/// State of one joint at the end of a step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointRecord {
+    /// Released angle ψ about the joint axis.
+    pub angle: f64,
+    /// Released translation `r_R` in the master frame.
+    pub released_translation: [f64; 3],
+    /// `‖r_s − r_m − Λ_m f(ψ)‖ + ‖Λ_mᵀΛ_s − exp(ψ t̂)‖` (Frobenius).
+    pub constraint_error: f64,
+}
+
+/// One converged (time or load) step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepRecord {
+    /// Time at the end of the step (statics: the load factor).
+    pub time: f64,
+    /// Step size actually used, after halvings.
+    pub dt: f64,
+    /// Newton iterations of the step.
+    pub iterations: usize,
+    /// Final scaled residual norm.
+    pub residual: f64,
+    /// Scaled residual after each Newton iteration (index 0: before the first solve).
+    pub residual_history: Vec<f64>,
+    /// Energy–momentum β of the step; NaN for the other integrators and statics.
+    pub beta: f64,
+    /// Energies at the end of the step.
+    pub energy: Energies,
+    /// Total linear momentum.
+    pub momentum_linear: [f64; 3],
+    /// Total angular momentum about the origin.
+    pub momentum_angular: [f64; 3],
+    /// Position of every node.
+    pub positions: Vec<[f64; 3]>,
+    /// Rotation of every node's triad from its initial configuration, as a unit
+    /// quaternion `(w, x, y, z)`.
+    pub quaternions: Vec<[f64; 4]>,
+    /// One record per joint, in model order.
+    pub joints: Vec<JointRecord>,
+}
