@@ -12,3 +12,8 @@ pub mod shape;
 
 pub use element::BeamElement;
 pub use section::Section;
+pub mod mesh;
+pub mod state;
+
+pub use mesh::{Element, Mesh, MeshError};
+pub use state::Configuration;

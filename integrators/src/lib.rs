@@ -1,1 +1,18 @@
+//! flexmech-integrators: the mechanism, parallel assembly, sparse linear
+//! solves, Newton's method with step control, and the solvers (statics and
+//! the time integrators).
+
+pub mod assembly;
+pub mod dofs;
+pub mod error;
+pub mod linsolve;
+pub mod mechanism;
+pub mod newton;
 pub mod record;
+pub mod statics;
+
+pub use error::{NewtonFailure, SolveError};
+pub use mechanism::{Mechanism, NodalLoad, Schedule};
+pub use newton::NewtonSettings;
+pub use record::{Energies, JointRecord, StepRecord};
+pub use statics::{solve_static, StaticOutcome, StaticSettings};

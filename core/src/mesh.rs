@@ -1,0 +1,311 @@
+//! Meshes of beams: nodes (initial positions) and elements (initial geometry).
+//! Straight beams and circular arcs are meshed into equal elements; node
+//! numbering is global and contiguous per beam.
+
+use crate::element::BeamElement;
+use crate::rotation::exp;
+use crate::section::Section;
+use nalgebra::{Matrix3, Vector3};
+use thiserror::Error;
+
+/// Degenerate beam geometry (the model loader reports these with file context;
+/// the mesh still refuses them so that no library path can panic).
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum MeshError {
+    #[error("beam has zero length")]
+    ZeroLength,
+    #[error("the section axis e2 is parallel to the beam axis")]
+    ParallelE2,
+    #[error("arc radius is zero")]
+    ZeroRadius,
+    #[error("arc normal must be non-zero and perpendicular to start − center")]
+    BadNormal,
+    #[error("a beam needs at least one element with 2 or 3 nodes, got {elements} elements of {nodes_per_element} nodes")]
+    BadElementCount {
+        elements: usize,
+        nodes_per_element: usize,
+    },
+}
+
+/// A beam element of either order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Element {
+    /// 2-node element, closed-form residual.
+    Linear(BeamElement<2>),
+    /// 3-node element, AD residual and tangent.
+    Quadratic(BeamElement<3>),
+}
+
+impl Element {
+    /// Global node numbers.
+    pub fn nodes(&self) -> &[usize] {
+        match self {
+            Element::Linear(e) => &e.nodes,
+            Element::Quadratic(e) => &e.nodes,
+        }
+    }
+
+    /// Number of element unknowns `6N`.
+    pub fn dofs(&self) -> usize {
+        6 * self.nodes().len()
+    }
+
+    /// The element's section.
+    pub fn section(&self) -> &Section {
+        match self {
+            Element::Linear(e) => &e.section,
+            Element::Quadratic(e) => &e.section,
+        }
+    }
+
+    /// Initial length.
+    pub fn length(&self) -> f64 {
+        match self {
+            Element::Linear(e) => e.length,
+            Element::Quadratic(e) => e.length,
+        }
+    }
+
+    /// Strain energy in a global configuration.
+    pub fn energy(&self, x: &[Vector3<f64>], rot: &[Matrix3<f64>]) -> f64 {
+        match self {
+            Element::Linear(e) => {
+                let (xe, re) = gather(&e.nodes, x, rot);
+                e.energy(&xe, &re)
+            }
+            Element::Quadratic(e) => {
+                let (xe, re) = gather(&e.nodes, x, rot);
+                e.energy(&xe, &re)
+            }
+        }
+    }
+
+    /// Residual (internal force, `6N`) and tangent (`6N × 6N`, column-major)
+    /// in a global configuration, written into `r` and `k`.
+    pub fn residual_tangent(
+        &self,
+        x: &[Vector3<f64>],
+        rot: &[Matrix3<f64>],
+        r: &mut [f64],
+        k: &mut [f64],
+    ) {
+        match self {
+            Element::Linear(e) => {
+                let (xe, re) = gather(&e.nodes, x, rot);
+                let (rv, km) = e.residual_tangent(&xe, &re);
+                r.copy_from_slice(rv.as_slice());
+                k.copy_from_slice(km.as_slice());
+            }
+            Element::Quadratic(e) => {
+                let (xe, re) = gather(&e.nodes, x, rot);
+                let (rv, km) = e.residual_tangent_ad::<18>(&xe, &re);
+                r.copy_from_slice(rv.as_slice());
+                k.copy_from_slice(km.as_slice());
+            }
+        }
+    }
+}
+
+fn gather<const N: usize>(
+    nodes: &[usize; N],
+    x: &[Vector3<f64>],
+    rot: &[Matrix3<f64>],
+) -> ([Vector3<f64>; N], [Matrix3<f64>; N]) {
+    (
+        std::array::from_fn(|i| x[nodes[i]]),
+        std::array::from_fn(|i| rot[nodes[i]]),
+    )
+}
+
+/// Nodes and elements of a mechanism's beams.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Mesh {
+    /// Initial position of every node.
+    pub positions: Vec<Vector3<f64>>,
+    /// All elements.
+    pub elements: Vec<Element>,
+}
+
+/// Orthonormal triad with first column `t1` (unit) and second column the part
+/// of `e2` orthogonal to it.
+fn triad(t1: &Vector3<f64>, e2: &Vector3<f64>) -> Result<Matrix3<f64>, MeshError> {
+    let t2 = e2 - t1 * e2.dot(t1);
+    if t2.norm() <= 1e-8 * e2.norm() || e2.norm() == 0.0 {
+        return Err(MeshError::ParallelE2);
+    }
+    let t2 = t2.normalize();
+    Ok(Matrix3::from_columns(&[*t1, t2, t1.cross(&t2)]))
+}
+
+impl Mesh {
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Meshes a beam given node positions and triads along its length
+    /// (`count` nodes, parameter `u ∈ [0, 1]`), returning its node numbers.
+    fn add_beam(
+        &mut self,
+        elements: usize,
+        npe: usize,
+        section: Section,
+        length: f64,
+        frame: impl Fn(f64) -> Result<(Vector3<f64>, Matrix3<f64>), MeshError>,
+    ) -> Result<Vec<usize>, MeshError> {
+        if elements == 0 || !(2..=3).contains(&npe) {
+            return Err(MeshError::BadElementCount {
+                elements,
+                nodes_per_element: npe,
+            });
+        }
+        let count = elements * (npe - 1) + 1;
+        let first = self.positions.len();
+        let mut triads = Vec::with_capacity(count);
+        for k in 0..count {
+            let (x, t) = frame(k as f64 / (count - 1) as f64)?;
+            self.positions.push(x);
+            triads.push(t);
+        }
+        let le = length / elements as f64;
+        for e in 0..elements {
+            let base = e * (npe - 1);
+            if npe == 2 {
+                let nodes = [first + base, first + base + 1];
+                let x0 = nodes.map(|n| self.positions[n]);
+                let l0 = [triads[base], triads[base + 1]];
+                self.elements.push(Element::Linear(BeamElement::new(
+                    nodes, section, le, &x0, l0,
+                )));
+            } else {
+                let nodes = [first + base, first + base + 1, first + base + 2];
+                let x0 = nodes.map(|n| self.positions[n]);
+                let l0 = [triads[base], triads[base + 1], triads[base + 2]];
+                self.elements.push(Element::Quadratic(BeamElement::new(
+                    nodes, section, le, &x0, l0,
+                )));
+            }
+        }
+        Ok((first..first + count).collect())
+    }
+
+    /// A straight beam from `start` to `end` with section axis `e2`.
+    pub fn add_straight_beam(
+        &mut self,
+        start: Vector3<f64>,
+        end: Vector3<f64>,
+        e2: Vector3<f64>,
+        elements: usize,
+        nodes_per_element: usize,
+        section: Section,
+    ) -> Result<Vec<usize>, MeshError> {
+        let d = end - start;
+        let length = d.norm();
+        if length == 0.0 || !length.is_finite() {
+            return Err(MeshError::ZeroLength);
+        }
+        let t = triad(&(d / length), &e2)?;
+        self.add_beam(elements, nodes_per_element, section, length, |u| {
+            Ok((start + d * u, t))
+        })
+    }
+
+    /// A circular arc starting at `start`, turning about the unit `normal`
+    /// through `sweep` radians around `center`. The tangent at the start is
+    /// `sign(sweep)·normal × (start − center)/radius`; the section axis `e2` is
+    /// the given one carried along the arc, or the direction to the center.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_arc_beam(
+        &mut self,
+        start: Vector3<f64>,
+        center: Vector3<f64>,
+        normal: Vector3<f64>,
+        sweep: f64,
+        e2: Option<Vector3<f64>>,
+        elements: usize,
+        nodes_per_element: usize,
+        section: Section,
+    ) -> Result<Vec<usize>, MeshError> {
+        let radial = start - center;
+        let radius = radial.norm();
+        if radius == 0.0 || !radius.is_finite() {
+            return Err(MeshError::ZeroRadius);
+        }
+        if normal.norm() == 0.0
+            || normal.normalize().dot(&(radial / radius)).abs() > 1e-8
+            || sweep == 0.0
+        {
+            return Err(MeshError::BadNormal);
+        }
+        let n = normal.normalize();
+        let sign = sweep.signum();
+        let length = radius * sweep.abs();
+        self.add_beam(elements, nodes_per_element, section, length, |u| {
+            let q = exp(&(n * (sweep * u)));
+            let r = q * radial;
+            let t1 = n.cross(&r).normalize() * sign;
+            let e2u = match e2 {
+                Some(v) => q * v,
+                None => -r / radius,
+            };
+            Ok((center + r, triad(&t1, &e2u)?))
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sec() -> Section {
+        Section::new([1.0, 1.0, 1.0], [1.0, 1.0, 1.0], 0.0, [0.0; 3])
+    }
+
+    #[test]
+    fn arc_nodes_lie_on_the_circle_with_tangent_triads() {
+        let mut m = Mesh::default();
+        let sweep = std::f64::consts::FRAC_PI_4;
+        let nodes = m
+            .add_arc_beam(
+                Vector3::zeros(),
+                Vector3::new(100.0, 0.0, 0.0),
+                Vector3::new(0.0, 0.0, -1.0),
+                sweep,
+                None,
+                8,
+                3,
+                sec(),
+            )
+            .unwrap();
+        assert_eq!(nodes.len(), 17);
+        let tip = m.positions[*nodes.last().unwrap()];
+        let expected = Vector3::new(100.0 - 100.0 * sweep.cos(), 100.0 * sweep.sin(), 0.0);
+        assert!((tip - expected).norm() < 1e-12);
+        // Tangent at the start is normal × (start − center)/radius = +y.
+        if let Element::Quadratic(e) = &m.elements[0] {
+            assert!((e.lambda0[0].column(0) - Vector3::y()).norm() < 1e-15);
+            assert!((e.length - 100.0 * sweep / 8.0).abs() < 1e-12);
+        } else {
+            panic!("expected quadratic elements");
+        }
+    }
+
+    #[test]
+    fn degenerate_beams_are_errors() {
+        let mut m = Mesh::default();
+        let z = Vector3::zeros();
+        assert_eq!(
+            m.add_straight_beam(z, z, Vector3::x(), 2, 2, sec()),
+            Err(MeshError::ZeroLength)
+        );
+        assert_eq!(
+            m.add_straight_beam(z, Vector3::x(), Vector3::x() * 2.0, 2, 2, sec()),
+            Err(MeshError::ParallelE2)
+        );
+        assert!(matches!(
+            m.add_straight_beam(z, Vector3::x(), Vector3::y(), 0, 2, sec()),
+            Err(MeshError::BadElementCount { .. })
+        ));
+        assert_eq!(m.node_count(), 0);
+    }
+}

@@ -1,0 +1,35 @@
+//! The configuration of a mesh: nodal positions and nodal rotations.
+
+use crate::rotation::{exp, matrix_from_quaternion, quaternion_from_matrix};
+use nalgebra::{Matrix3, Vector3, Vector4};
+
+/// Positions `xᵢ` and rotations `Rᵢ` (from the initial configuration) of every node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Configuration {
+    pub x: Vec<Vector3<f64>>,
+    pub rot: Vec<Matrix3<f64>>,
+}
+
+impl Configuration {
+    /// The initial configuration: positions as given, every rotation the identity.
+    pub fn initial(positions: &[Vector3<f64>]) -> Self {
+        Self {
+            x: positions.to_vec(),
+            rot: vec![Matrix3::identity(); positions.len()],
+        }
+    }
+
+    /// Applies a nodal increment: `x ← x + u`, `R ← exp(φ̂) R` (spatial,
+    /// multiplicative — rotation vectors are never added), re-normalised
+    /// through the quaternion so that orthogonality does not drift.
+    pub fn increment(&mut self, node: usize, u: &Vector3<f64>, phi: &Vector3<f64>) {
+        self.x[node] += u;
+        let r = exp(phi) * self.rot[node];
+        self.rot[node] = matrix_from_quaternion(&quaternion_from_matrix(&r).normalize());
+    }
+
+    /// Unit quaternion `(w, x, y, z)` of node `i`'s rotation, `w ≥ 0`.
+    pub fn quaternion(&self, i: usize) -> Vector4<f64> {
+        quaternion_from_matrix(&self.rot[i]).normalize()
+    }
+}

@@ -1,0 +1,66 @@
+//! Numbering of the unknowns and the map from them to nodal increments.
+//!
+//! Every node's increment `pₙ = (uₙ, φₙ)` is a linear combination of global
+//! unknowns: `pₙ = Σₖ cₖ q[eqₖ]`. For an independent node the columns are unit
+//! vectors of its free DOFs; the master–slave joints (paper eqs 5–6) make a
+//! slave's columns those of `N` applied to its master's and the released
+//! unknowns. Residuals are carried back by the transpose (paper eqs 7–8).
+
+use nalgebra::Vector6;
+
+/// How node `n`'s increment depends on the unknowns.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct NodeMap {
+    /// Global equation numbers.
+    pub eqs: Vec<usize>,
+    /// The column of each equation: `pₙ = Σₖ cols[k]·q[eqs[k]]`.
+    pub cols: Vec<Vector6<f64>>,
+}
+
+/// The unknowns of a mechanism and every node's map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DofMap {
+    /// Number of unknowns.
+    pub n_eq: usize,
+    /// One map per node.
+    pub nodes: Vec<NodeMap>,
+}
+
+impl DofMap {
+    /// Independent nodes only: each free DOF is an unknown, numbered node by node.
+    pub fn independent(fixed: &[[bool; 6]]) -> Self {
+        let mut n_eq = 0;
+        let nodes = fixed
+            .iter()
+            .map(|f| {
+                let mut m = NodeMap::default();
+                for (d, &held) in f.iter().enumerate() {
+                    if !held {
+                        m.eqs.push(n_eq);
+                        m.cols.push(Vector6::ith(d, 1.0));
+                        n_eq += 1;
+                    }
+                }
+                m
+            })
+            .collect();
+        Self { n_eq, nodes }
+    }
+
+    /// Nodal increment of node `n` for the global increment `dq`.
+    pub fn node_increment(&self, n: usize, dq: &[f64]) -> Vector6<f64> {
+        let m = &self.nodes[n];
+        m.eqs.iter().zip(&m.cols).map(|(&e, c)| c * dq[e]).sum()
+    }
+
+    /// Reduced residual `Σₙ Tₙᵀ gₙ` from nodal residuals `g` (6 per node).
+    pub fn reduce(&self, g: &[f64], out: &mut [f64]) {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for (n, m) in self.nodes.iter().enumerate() {
+            let gn = Vector6::from_column_slice(&g[6 * n..6 * n + 6]);
+            for (&e, c) in m.eqs.iter().zip(&m.cols) {
+                out[e] += c.dot(&gn);
+            }
+        }
+    }
+}

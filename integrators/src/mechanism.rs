@@ -1,0 +1,101 @@
+//! The mechanism: a mesh with supports, loads and gravity — everything a solver
+//! is handed. Nothing here reads files; the model loader builds it.
+
+use flexmech_core::Mesh;
+use nalgebra::Vector3;
+use std::fmt;
+use std::sync::Arc;
+
+/// A scalar function of time (statics: of the load factor λ).
+#[derive(Clone)]
+pub struct Schedule(Arc<dyn Fn(f64) -> f64 + Send + Sync>);
+
+impl Schedule {
+    /// A schedule from any function.
+    pub fn new(f: impl Fn(f64) -> f64 + Send + Sync + 'static) -> Self {
+        Self(Arc::new(f))
+    }
+    /// The same value at every time.
+    pub fn constant(v: f64) -> Self {
+        Self::new(move |_| v)
+    }
+    /// `s(t) = t`: the proportional load ramp of a static analysis.
+    pub fn ramp() -> Self {
+        Self::new(|t| t)
+    }
+    /// Value at `t`.
+    pub fn at(&self, t: f64) -> f64 {
+        (self.0)(t)
+    }
+}
+
+impl fmt::Debug for Schedule {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("Schedule(..)")
+    }
+}
+
+/// A dead nodal force and a fixed-axis (spatial) moment, scaled by `scale(t)`.
+#[derive(Debug, Clone)]
+pub struct NodalLoad {
+    pub node: usize,
+    pub force: Vector3<f64>,
+    pub moment: Vector3<f64>,
+    pub scale: Schedule,
+}
+
+/// Everything a solver needs about the mechanism.
+#[derive(Debug, Clone)]
+pub struct Mechanism {
+    pub mesh: Mesh,
+    /// Per node `[ux, uy, uz, rx, ry, rz]`: true where held at the initial value.
+    pub fixed: Vec<[bool; 6]>,
+    pub loads: Vec<NodalLoad>,
+    /// Gravity acceleration (acts on `ρA`).
+    pub gravity: Vector3<f64>,
+    /// Scale of gravity over time (statics: ramped with the load factor).
+    pub gravity_scale: Schedule,
+}
+
+impl Mechanism {
+    /// A mechanism with no supports, loads or gravity.
+    pub fn new(mesh: Mesh) -> Self {
+        let n = mesh.node_count();
+        Self {
+            mesh,
+            fixed: vec![[false; 6]; n],
+            loads: Vec::new(),
+            gravity: Vector3::zeros(),
+            gravity_scale: Schedule::constant(1.0),
+        }
+    }
+
+    /// External nodal forces and moments at time `t` (6 per node:
+    /// force, then spatial moment), including consistent nodal gravity
+    /// forces `∫ρA g Iᵢ ds`.
+    pub fn external_forces(&self, t: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for load in &self.loads {
+            let s = load.scale.at(t);
+            for c in 0..3 {
+                out[6 * load.node + c] += s * load.force[c];
+                out[6 * load.node + 3 + c] += s * load.moment[c];
+            }
+        }
+        if self.gravity != Vector3::zeros() {
+            let g = self.gravity * self.gravity_scale.at(t);
+            for e in &self.mesh.elements {
+                let m = e.section().rho_a * e.length();
+                let weights: &[f64] = match e.nodes().len() {
+                    2 => &[0.5, 0.5],
+                    _ => &[1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
+                };
+                for (&n, w) in e.nodes().iter().zip(weights) {
+                    for c in 0..3 {
+                        out[6 * n + c] += m * w * g[c];
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,94 @@
+//! Newton's method with the exact tangent, shared by every solver.
+//!
+//! Convergence is measured on the *scaled* residual
+//! `‖r‖₂ / max(‖f_ext‖₂, ‖Σₑ|rₑ|‖₂)`: the residual relative to the larger of
+//! the applied loads and the magnitude of the internal forces that cancel in
+//! it, so the tolerance means the same thing for any units and stays above
+//! round-off when large internal forces balance.
+
+use crate::error::NewtonFailure;
+use crate::linsolve::SparseLu;
+
+/// Iteration limits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonSettings {
+    /// Tolerance on the scaled residual.
+    pub tolerance: f64,
+    /// Maximum number of linear solves.
+    pub max_iterations: usize,
+}
+
+/// A nonlinear system `r(q) = 0` in the reduced unknowns.
+pub trait NewtonSystem {
+    /// Evaluates the reduced residual into `r` and the tangent into the
+    /// solver's value array at the current iterate; returns the force scale.
+    fn evaluate(&mut self, r: &mut [f64]) -> f64;
+    /// CSC values of the tangent from the last [`NewtonSystem::evaluate`].
+    fn tangent_values(&self) -> &[f64];
+    /// Applies the increment `dq` to the current iterate.
+    fn apply(&mut self, dq: &[f64]);
+}
+
+/// Outcome of a converged solve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NewtonReport {
+    /// Linear solves performed.
+    pub iterations: usize,
+    /// Final scaled residual.
+    pub residual: f64,
+    /// Scaled residual before each solve and at the end.
+    pub history: Vec<f64>,
+}
+
+/// Runs Newton's method from the system's current iterate. `r` and `dq` are
+/// caller-owned scratch vectors of length `n_eq`.
+pub fn solve<S: NewtonSystem>(
+    sys: &mut S,
+    lu: &mut SparseLu,
+    settings: &NewtonSettings,
+    r: &mut [f64],
+    dq: &mut [f64],
+) -> Result<NewtonReport, NewtonFailure> {
+    let mut history = Vec::with_capacity(settings.max_iterations + 1);
+    for it in 0..=settings.max_iterations {
+        let scale = sys.evaluate(r);
+        let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let res = if norm == 0.0 {
+            0.0
+        } else {
+            norm / scale.max(f64::MIN_POSITIVE)
+        };
+        history.push(res);
+        if !res.is_finite() {
+            return Err(NewtonFailure::NotFinite { iteration: it });
+        }
+        if res <= settings.tolerance {
+            return Ok(NewtonReport {
+                iterations: it,
+                residual: res,
+                history,
+            });
+        }
+        if it > 0 && res > 1e8 * history[0].max(settings.tolerance) {
+            return Err(NewtonFailure::Diverged {
+                iteration: it,
+                residual: res,
+                initial: history[0],
+            });
+        }
+        if it == settings.max_iterations {
+            break;
+        }
+        lu.factor(sys.tangent_values())
+            .map_err(NewtonFailure::LinearSolve)?;
+        for (d, v) in dq.iter_mut().zip(r.iter()) {
+            *d = -v;
+        }
+        lu.solve(dq).map_err(NewtonFailure::LinearSolve)?;
+        sys.apply(dq);
+    }
+    Err(NewtonFailure::MaxIterations {
+        iterations: settings.max_iterations,
+        residual: *history.last().unwrap_or(&f64::NAN),
+    })
+}

@@ -1,0 +1,216 @@
+//! Static equilibrium under proportional (or scheduled) loading: the load
+//! factor λ runs from 0 to 1; each step is solved by Newton with the exact
+//! tangent; a step that fails is retried with half the increment (up to
+//! `max_halvings` times in a row) and the increment grows back to nominal
+//! after three easy steps.
+
+use crate::assembly::Assembler;
+use crate::dofs::DofMap;
+use crate::error::{NewtonFailure, SolveError};
+use crate::linsolve::SparseLu;
+use crate::mechanism::Mechanism;
+use crate::newton::{self, NewtonSettings, NewtonSystem};
+use crate::record::{Energies, StepRecord};
+use flexmech_core::Configuration;
+use nalgebra::Vector3;
+use rayon::prelude::*;
+
+/// Settings of a static analysis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StaticSettings {
+    /// Number of equal load-factor steps from 0 to 1.
+    pub load_steps: usize,
+    /// Newton settings.
+    pub newton: NewtonSettings,
+    /// Consecutive halvings allowed for one step.
+    pub max_halvings: usize,
+}
+
+/// Result of a completed static analysis.
+#[derive(Debug, Clone)]
+pub struct StaticOutcome {
+    /// Final configuration.
+    pub config: Configuration,
+    /// Converged steps (including those after halvings).
+    pub steps: usize,
+}
+
+/// The static problem at one load factor: the [`NewtonSystem`] Newton solves.
+struct StaticProblem<'a> {
+    mech: &'a Mechanism,
+    dofs: &'a DofMap,
+    asm: Assembler,
+    config: Configuration,
+    fext: Vec<f64>,
+    nodal_r: Vec<f64>,
+    scratch: Vec<f64>,
+}
+
+impl NewtonSystem for StaticProblem<'_> {
+    fn evaluate(&mut self, r: &mut [f64]) -> f64 {
+        self.asm.assemble(&self.mech.mesh, self.dofs, &self.config);
+        for ((g, fi), fe) in self.nodal_r.iter_mut().zip(&self.asm.nodal).zip(&self.fext) {
+            *g = fi - fe;
+        }
+        self.dofs.reduce(&self.nodal_r, r);
+        self.dofs.reduce(&self.fext, &mut self.scratch);
+        let f_ext = norm(&self.scratch);
+        self.dofs.reduce(&self.asm.nodal_abs, &mut self.scratch);
+        f_ext.max(norm(&self.scratch))
+    }
+
+    fn tangent_values(&self) -> &[f64] {
+        &self.asm.values
+    }
+
+    fn apply(&mut self, dq: &[f64]) {
+        for n in 0..self.config.x.len() {
+            let p = self.dofs.node_increment(n, dq);
+            if p != nalgebra::Vector6::zeros() {
+                self.config.increment(
+                    n,
+                    &p.fixed_rows::<3>(0).into_owned(),
+                    &p.fixed_rows::<3>(3).into_owned(),
+                );
+            }
+        }
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// Strain energy of the whole mesh (element energies summed in element order).
+pub fn strain_energy(mech: &Mechanism, config: &Configuration) -> f64 {
+    let per: Vec<f64> = mech
+        .mesh
+        .elements
+        .par_iter()
+        .map(|e| e.energy(&config.x, &config.rot))
+        .collect();
+    per.iter().sum()
+}
+
+/// A record of the configuration with energies (statics: no kinetic energy,
+/// no momenta; the potential is that of the dead forces, `−Σ f·u`; moments,
+/// which are not conservative in 3D, are left out of it).
+fn record(
+    mech: &Mechanism,
+    config: &Configuration,
+    fext: &[f64],
+    time: f64,
+    dt: f64,
+    report: &newton::NewtonReport,
+) -> StepRecord {
+    let strain = strain_energy(mech, config);
+    let potential: f64 = -(0..config.x.len())
+        .map(|n| {
+            let u: Vector3<f64> = config.x[n] - mech.mesh.positions[n];
+            u.dot(&Vector3::new(fext[6 * n], fext[6 * n + 1], fext[6 * n + 2]))
+        })
+        .sum::<f64>();
+    StepRecord {
+        time,
+        dt,
+        iterations: report.iterations,
+        residual: report.residual,
+        residual_history: report.history.clone(),
+        beta: f64::NAN,
+        energy: Energies {
+            kinetic: 0.0,
+            strain,
+            potential,
+            total: strain + potential,
+        },
+        momentum_linear: [0.0; 3],
+        momentum_angular: [0.0; 3],
+        positions: config.x.iter().map(|x| [x.x, x.y, x.z]).collect(),
+        quaternions: (0..config.x.len())
+            .map(|i| {
+                let q = config.quaternion(i);
+                [q.x, q.y, q.z, q.w]
+            })
+            .collect(),
+        joints: Vec::new(),
+    }
+}
+
+/// Solves the static problem, calling `on_step` after every converged step.
+/// On failure the steps already reported stay valid; the error says where.
+pub fn solve_static(
+    mech: &Mechanism,
+    settings: &StaticSettings,
+    mut on_step: impl FnMut(&StepRecord),
+) -> Result<StaticOutcome, SolveError> {
+    if settings.load_steps == 0 {
+        return Err(SolveError::InvalidMechanism(
+            "load_steps must be at least 1".into(),
+        ));
+    }
+    let dofs = DofMap::independent(&mech.fixed);
+    let n = dofs.n_eq;
+    let asm = Assembler::new(&mech.mesh, &dofs);
+    let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
+    let nodes = mech.mesh.node_count();
+    let mut prob = StaticProblem {
+        mech,
+        dofs: &dofs,
+        asm,
+        config: Configuration::initial(&mech.mesh.positions),
+        fext: vec![0.0; 6 * nodes],
+        nodal_r: vec![0.0; 6 * nodes],
+        scratch: vec![0.0; n],
+    };
+    let (mut r, mut dq) = (vec![0.0; n], vec![0.0; n]);
+    let nominal = 1.0 / settings.load_steps as f64;
+    let (mut lambda, mut step, mut halvings, mut easy, mut steps) =
+        (0.0f64, nominal, 0usize, 0usize, 0usize);
+    while lambda < 1.0 - 1e-12 {
+        let target = if lambda + step > 1.0 - 1e-12 {
+            1.0
+        } else {
+            lambda + step
+        };
+        let saved = prob.config.clone();
+        mech.external_forces(target, &mut prob.fext);
+        match newton::solve(&mut prob, &mut lu, &settings.newton, &mut r, &mut dq) {
+            Ok(report) => {
+                let dt = target - lambda;
+                lambda = target;
+                steps += 1;
+                halvings = 0;
+                easy += 1;
+                on_step(&record(mech, &prob.config, &prob.fext, lambda, dt, &report));
+                if easy >= 3 && step < nominal {
+                    step = (2.0 * step).min(nominal);
+                    easy = 0;
+                }
+            }
+            Err(reason) => {
+                prob.config = saved;
+                if let NewtonFailure::LinearSolve(msg) = &reason {
+                    if lambda == 0.0 && halvings == 0 {
+                        // A singular tangent at the undeformed state will not be
+                        // cured by a smaller load: the mechanism is under-supported.
+                        return Err(SolveError::Singular(msg.clone()));
+                    }
+                }
+                if halvings >= settings.max_halvings {
+                    return Err(SolveError::NoConvergence {
+                        time: target,
+                        halvings,
+                        reason,
+                    });
+                }
+                halvings += 1;
+                easy = 0;
+                step *= 0.5;
+            }
+        }
+    }
+    Ok(StaticOutcome {
+        config: prob.config,
+        steps,
+    })
+}
