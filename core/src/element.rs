@@ -46,7 +46,7 @@ pub struct BeamElement<const N: usize> {
 
 /// The two middle nodes `(I, J)` that define the reference rotation.
 const fn reference_nodes(n: usize) -> (usize, usize) {
-    ((n + 1) / 2 - 1, (n + 2) / 2 - 1)
+    (n.div_ceil(2) - 1, (n + 2) / 2 - 1)
 }
 
 impl<const N: usize> BeamElement<N> {

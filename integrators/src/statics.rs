@@ -2,7 +2,8 @@
 //! factor λ runs from 0 to 1; each step is solved by Newton with the exact
 //! tangent; a step that fails is retried with half the increment (up to
 //! `max_halvings` times in a row) and the increment grows back to nominal
-//! after three easy steps.
+//! after three easy steps. Every planned level `k/load_steps` is reached
+//! exactly; halvings only insert levels between them.
 
 use crate::assembly::Assembler;
 use crate::dofs::DofMap;
@@ -167,11 +168,11 @@ pub fn solve_static(
     let (mut lambda, mut step, mut halvings, mut easy, mut steps) =
         (0.0f64, nominal, 0usize, 0usize, 0usize);
     while lambda < 1.0 - 1e-12 {
-        let target = if lambda + step > 1.0 - 1e-12 {
-            1.0
-        } else {
-            lambda + step
-        };
+        // Never step over a planned level k/load_steps: results are reported
+        // at the load factors the user asked for; halvings only add levels.
+        let next_planned = ((lambda / nominal + 1e-9).floor() + 1.0) * nominal;
+        let target = (lambda + step).min(next_planned);
+        let target = if target > 1.0 - 1e-12 { 1.0 } else { target };
         let saved = prob.config.clone();
         mech.external_forces(target, &mut prob.fext);
         match newton::solve(&mut prob, &mut lu, &settings.newton, &mut r, &mut dq) {

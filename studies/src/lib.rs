@@ -1,0 +1,10 @@
+//! flexmech-studies: model files, the mechanism builder, runs that stream
+//! results into HDF5 files, and the `flexmech` command line.
+
+pub mod build;
+pub mod model;
+pub mod results;
+pub mod run;
+
+pub use build::{build, Built};
+pub use run::{run_model, RunError, RunSummary};

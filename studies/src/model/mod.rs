@@ -1,0 +1,49 @@
+//! Model files: parse and validate a mechanism described in TOML (see
+//! `MODEL_FORMAT.md`) into a [`Model`].
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use flexmech_studies::model::load_model;
+//!
+//! match load_model(Path::new("data/screw.toml")) {
+//!     Ok(model) => println!("{} beams", model.beams.len()),
+//!     // e.g. `data/screw.toml:12: key `solver.dt`: must be > 0, found -0.01`
+//!     Err(e) => eprintln!("{e}"),
+//! }
+//! ```
+//!
+//! Every problem is reported as a [`ModelError`] naming the file, the key path
+//! (`solver.dt`, `beam[2].elements`, `joint[0].slave`; array-of-tables entries
+//! counted from 0), the line where known, and what was expected.
+
+use std::path::Path;
+
+pub mod error;
+mod labels;
+mod locate;
+mod raw;
+pub mod time_function;
+pub mod types;
+mod validate;
+
+pub use error::ModelError;
+pub use types::*;
+
+/// Reads and validates the model file at `path`. An unreadable file is a
+/// [`ModelError`] naming the file.
+pub fn load_model(path: &Path) -> Result<Model, ModelError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ModelError::new(path, "", None, format!("cannot read the model file: {e}")))?;
+    parse_model(&text, path)
+}
+
+/// Parses and validates model-file `text`; `path` is used only in error
+/// messages and stored in [`Model::path`].
+pub fn parse_model(text: &str, path: &Path) -> Result<Model, ModelError> {
+    if let Err(e) = toml::de::DeTable::parse(text) {
+        return Err(locate::syntax_error(text, path, &e));
+    }
+    let raw: raw::RawModel =
+        toml::from_str(text).map_err(|e| locate::deserialize_error(text, path, &e))?;
+    validate::validate(raw, text, path)
+}

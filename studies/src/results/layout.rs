@@ -1,0 +1,136 @@
+//! Names of everything in a result file: the public contract of
+//! `MODEL_FORMAT.md`, "Result file (HDF5)". Never rename an entry here; add new
+//! ones instead.
+//!
+//! Dataset paths are absolute (`/energy/kinetic`). Per-node and per-joint
+//! datasets live below a group named after the label verbatim; build their
+//! paths with [`node_path`] and [`joint_path`].
+
+/// Root attribute: the model file text (TOML) the run was started from.
+pub const ATTR_MODEL: &str = "model";
+/// Root attribute: integrator name (`"static"` for statics).
+pub const ATTR_INTEGRATOR: &str = "integrator";
+/// Root attribute: version of the crate that wrote the file.
+pub const ATTR_VERSION: &str = "version";
+/// Root attribute: [`STATUS_RUNNING`], [`STATUS_COMPLETED`] or `"failed: <reason>"`.
+pub const ATTR_STATUS: &str = "status";
+/// Root attribute: wall-clock time of the run in seconds (written by `finish`).
+pub const ATTR_WALL_TIME: &str = "wall_time_s";
+/// Attribute on datasets and groups: a one-line human-readable meaning.
+pub const ATTR_DESCRIPTION: &str = "description";
+/// Attribute on `/nodes/<label>` (extension): the node index in the model.
+pub const ATTR_NODE_INDEX: &str = "node_index";
+/// Attribute on `/joints/<name>` (extension): the joint index in model order.
+pub const ATTR_JOINT_INDEX: &str = "joint_index";
+
+/// `status` while the run is in progress (and after a crash).
+pub const STATUS_RUNNING: &str = "running";
+/// `status` of a run that reached its end.
+pub const STATUS_COMPLETED: &str = "completed";
+/// Prefix of the `status` of a run that stopped early.
+pub const STATUS_FAILED_PREFIX: &str = "failed: ";
+
+/// `status` text for a run that failed for `reason`: `"failed: <reason>"`.
+pub fn failed_status(reason: &str) -> String {
+    format!("{STATUS_FAILED_PREFIX}{reason}")
+}
+
+/// T: time (statics: load factor) of each stored step.
+pub const TIME: &str = "/time";
+
+/// Group of the energy datasets.
+pub const ENERGY: &str = "/energy";
+/// T: kinetic energy.
+pub const ENERGY_KINETIC: &str = "/energy/kinetic";
+/// T: strain energy.
+pub const ENERGY_STRAIN: &str = "/energy/strain";
+/// T: potential of gravity and dead loads.
+pub const ENERGY_POTENTIAL: &str = "/energy/potential";
+/// T: kinetic + strain + potential.
+pub const ENERGY_TOTAL: &str = "/energy/total";
+
+/// Group of the momentum datasets.
+pub const MOMENTUM: &str = "/momentum";
+/// T×3: total linear momentum.
+pub const MOMENTUM_LINEAR: &str = "/momentum/linear";
+/// T×3: total angular momentum about the origin.
+pub const MOMENTUM_ANGULAR: &str = "/momentum/angular";
+
+/// Group of the solver datasets.
+pub const SOLVER: &str = "/solver";
+/// T (u64): Newton iterations of the step.
+pub const SOLVER_ITERATIONS: &str = "/solver/iterations";
+/// T: step size actually used (after halvings).
+pub const SOLVER_DT: &str = "/solver/dt";
+/// T: final scaled residual norm.
+pub const SOLVER_RESIDUAL: &str = "/solver/residual";
+/// T: energy–momentum β (NaN for other integrators).
+pub const SOLVER_BETA: &str = "/solver/beta";
+/// Flat (extension): every step's Newton residual history, concatenated.
+pub const SOLVER_NEWTON_RESIDUALS: &str = "/solver/newton_residuals";
+/// T+1 (u64, extension): step k's history is
+/// `newton_residuals[offsets[k]..offsets[k+1]]`; `offsets[0] = 0`.
+pub const SOLVER_NEWTON_OFFSETS: &str = "/solver/newton_offsets";
+
+/// Group holding one group per tracked node, named by its label.
+pub const NODES: &str = "/nodes";
+/// T×3 dataset in `/nodes/<label>`: position.
+pub const NODE_POSITION: &str = "position";
+/// T×3 dataset in `/nodes/<label>`: position − initial position.
+pub const NODE_DISPLACEMENT: &str = "displacement";
+/// T×3 dataset in `/nodes/<label>`: rotation vector of the node's triad, |ψ| ≤ π.
+pub const NODE_ROTATION: &str = "rotation";
+
+/// Group holding one group per joint, named by its name.
+pub const JOINTS: &str = "/joints";
+/// T dataset in `/joints/<name>`: released angle ψ.
+pub const JOINT_ANGLE: &str = "angle";
+/// T×3 dataset in `/joints/<name>`: released translation r_R in the master frame.
+pub const JOINT_RELEASED_TRANSLATION: &str = "released_translation";
+/// T dataset in `/joints/<name>`: constraint violation.
+pub const JOINT_CONSTRAINT_ERROR: &str = "constraint_error";
+
+/// Group of the full-configuration datasets.
+pub const CONFIGURATION: &str = "/configuration";
+/// T×nodes×3: every node's position.
+pub const CONFIGURATION_POSITION: &str = "/configuration/position";
+/// T×nodes×4: every node's triad as a unit quaternion (w, x, y, z).
+pub const CONFIGURATION_QUATERNION: &str = "/configuration/quaternion";
+
+/// Path of the group of tracked node `label`: `/nodes/<label>`.
+pub fn node_group(label: &str) -> String {
+    format!("{NODES}/{label}")
+}
+
+/// Path of dataset `leaf` (e.g. [`NODE_POSITION`]) of tracked node `label`.
+pub fn node_path(label: &str, leaf: &str) -> String {
+    format!("{NODES}/{label}/{leaf}")
+}
+
+/// Path of the group of joint `name`: `/joints/<name>`.
+pub fn joint_group(name: &str) -> String {
+    format!("{JOINTS}/{name}")
+}
+
+/// Path of dataset `leaf` (e.g. [`JOINT_ANGLE`]) of joint `name`.
+pub fn joint_path(name: &str, leaf: &str) -> String {
+    format!("{JOINTS}/{name}/{leaf}")
+}
+
+/// Why `name` cannot be used verbatim as an HDF5 group name, if it cannot.
+///
+/// Labels such as `arm.end` or `post.3` are fine; `/` separates path
+/// components, `.` alone means "this group", and HDF5 names are C strings.
+pub fn invalid_name_reason(name: &str) -> Option<&'static str> {
+    if name.is_empty() {
+        Some("empty name")
+    } else if name == "." {
+        Some("\".\" denotes the group itself")
+    } else if name.contains('/') {
+        Some("contains '/', the HDF5 path separator")
+    } else if name.contains('\0') {
+        Some("contains a NUL character")
+    } else {
+        None
+    }
+}

@@ -1,0 +1,81 @@
+//! HDF5 result files, written incrementally from a stream of
+//! [`StepRecord`](flexmech_integrators::record::StepRecord)s.
+//!
+//! [`ResultWriter::create`] writes the root attributes and empty datasets,
+//! [`ResultWriter::append`] adds one row to every dataset per converged step
+//! and flushes the file, and [`ResultWriter::finish`] records the outcome. A
+//! run that fails part-way (or a process that dies) therefore still leaves a
+//! valid file holding every step appended so far.
+//!
+//! # Layout
+//!
+//! This is the contract of `MODEL_FORMAT.md`, "Result file (HDF5)"; names are
+//! never renamed (constants in [`layout`]). `T` is the number of appended
+//! steps; datasets are `f64` unless noted, extendable along their first
+//! dimension, and carry a `description` attribute.
+//!
+//! | path | shape | meaning |
+//! |---|---|---|
+//! | `/time` | T | time of each step (statics: load factor) |
+//! | `/energy/kinetic`, `/energy/strain`, `/energy/potential`, `/energy/total` | T | energies |
+//! | `/momentum/linear`, `/momentum/angular` | T×3 | total momenta (angular about the origin) |
+//! | `/solver/iterations` | T, `u64` | Newton iterations of the step |
+//! | `/solver/dt` | T | step size actually used (after halvings) |
+//! | `/solver/residual` | T | final scaled residual norm |
+//! | `/solver/beta` | T | energy–momentum β (NaN for other integrators) |
+//! | `/solver/newton_residuals` | Σ iterations | *extension:* every step's scaled residual history, concatenated |
+//! | `/solver/newton_offsets` | T+1, `u64` | *extension:* step k's history is `newton_residuals[offsets[k]..offsets[k+1]]`; `offsets[0] = 0` |
+//! | `/nodes/<label>/position` | T×3 | tracked node's position |
+//! | `/nodes/<label>/displacement` | T×3 | position − initial position |
+//! | `/nodes/<label>/rotation` | T×3 | rotation vector of the node's triad, ‖ψ‖ ≤ π (see [`rotation_vector`]) |
+//! | `/joints/<name>/angle` | T | released angle ψ |
+//! | `/joints/<name>/released_translation` | T×3 | r_R in the master frame |
+//! | `/joints/<name>/constraint_error` | T | ‖r_s − r_m − Λ_m f(ψ)‖ + ‖Λ_mᵀΛ_s − exp(ψ t̂)‖ |
+//! | `/configuration/position` | T×nodes×3 | every node's position |
+//! | `/configuration/quaternion` | T×nodes×4 | every node's triad as (w, x, y, z) |
+//!
+//! `<label>` and `<name>` are the tracked-node labels and joint names of
+//! [`RunMeta`], used verbatim as group names (`arm.end`, `post.3`); they must
+//! not be empty, be `.`, or contain `/`. Group `/nodes/<label>` has a `u64`
+//! attribute `node_index`, group `/joints/<name>` a `u64` attribute
+//! `joint_index` (extensions).
+//!
+//! Root attributes (UTF-8 strings unless noted):
+//!
+//! | attribute | value |
+//! |---|---|
+//! | `model` | the model file text (TOML) |
+//! | `integrator` | integrator name (`"static"` for statics) |
+//! | `version` | version of `flexmech-studies` that wrote the file |
+//! | `status` | `"running"` until [`ResultWriter::finish`], then `"completed"` or `"failed: <reason>"` |
+//! | `wall_time_s` | `f64`, written by [`ResultWriter::finish`] |
+//!
+//! A file whose `status` is still `"running"` comes from a process that
+//! stopped without calling `finish`; it holds every step appended before.
+//!
+//! # Example
+//!
+//! ```no_run
+//! use flexmech_studies::results::{ResultWriter, RunMeta, layout};
+//! # fn steps() -> Vec<flexmech_integrators::record::StepRecord> { Vec::new() }
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let meta = RunMeta {
+//!     model_text: "# the TOML model".into(),
+//!     integrator: "energy-momentum".into(),
+//!     initial_positions: vec![[0.0; 3], [1.0, 0.0, 0.0]],
+//!     tracked: vec![("arm.end".into(), 1)],
+//!     joint_names: vec![],
+//! };
+//! let mut writer = ResultWriter::create("run.h5".as_ref(), &meta)?;
+//! for step in steps() {
+//!     writer.append(&step)?;
+//! }
+//! writer.finish(layout::STATUS_COMPLETED, 1.5)?;
+//! # Ok(())
+//! # }
+//! ```
+
+pub mod layout;
+mod writer;
+
+pub use writer::{rotation_vector, ResultError, ResultWriter, RunMeta};

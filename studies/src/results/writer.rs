@@ -1,0 +1,781 @@
+//! The incremental HDF5 writer. The layout it produces is documented on the
+//! parent module ([`crate::results`]); the names live in [`super::layout`].
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+use flexmech_integrators::record::StepRecord;
+use hdf5::types::VarLenUnicode;
+use hdf5::{Dataset, Extent, File, H5Type, Location};
+
+use super::layout as names;
+
+/// Rows per chunk of the time series (`T`, `T×3`, `T×4`).
+const SERIES_CHUNK_ROWS: usize = 256;
+/// Elements per chunk of the flat Newton residual history and its offsets.
+const NEWTON_CHUNK: usize = 1024;
+/// Upper bound on the rows (steps) per chunk of `/configuration/*`.
+const CONFIG_CHUNK_ROWS: usize = 16;
+/// Upper bound on the nodes per chunk of `/configuration/*`.
+const CONFIG_CHUNK_NODES: usize = 16_384;
+/// Target size of one `/configuration/*` chunk; it must fit HDF5's default
+/// 1 MiB per-dataset chunk cache, or every one-step write becomes a
+/// read-modify-write of the whole chunk.
+const CONFIG_CHUNK_BYTES: usize = 512 * 1024;
+
+/// What a run is: written once, when the file is created.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RunMeta {
+    /// The model file text; root attribute `model`.
+    pub model_text: String,
+    /// Integrator name; root attribute `integrator` (`"static"` for statics).
+    pub integrator: String,
+    /// Initial position of every node. Its length is the node count every
+    /// [`StepRecord`] must match; displacements are measured from it.
+    pub initial_positions: Vec<[f64; 3]>,
+    /// Tracked nodes as `(label, node index)`: the label, verbatim, names the
+    /// group `/nodes/<label>` holding `position`, `displacement` and `rotation`.
+    pub tracked: Vec<(String, usize)>,
+    /// Joint names in model order: `/joints/<name>` holds `angle`,
+    /// `released_translation` and `constraint_error`. Every [`StepRecord`]
+    /// must carry exactly this many joint records.
+    pub joint_names: Vec<String>,
+}
+
+/// Everything that can go wrong while writing a result file.
+#[derive(Debug, thiserror::Error)]
+pub enum ResultError {
+    /// The HDF5 library reported an error.
+    #[error("{}: HDF5 error while {what}: {source}", .path.display())]
+    Hdf5 {
+        /// The result file.
+        path: PathBuf,
+        /// What was being done, naming the dataset or attribute.
+        what: String,
+        /// The library's error.
+        #[source]
+        source: hdf5::Error,
+    },
+    /// A step record does not match the run's meta data; nothing of the step
+    /// was written and the writer stays usable.
+    #[error(
+        "{}: step {step} (0-based) has {found} {field}, but the run has {expected}",
+        .path.display()
+    )]
+    RecordLength {
+        /// The result file.
+        path: PathBuf,
+        /// Index of the rejected step (= steps written before it).
+        step: usize,
+        /// `"positions"`, `"quaternions"` or `"joints"`.
+        field: &'static str,
+        /// Length given by [`RunMeta`].
+        expected: usize,
+        /// Length found in the record.
+        found: usize,
+    },
+    /// A tracked node refers to a node the run does not have.
+    #[error(
+        "{}: tracked node {label:?} refers to node {index}, but the run has {nodes} nodes",
+        .path.display()
+    )]
+    NodeIndex {
+        /// The result file.
+        path: PathBuf,
+        /// The tracked node's label.
+        label: String,
+        /// The out-of-range index.
+        index: usize,
+        /// Number of nodes (`initial_positions.len()`).
+        nodes: usize,
+    },
+    /// A label or joint name cannot be used verbatim as a group name, or is
+    /// used twice.
+    #[error("{}: {kind} name {name:?} cannot name an HDF5 group: {reason}", .path.display())]
+    InvalidName {
+        /// The result file.
+        path: PathBuf,
+        /// `"node label"` or `"joint"`.
+        kind: &'static str,
+        /// The offending name.
+        name: String,
+        /// Why it is rejected.
+        reason: &'static str,
+    },
+}
+
+/// Attaches the file path and a description of the operation to HDF5 errors.
+trait Context<T> {
+    fn ctx(self, path: &Path, what: impl FnOnce() -> String) -> Result<T, ResultError>;
+}
+
+impl<T> Context<T> for hdf5::Result<T> {
+    fn ctx(self, path: &Path, what: impl FnOnce() -> String) -> Result<T, ResultError> {
+        self.map_err(|source| ResultError::Hdf5 {
+            path: path.to_path_buf(),
+            what: what(),
+            source,
+        })
+    }
+}
+
+/// Rotation vector ψ (axis × angle, |ψ| ≤ π) of the unit quaternion
+/// `q = (w, x, y, z)`.
+///
+/// The quaternion is normalised, its sign chosen so that `w ≥ 0` (q and −q
+/// are the same rotation), and `ψ = 2·atan2(|v|, w)·v/|v|` with `v = (x, y, z)`;
+/// for `|v| < 1e-4` the factor `2·atan2(|v|, w)/|v|` is replaced by its series
+/// `(2/w)(1 − |v|²/(3w²))`, exact to rounding there. A zero or non-finite
+/// quaternion gives NaNs.
+pub fn rotation_vector(q: [f64; 4]) -> [f64; 3] {
+    let norm = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if !(norm.is_finite() && norm > 0.0) {
+        return [f64::NAN; 3];
+    }
+    let sign = if q[0] < 0.0 { -1.0 } else { 1.0 };
+    let s = sign / norm;
+    let (w, v) = (q[0] * s, [q[1] * s, q[2] * s, q[3] * s]);
+    let sin_half = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let factor = if sin_half < 1e-4 {
+        // Here w = sqrt(1 − |v|²) > 0.99999999.
+        2.0 / w * (1.0 - sin_half * sin_half / (3.0 * w * w))
+    } else {
+        2.0 * sin_half.atan2(w) / sin_half
+    };
+    [factor * v[0], factor * v[1], factor * v[2]]
+}
+
+/// Replaces NUL characters (impossible in an HDF5 string) and converts.
+fn varlen(text: &str) -> VarLenUnicode {
+    let clean;
+    let text = if text.contains('\0') {
+        clean = text.replace('\0', "\u{FFFD}");
+        clean.as_str()
+    } else {
+        text
+    };
+    text.parse::<VarLenUnicode>()
+        .unwrap_or_else(|_| VarLenUnicode::new())
+}
+
+fn create_str_attr(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
+    let attr = loc.new_attr::<VarLenUnicode>().shape(()).create(name)?;
+    attr.as_writer().write_scalar(&varlen(value))
+}
+
+fn set_str_attr(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
+    if loc.attr_names()?.iter().any(|n| n == name) {
+        loc.attr(name)?.as_writer().write_scalar(&varlen(value))
+    } else {
+        create_str_attr(loc, name, value)
+    }
+}
+
+fn create_group(
+    file: &File,
+    path: &Path,
+    name: &str,
+    description: &str,
+) -> Result<(), ResultError> {
+    let group = file
+        .create_group(name)
+        .ctx(path, || format!("creating group {name}"))?;
+    create_str_attr(&group, names::ATTR_DESCRIPTION, description)
+        .ctx(path, || format!("writing the description of {name}"))
+}
+
+/// One extendable dataset: rows along the first (unlimited) dimension, fixed
+/// trailing dimensions.
+struct Series {
+    ds: Dataset,
+    name: String,
+    tail: Vec<usize>,
+}
+
+impl Series {
+    /// Creates `name` with `rows` rows of shape `tail`, chunked as `chunk`.
+    fn create<T: H5Type>(
+        file: &File,
+        path: &Path,
+        name: &str,
+        rows: usize,
+        tail: &[usize],
+        chunk: &[usize],
+        description: &str,
+    ) -> Result<Self, ResultError> {
+        let mut extents = Vec::with_capacity(1 + tail.len());
+        extents.push(Extent::new(rows, None));
+        // A zero-length fixed dimension cannot be chunked; leave it unlimited.
+        extents.extend(tail.iter().map(|&d| Extent::new(d, (d > 0).then_some(d))));
+        let ds = file
+            .new_dataset::<T>()
+            .shape(extents)
+            .chunk(chunk.to_vec())
+            .create(name)
+            .ctx(path, || format!("creating dataset {name}"))?;
+        create_str_attr(&ds, names::ATTR_DESCRIPTION, description)
+            .ctx(path, || format!("writing the description of {name}"))?;
+        Ok(Self {
+            ds,
+            name: name.to_owned(),
+            tail: tail.to_vec(),
+        })
+    }
+
+    /// A `T` or `T×n` series, chunked by [`SERIES_CHUNK_ROWS`].
+    fn time_series<T: H5Type>(
+        file: &File,
+        path: &Path,
+        name: &str,
+        tail: &[usize],
+        description: &str,
+    ) -> Result<Self, ResultError> {
+        let mut chunk = vec![SERIES_CHUNK_ROWS];
+        chunk.extend(tail.iter().map(|&d| d.max(1)));
+        Self::create::<T>(file, path, name, 0, tail, &chunk, description)
+    }
+
+    /// Sets the number of rows (grows or shrinks).
+    fn set_rows(&self, rows: usize, path: &Path) -> Result<(), ResultError> {
+        let mut shape = Vec::with_capacity(1 + self.tail.len());
+        shape.push(rows);
+        shape.extend_from_slice(&self.tail);
+        self.ds
+            .resize(shape)
+            .ctx(path, || format!("resizing {} to {rows} rows", self.name))
+    }
+
+    /// Writes `values` into rows `start..start + values.len()` of a 1-D dataset.
+    fn write_values<T: H5Type>(
+        &self,
+        start: usize,
+        values: &[T],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        self.ds
+            .write_slice(values, start..start + values.len())
+            .ctx(path, || format!("writing row {start} of {}", self.name))
+    }
+
+    /// Extends a 1-D series to `t + 1` rows and writes `value` at row `t`.
+    fn push_scalar<T: H5Type>(&self, t: usize, value: T, path: &Path) -> Result<(), ResultError> {
+        self.set_rows(t + 1, path)?;
+        self.write_values(t, &[value], path)
+    }
+
+    /// Extends a `T×N` series to `t + 1` rows and writes `row` at row `t`.
+    fn push_row<const N: usize>(
+        &self,
+        t: usize,
+        row: [f64; N],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        self.set_rows(t + 1, path)?;
+        let rows = [row];
+        self.ds
+            .write_slice::<_, f64, _, _>(&rows[..], (t..t + 1, ..))
+            .ctx(path, || format!("writing row {t} of {}", self.name))
+    }
+
+    /// Extends a `T×n×N` series to `t + 1` rows and writes `block` (n rows of
+    /// N) at row `t`.
+    fn push_block<const N: usize>(
+        &self,
+        t: usize,
+        block: &[[f64; N]],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        self.set_rows(t + 1, path)?;
+        self.ds
+            .write_slice::<_, f64, _, _>(block, (t, .., ..))
+            .ctx(path, || format!("writing row {t} of {}", self.name))
+    }
+}
+
+struct NodeSets {
+    index: usize,
+    position: Series,
+    displacement: Series,
+    rotation: Series,
+}
+
+struct JointSets {
+    angle: Series,
+    released_translation: Series,
+    constraint_error: Series,
+}
+
+/// Every dataset handle of the file, kept open for the whole run.
+struct Datasets {
+    time: Series,
+    kinetic: Series,
+    strain: Series,
+    potential: Series,
+    total: Series,
+    momentum_linear: Series,
+    momentum_angular: Series,
+    iterations: Series,
+    dt: Series,
+    residual: Series,
+    beta: Series,
+    newton_residuals: Series,
+    newton_offsets: Series,
+    nodes: Vec<NodeSets>,
+    joints: Vec<JointSets>,
+    config_position: Series,
+    config_quaternion: Series,
+}
+
+impl Datasets {
+    /// Every dataset with one row per step.
+    fn per_step(&self) -> impl Iterator<Item = &Series> {
+        [
+            &self.time,
+            &self.kinetic,
+            &self.strain,
+            &self.potential,
+            &self.total,
+            &self.momentum_linear,
+            &self.momentum_angular,
+            &self.iterations,
+            &self.dt,
+            &self.residual,
+            &self.beta,
+            &self.config_position,
+            &self.config_quaternion,
+        ]
+        .into_iter()
+        .chain(
+            self.nodes
+                .iter()
+                .flat_map(|n| [&n.position, &n.displacement, &n.rotation]),
+        )
+        .chain(
+            self.joints
+                .iter()
+                .flat_map(|j| [&j.angle, &j.released_translation, &j.constraint_error]),
+        )
+    }
+}
+
+/// Writes a result file step by step (layout: see the [module](crate::results)
+/// documentation).
+///
+/// [`create`](Self::create) writes the root attributes with `status =
+/// "running"` and empty datasets; every [`append`](Self::append) extends each
+/// dataset by one row and flushes the file, so a run that dies leaves a valid
+/// file holding every step appended so far; [`finish`](Self::finish) records
+/// the final status and wall time and closes the file. Dropping the writer
+/// without `finish` closes the file with `status = "running"`.
+pub struct ResultWriter {
+    path: PathBuf,
+    file: File,
+    sets: Datasets,
+    initial_positions: Vec<[f64; 3]>,
+    steps: usize,
+    newton_len: usize,
+    /// An append failed part-way: some datasets may hold an extra row.
+    inconsistent: bool,
+}
+
+impl std::fmt::Debug for ResultWriter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ResultWriter")
+            .field("path", &self.path)
+            .field("nodes", &self.initial_positions.len())
+            .field("tracked", &self.sets.nodes.len())
+            .field("joints", &self.sets.joints.len())
+            .field("steps", &self.steps)
+            .finish_non_exhaustive()
+    }
+}
+
+fn check_names<'a>(
+    path: &Path,
+    kind: &'static str,
+    list: impl Iterator<Item = &'a str>,
+) -> Result<(), ResultError> {
+    let mut seen = HashSet::new();
+    for name in list {
+        let reason = names::invalid_name_reason(name)
+            .or_else(|| (!seen.insert(name)).then_some("used twice"));
+        if let Some(reason) = reason {
+            return Err(ResultError::InvalidName {
+                path: path.to_path_buf(),
+                kind,
+                name: name.to_owned(),
+                reason,
+            });
+        }
+    }
+    Ok(())
+}
+
+impl ResultWriter {
+    /// Creates (or truncates) the file at `path`, writes the root attributes
+    /// `model`, `integrator`, `version` (this crate's version) and `status =
+    /// "running"`, creates every dataset with zero rows, and flushes.
+    ///
+    /// Fails before touching the file if a label or joint name is empty,
+    /// contains `/`, is `.` or is used twice, or if a tracked node index is
+    /// out of range.
+    pub fn create(path: &Path, meta: &RunMeta) -> Result<Self, ResultError> {
+        let n_nodes = meta.initial_positions.len();
+        check_names(
+            path,
+            "node label",
+            meta.tracked.iter().map(|(l, _)| l.as_str()),
+        )?;
+        check_names(path, "joint", meta.joint_names.iter().map(String::as_str))?;
+        if let Some((label, index)) = meta.tracked.iter().find(|(_, i)| *i >= n_nodes) {
+            return Err(ResultError::NodeIndex {
+                path: path.to_path_buf(),
+                label: label.clone(),
+                index: *index,
+                nodes: n_nodes,
+            });
+        }
+
+        let file = File::create(path).ctx(path, || "creating the file".to_owned())?;
+        let attrs = [
+            (names::ATTR_MODEL, meta.model_text.as_str()),
+            (names::ATTR_INTEGRATOR, meta.integrator.as_str()),
+            (names::ATTR_VERSION, env!("CARGO_PKG_VERSION")),
+            (names::ATTR_STATUS, names::STATUS_RUNNING),
+        ];
+        for (name, value) in attrs {
+            create_str_attr(&file, name, value)
+                .ctx(path, || format!("writing root attribute {name}"))?;
+        }
+
+        let groups = [
+            (
+                names::ENERGY,
+                "energies of the whole mechanism at the end of each step",
+            ),
+            (names::MOMENTUM, "total momenta at the end of each step"),
+            (names::SOLVER, "solver statistics of each step"),
+            (names::NODES, "tracked nodes, one group per label"),
+            (names::JOINTS, "joints, one group per name, in model order"),
+            (names::CONFIGURATION, "every node at every stored step"),
+        ];
+        for (name, description) in groups {
+            create_group(&file, path, name, description)?;
+        }
+
+        let f64s = |name: &str, tail: &[usize], description: &str| {
+            Series::time_series::<f64>(&file, path, name, tail, description)
+        };
+        let time = f64s(
+            names::TIME,
+            &[],
+            "time of each stored step (statics: load factor)",
+        )?;
+        let kinetic = f64s(names::ENERGY_KINETIC, &[], "kinetic energy")?;
+        let strain = f64s(names::ENERGY_STRAIN, &[], "strain energy")?;
+        let potential = f64s(
+            names::ENERGY_POTENTIAL,
+            &[],
+            "potential of gravity and dead external loads",
+        )?;
+        let total = f64s(names::ENERGY_TOTAL, &[], "kinetic + strain + potential")?;
+        let momentum_linear = f64s(names::MOMENTUM_LINEAR, &[3], "total linear momentum")?;
+        let momentum_angular = f64s(
+            names::MOMENTUM_ANGULAR,
+            &[3],
+            "total angular momentum about the origin",
+        )?;
+        let iterations = Series::time_series::<u64>(
+            &file,
+            path,
+            names::SOLVER_ITERATIONS,
+            &[],
+            "Newton iterations of the step",
+        )?;
+        let dt = f64s(
+            names::SOLVER_DT,
+            &[],
+            "step size actually used (after halvings)",
+        )?;
+        let residual = f64s(names::SOLVER_RESIDUAL, &[], "final scaled residual norm")?;
+        let beta = f64s(
+            names::SOLVER_BETA,
+            &[],
+            "energy-momentum beta of the step (NaN for other integrators)",
+        )?;
+        let newton_residuals = Series::create::<f64>(
+            &file,
+            path,
+            names::SOLVER_NEWTON_RESIDUALS,
+            0,
+            &[],
+            &[NEWTON_CHUNK],
+            "scaled residual after each Newton iteration (first: before the first solve), \
+             all steps concatenated; see newton_offsets",
+        )?;
+        let newton_offsets = Series::create::<u64>(
+            &file,
+            path,
+            names::SOLVER_NEWTON_OFFSETS,
+            1,
+            &[],
+            &[NEWTON_CHUNK],
+            "T+1 offsets: step k's residuals are newton_residuals[offsets[k]..offsets[k+1]]",
+        )?;
+        newton_offsets.write_values(0, &[0_u64], path)?;
+
+        let mut nodes = Vec::with_capacity(meta.tracked.len());
+        for (label, node) in &meta.tracked {
+            let group = names::node_group(label);
+            create_group(&file, path, &group, "tracked node")?;
+            let g = file
+                .group(&group)
+                .ctx(path, || format!("opening group {group}"))?;
+            let node_attr = g.new_attr::<u64>().shape(()).create(names::ATTR_NODE_INDEX);
+            node_attr
+                .and_then(|a| a.as_writer().write_scalar(&(*node as u64)))
+                .ctx(path, || {
+                    format!("writing {group} attribute {}", names::ATTR_NODE_INDEX)
+                })?;
+            nodes.push(NodeSets {
+                index: *node,
+                position: f64s(
+                    &names::node_path(label, names::NODE_POSITION),
+                    &[3],
+                    "position of the node",
+                )?,
+                displacement: f64s(
+                    &names::node_path(label, names::NODE_DISPLACEMENT),
+                    &[3],
+                    "position minus initial position",
+                )?,
+                rotation: f64s(
+                    &names::node_path(label, names::NODE_ROTATION),
+                    &[3],
+                    "rotation vector (axis times angle, |psi| <= pi) of the node's triad",
+                )?,
+            });
+        }
+
+        let mut joints = Vec::with_capacity(meta.joint_names.len());
+        for (index, name) in meta.joint_names.iter().enumerate() {
+            let group = names::joint_group(name);
+            create_group(&file, path, &group, "joint")?;
+            let g = file
+                .group(&group)
+                .ctx(path, || format!("opening group {group}"))?;
+            let joint_attr = g
+                .new_attr::<u64>()
+                .shape(())
+                .create(names::ATTR_JOINT_INDEX);
+            joint_attr
+                .and_then(|a| a.as_writer().write_scalar(&(index as u64)))
+                .ctx(path, || {
+                    format!("writing {group} attribute {}", names::ATTR_JOINT_INDEX)
+                })?;
+            joints.push(JointSets {
+                angle: f64s(
+                    &names::joint_path(name, names::JOINT_ANGLE),
+                    &[],
+                    "released angle psi",
+                )?,
+                released_translation: f64s(
+                    &names::joint_path(name, names::JOINT_RELEASED_TRANSLATION),
+                    &[3],
+                    "released translation r_R in the master frame",
+                )?,
+                constraint_error: f64s(
+                    &names::joint_path(name, names::JOINT_CONSTRAINT_ERROR),
+                    &[],
+                    "|r_s - r_m - L_m f(psi)| + |L_m^T L_s - exp(psi t^)|_F",
+                )?,
+            });
+        }
+
+        let config = |name: &str, width: usize, description: &str| {
+            let node_chunk = n_nodes.clamp(1, CONFIG_CHUNK_NODES);
+            let rows = (CONFIG_CHUNK_BYTES / (node_chunk * width * 8)).clamp(1, CONFIG_CHUNK_ROWS);
+            let chunk = [rows, node_chunk, width];
+            Series::create::<f64>(&file, path, name, 0, &[n_nodes, width], &chunk, description)
+        };
+        let config_position = config(
+            names::CONFIGURATION_POSITION,
+            3,
+            "position of every node at every stored step (T x nodes x 3)",
+        )?;
+        let config_quaternion = config(
+            names::CONFIGURATION_QUATERNION,
+            4,
+            "rotation of every node's triad from its initial configuration as a unit \
+             quaternion (w, x, y, z) (T x nodes x 4)",
+        )?;
+
+        let sets = Datasets {
+            time,
+            kinetic,
+            strain,
+            potential,
+            total,
+            momentum_linear,
+            momentum_angular,
+            iterations,
+            dt,
+            residual,
+            beta,
+            newton_residuals,
+            newton_offsets,
+            nodes,
+            joints,
+            config_position,
+            config_quaternion,
+        };
+        file.flush().ctx(path, || "flushing the file".to_owned())?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            file,
+            sets,
+            initial_positions: meta.initial_positions.clone(),
+            steps: 0,
+            newton_len: 0,
+            inconsistent: false,
+        })
+    }
+
+    /// Appends one step: extends every dataset by one row (the Newton history
+    /// by `residual_history.len()` entries), writes the step, and flushes the
+    /// file so that the step survives a crash of the process.
+    ///
+    /// A record whose `positions`, `quaternions` or `joints` length differs
+    /// from the [`RunMeta`] is rejected with [`ResultError::RecordLength`]
+    /// before anything is written. If HDF5 fails part-way, the next `append`
+    /// rewrites the same row and `finish` trims the file back to the steps
+    /// written successfully.
+    pub fn append(&mut self, step: &StepRecord) -> Result<(), ResultError> {
+        let t = self.steps;
+        let n_nodes = self.initial_positions.len();
+        let lengths = [
+            ("positions", n_nodes, step.positions.len()),
+            ("quaternions", n_nodes, step.quaternions.len()),
+            ("joints", self.sets.joints.len(), step.joints.len()),
+        ];
+        for (field, expected, found) in lengths {
+            if expected != found {
+                return Err(ResultError::RecordLength {
+                    path: self.path.clone(),
+                    step: t,
+                    field,
+                    expected,
+                    found,
+                });
+            }
+        }
+        match self.write_step(t, step) {
+            Ok(()) => {
+                self.steps += 1;
+                self.newton_len += step.residual_history.len();
+                self.inconsistent = false;
+                Ok(())
+            }
+            Err(e) => {
+                self.inconsistent = true;
+                Err(e)
+            }
+        }
+    }
+
+    fn write_step(&self, t: usize, step: &StepRecord) -> Result<(), ResultError> {
+        let path = self.path.as_path();
+        let s = &self.sets;
+        s.time.push_scalar(t, step.time, path)?;
+        s.kinetic.push_scalar(t, step.energy.kinetic, path)?;
+        s.strain.push_scalar(t, step.energy.strain, path)?;
+        s.potential.push_scalar(t, step.energy.potential, path)?;
+        s.total.push_scalar(t, step.energy.total, path)?;
+        s.momentum_linear.push_row(t, step.momentum_linear, path)?;
+        s.momentum_angular
+            .push_row(t, step.momentum_angular, path)?;
+        s.iterations.push_scalar(t, step.iterations as u64, path)?;
+        s.dt.push_scalar(t, step.dt, path)?;
+        s.residual.push_scalar(t, step.residual, path)?;
+        s.beta.push_scalar(t, step.beta, path)?;
+
+        let history = &step.residual_history;
+        let end = self.newton_len + history.len();
+        s.newton_residuals.set_rows(end, path)?;
+        s.newton_residuals
+            .write_values(self.newton_len, history, path)?;
+        s.newton_offsets.set_rows(t + 2, path)?;
+        s.newton_offsets.write_values(t + 1, &[end as u64], path)?;
+
+        for node in &s.nodes {
+            let p = step.positions[node.index];
+            let p0 = self.initial_positions[node.index];
+            node.position.push_row(t, p, path)?;
+            node.displacement
+                .push_row(t, [p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]], path)?;
+            node.rotation
+                .push_row(t, rotation_vector(step.quaternions[node.index]), path)?;
+        }
+        for (joint, record) in s.joints.iter().zip(&step.joints) {
+            joint.angle.push_scalar(t, record.angle, path)?;
+            joint
+                .released_translation
+                .push_row(t, record.released_translation, path)?;
+            joint
+                .constraint_error
+                .push_scalar(t, record.constraint_error, path)?;
+        }
+        s.config_position.push_block(t, &step.positions, path)?;
+        s.config_quaternion.push_block(t, &step.quaternions, path)?;
+
+        self.file
+            .flush()
+            .ctx(path, || format!("flushing after step {t}"))
+    }
+
+    /// Sets the root attributes `status` (`"completed"` or `"failed:
+    /// <reason>"`, see [`layout::failed_status`](super::layout::failed_status))
+    /// and `wall_time_s`, and closes the file. Returns its path.
+    pub fn finish(self, status: &str, wall_time_s: f64) -> Result<PathBuf, ResultError> {
+        let Self {
+            path,
+            file,
+            sets,
+            steps,
+            newton_len,
+            inconsistent,
+            ..
+        } = self;
+        if inconsistent {
+            // Trim rows a failed append may have added.
+            for series in sets.per_step() {
+                series.set_rows(steps, &path)?;
+            }
+            sets.newton_residuals.set_rows(newton_len, &path)?;
+            sets.newton_offsets.set_rows(steps + 1, &path)?;
+        }
+        set_str_attr(&file, names::ATTR_STATUS, status).ctx(&path, || {
+            format!("writing root attribute {}", names::ATTR_STATUS)
+        })?;
+        file.new_attr::<f64>()
+            .shape(())
+            .create(names::ATTR_WALL_TIME)
+            .and_then(|a| a.as_writer().write_scalar(&wall_time_s))
+            .ctx(&path, || {
+                format!("writing root attribute {}", names::ATTR_WALL_TIME)
+            })?;
+        drop(sets);
+        file.close().ctx(&path, || "closing the file".to_owned())?;
+        Ok(path)
+    }
+
+    /// Number of steps appended successfully (`T`).
+    pub fn steps_written(&self) -> usize {
+        self.steps
+    }
+
+    /// Path of the file being written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}

@@ -1,0 +1,173 @@
+//! Running one model: build it, solve it, stream every kept step into its
+//! HDF5 result file. A run that fails part-way still leaves a valid file with
+//! `status = "failed: …"` and every step computed before the failure.
+
+use crate::build::{build, Built};
+use crate::model::{Analysis, Model, ModelError};
+use crate::results::{layout, ResultError, ResultWriter, RunMeta};
+use flexmech_integrators::{solve_static, NewtonSettings, SolveError, StaticSettings, StepRecord};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use thiserror::Error;
+
+/// Why a run did not complete.
+#[derive(Debug, Error)]
+pub enum RunError {
+    /// The model could not be loaded or built.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The output directory could not be created.
+    #[error("cannot create the output directory {dir}: {source}")]
+    OutputDir {
+        dir: PathBuf,
+        source: std::io::Error,
+    },
+    /// Writing the result file failed.
+    #[error(transparent)]
+    Result(#[from] ResultError),
+    /// The solver stopped; `file` holds the steps computed before.
+    #[error("{model}: {error} (steps computed so far are in {})", file.display())]
+    Solve {
+        model: String,
+        error: SolveError,
+        file: PathBuf,
+    },
+}
+
+/// What a completed run reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSummary {
+    /// The result file.
+    pub file: PathBuf,
+    /// Converged steps.
+    pub steps: usize,
+    /// Steps written (every `output.every`-th and the last).
+    pub written: usize,
+    /// Total Newton iterations.
+    pub iterations: usize,
+    /// Wall time of the solve, seconds.
+    pub wall_time_s: f64,
+}
+
+/// Keeps every `every`-th step and always the last one.
+struct Sink {
+    writer: ResultWriter,
+    every: usize,
+    count: usize,
+    iterations: usize,
+    pending: Option<StepRecord>,
+    error: Option<ResultError>,
+}
+
+impl Sink {
+    fn push(&mut self, step: &StepRecord) {
+        self.count += 1;
+        self.iterations += step.iterations;
+        if self.error.is_some() {
+            return;
+        }
+        if self.count.is_multiple_of(self.every) {
+            self.pending = None;
+            if let Err(e) = self.writer.append(step) {
+                self.error = Some(e);
+            }
+        } else {
+            self.pending = Some(step.clone());
+        }
+    }
+
+    fn flush_last(&mut self) {
+        if let (Some(step), None) = (self.pending.take(), &self.error) {
+            if let Err(e) = self.writer.append(&step) {
+                self.error = Some(e);
+            }
+        }
+    }
+}
+
+/// Runs `model` and writes `out_dir/<name>.h5`.
+pub fn run_model(model: &Model, out_dir: &Path) -> Result<RunSummary, RunError> {
+    let built: Built = build(model)?;
+    std::fs::create_dir_all(out_dir).map_err(|source| RunError::OutputDir {
+        dir: out_dir.to_path_buf(),
+        source,
+    })?;
+    let file = out_dir.join(format!("{}.h5", model.name));
+    let mech = &built.mechanism;
+    let meta = RunMeta {
+        model_text: model.source_text.clone(),
+        integrator: match model.solver.analysis {
+            Analysis::Static { .. } => "static".to_string(),
+            Analysis::Dynamic { integrator, .. } => integrator.name().to_string(),
+        },
+        initial_positions: mech
+            .mesh
+            .positions
+            .iter()
+            .map(|x| [x.x, x.y, x.z])
+            .collect(),
+        tracked: model
+            .output
+            .track
+            .iter()
+            .map(|(label, r)| (label.clone(), built.node(*r)))
+            .collect(),
+        joint_names: model.joints.iter().map(|j| j.name.clone()).collect(),
+    };
+    let writer = ResultWriter::create(&file, &meta)?;
+    let mut sink = Sink {
+        writer,
+        every: model.output.every.max(1),
+        count: 0,
+        iterations: 0,
+        pending: None,
+        error: None,
+    };
+    let start = Instant::now();
+    let outcome = match model.solver.analysis {
+        Analysis::Static { load_steps } => {
+            let settings = StaticSettings {
+                load_steps,
+                newton: NewtonSettings {
+                    tolerance: model.solver.tolerance,
+                    max_iterations: model.solver.max_iterations,
+                },
+                max_halvings: model.solver.max_halvings,
+            };
+            solve_static(mech, &settings, |s| sink.push(s)).map(|_| ())
+        }
+        Analysis::Dynamic { .. } => unreachable!("rejected by build"),
+    };
+    let wall = start.elapsed().as_secs_f64();
+    sink.flush_last();
+    if let Some(e) = sink.error.take() {
+        // The file is as valid as HDF5 left it; report the write failure.
+        let _ = sink
+            .writer
+            .finish(&layout::failed_status(&e.to_string()), wall);
+        return Err(e.into());
+    }
+    let written = sink.writer.steps_written();
+    match outcome {
+        Ok(()) => {
+            let file = sink.writer.finish(layout::STATUS_COMPLETED, wall)?;
+            Ok(RunSummary {
+                file,
+                steps: sink.count,
+                written,
+                iterations: sink.iterations,
+                wall_time_s: wall,
+            })
+        }
+        Err(error) => {
+            let file = sink
+                .writer
+                .finish(&layout::failed_status(&error.to_string()), wall)?;
+            Err(RunError::Solve {
+                model: model.name.clone(),
+                error,
+                file,
+            })
+        }
+    }
+}

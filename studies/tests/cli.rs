@@ -1,0 +1,117 @@
+//! The `flexmech` binary as a user meets it: runs that succeed write result
+//! files; bad input prints a message naming the file, key and problem and
+//! exits non-zero without losing the other models' results.
+
+use std::path::Path;
+use std::process::Command;
+
+fn flexmech() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_flexmech"))
+}
+
+fn bench(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../data/benchmarks")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+#[test]
+fn run_writes_one_result_file_per_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = flexmech()
+        .args([
+            "run",
+            &bench("rollup_linear.toml"),
+            &bench("bathe_bolourchi.toml"),
+            "--out",
+        ])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.path().join("rollup-linear.h5").is_file());
+    assert!(dir.path().join("bathe-bolourchi.h5").is_file());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("completed"), "{stdout}");
+}
+
+#[test]
+fn bad_model_is_a_clear_error_and_good_ones_still_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    let text = std::fs::read_to_string(bench("rollup_linear.toml"))
+        .unwrap()
+        .replace("load_steps = 10", "load_steps = 10\ndt = -0.5");
+    std::fs::write(&bad, text).unwrap();
+    let out = flexmech()
+        .args(["run"])
+        .arg(&bad)
+        .arg(bench("rollup_quadratic.toml"))
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("bad.toml") && stderr.contains("solver.dt"),
+        "{stderr}"
+    );
+    // The good model after the bad one was still solved.
+    assert!(dir.path().join("rollup-quadratic.h5").is_file());
+}
+
+#[test]
+fn missing_file_and_unsupported_features_are_named() {
+    let out = flexmech()
+        .args(["run", "/nonexistent/model.toml"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("/nonexistent/model.toml") && stderr.contains("cannot read"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn failed_solve_keeps_a_valid_file_with_the_steps_so_far() {
+    // Ten turns in one step with no halvings and two iterations cannot converge.
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("hard.toml");
+    let text = std::fs::read_to_string(bench("rollup_linear.toml"))
+        .unwrap()
+        .replace("load_steps = 10", "load_steps = 4\nmax_halvings = 0")
+        .replace("max_iterations = 30", "max_iterations = 4")
+        .replace(
+            "moment = [0.0, 0.0, 62.83185307179586]",
+            "moment = [0.0, 0.0, 628.3185307179586]",
+        );
+    std::fs::write(&model, text).unwrap();
+    let out = flexmech()
+        .arg("run")
+        .arg(&model)
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("no convergence"), "{stderr}");
+    let f = hdf5::File::open(dir.path().join("rollup-linear.h5")).unwrap();
+    let status: hdf5::types::VarLenUnicode = f.attr("status").unwrap().read_scalar().unwrap();
+    assert!(
+        status.as_str().starts_with("failed: no convergence"),
+        "{status}"
+    );
+    let t: Vec<f64> = f.dataset("/time").unwrap().read_raw().unwrap();
+    let pos = f.dataset("/configuration/position").unwrap();
+    assert_eq!(pos.shape()[0], t.len());
+}
