@@ -32,6 +32,8 @@ struct Work {
 pub struct Assembler {
     pattern: SymbolicSparseColMat<usize>,
     slots: Vec<Slots>,
+    /// Extra dense blocks (joints' configuration-dependent terms).
+    blocks: Vec<Slots>,
     work: Vec<Work>,
     /// CSC values of the reduced tangent after [`Assembler::assemble`].
     pub values: Vec<f64>,
@@ -43,8 +45,10 @@ pub struct Assembler {
 }
 
 impl Assembler {
-    /// Builds the pattern for `mesh` with the unknowns of `dofs`.
-    pub fn new(mesh: &Mesh, dofs: &DofMap) -> Self {
+    /// Builds the pattern for `mesh` with the unknowns of `dofs`, plus one
+    /// dense block over each equation list of `blocks` (added later with
+    /// [`Assembler::add_block`]).
+    pub fn new(mesh: &Mesh, dofs: &DofMap, blocks: &[Vec<usize>]) -> Self {
         let n = dofs.n_eq;
         let mut cols: Vec<Vec<usize>> = vec![Vec::new(); n];
         for (e, c) in cols.iter_mut().enumerate() {
@@ -76,6 +80,16 @@ impl Assembler {
                 pos: Vec::new(),
             });
         }
+        let mut extra: Vec<Slots> = Vec::with_capacity(blocks.len());
+        for eqs in blocks {
+            for &j in eqs {
+                cols[j].extend(eqs.iter().copied());
+            }
+            extra.push(Slots {
+                eqs: eqs.clone(),
+                pos: Vec::new(),
+            });
+        }
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();
         col_ptr.push(0);
@@ -85,7 +99,7 @@ impl Assembler {
             row_idx.extend(c.iter().copied());
             col_ptr.push(row_idx.len());
         }
-        for s in &mut slots {
+        for s in slots.iter_mut().chain(extra.iter_mut()) {
             let m = s.eqs.len();
             s.pos = Vec::with_capacity(m * m);
             for &cj in &s.eqs {
@@ -103,6 +117,7 @@ impl Assembler {
         Self {
             pattern,
             slots,
+            blocks: extra,
             work,
             values: vec![0.0; nnz],
             nodal: vec![0.0; 6 * mesh.node_count()],
@@ -159,6 +174,14 @@ impl Assembler {
             for (&p, &v) in s.pos.iter().zip(w.k_red.as_slice()) {
                 self.values[p] += v;
             }
+        }
+    }
+
+    /// Adds the dense matrix `m` (column-major over block `b`'s equations) to
+    /// the tangent values.
+    pub fn add_block(&mut self, b: usize, m: &DMatrix<f64>) {
+        for (&p, &v) in self.blocks[b].pos.iter().zip(m.as_slice()) {
+            self.values[p] += v;
         }
     }
 }

@@ -3,6 +3,7 @@
 //! the time integrators).
 
 pub mod assembly;
+pub mod constraints;
 pub mod dofs;
 pub mod error;
 pub mod linsolve;
@@ -11,8 +12,9 @@ pub mod newton;
 pub mod record;
 pub mod statics;
 
+pub use constraints::{MechanismState, Topology};
 pub use error::{NewtonFailure, SolveError};
-pub use mechanism::{Mechanism, NodalLoad, Schedule};
+pub use mechanism::{JointInstance, Mechanism, NodalLoad, PrescribedDof, Schedule};
 pub use newton::NewtonSettings;
 pub use record::{Energies, JointRecord, StepRecord};
 pub use statics::{solve_static, StaticOutcome, StaticSettings};

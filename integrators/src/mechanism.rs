@@ -2,6 +2,7 @@
 //! is handed. Nothing here reads files; the model loader builds it.
 
 use flexmech_core::Mesh;
+use flexmech_joints::{JointMap, ReleasedState};
 use nalgebra::Vector3;
 use std::fmt;
 use std::sync::Arc;
@@ -44,6 +45,29 @@ pub struct NodalLoad {
     pub scale: Schedule,
 }
 
+/// A joint of the mechanism: master–slave relation (1) between two nodes.
+#[derive(Debug, Clone)]
+pub struct JointInstance {
+    pub name: String,
+    pub master: usize,
+    pub slave: usize,
+    /// The joint kind's kinematics and derived maps.
+    pub map: Arc<dyn JointMap>,
+    /// Released coordinates at t = 0.
+    pub initial: ReleasedState,
+    /// Per released coordinate: `Some(value(t))` when it is driven.
+    pub driven: Vec<Option<Schedule>>,
+}
+
+/// A nodal DOF (0..6 = ux, uy, uz, rx, ry, rz) that follows `value(t)`:
+/// displacement from the initial position, or rotation about the global axis.
+#[derive(Debug, Clone)]
+pub struct PrescribedDof {
+    pub node: usize,
+    pub dof: usize,
+    pub value: Schedule,
+}
+
 /// Everything a solver needs about the mechanism.
 #[derive(Debug, Clone)]
 pub struct Mechanism {
@@ -55,6 +79,10 @@ pub struct Mechanism {
     pub gravity: Vector3<f64>,
     /// Scale of gravity over time (statics: ramped with the load factor).
     pub gravity_scale: Schedule,
+    /// Joints (any order; chains allowed, cycles refused).
+    pub joints: Vec<JointInstance>,
+    /// Prescribed nodal DOFs.
+    pub prescribed: Vec<PrescribedDof>,
 }
 
 impl Mechanism {
@@ -67,6 +95,8 @@ impl Mechanism {
             loads: Vec::new(),
             gravity: Vector3::zeros(),
             gravity_scale: Schedule::constant(1.0),
+            joints: Vec::new(),
+            prescribed: Vec::new(),
         }
     }
 

@@ -6,7 +6,7 @@
 //! exactly; halvings only insert levels between them.
 
 use crate::assembly::Assembler;
-use crate::dofs::DofMap;
+use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::{NewtonFailure, SolveError};
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
@@ -32,6 +32,8 @@ pub struct StaticSettings {
 pub struct StaticOutcome {
     /// Final configuration.
     pub config: Configuration,
+    /// Final state including the joints' released coordinates.
+    pub state: MechanismState,
     /// Converged steps (including those after halvings).
     pub steps: usize,
 }
@@ -39,9 +41,9 @@ pub struct StaticOutcome {
 /// The static problem at one load factor: the [`NewtonSystem`] Newton solves.
 struct StaticProblem<'a> {
     mech: &'a Mechanism,
-    dofs: &'a DofMap,
+    topo: Topology,
     asm: Assembler,
-    config: Configuration,
+    state: MechanismState,
     fext: Vec<f64>,
     nodal_r: Vec<f64>,
     scratch: Vec<f64>,
@@ -49,14 +51,26 @@ struct StaticProblem<'a> {
 
 impl NewtonSystem for StaticProblem<'_> {
     fn evaluate(&mut self, r: &mut [f64]) -> f64 {
-        self.asm.assemble(&self.mech.mesh, self.dofs, &self.config);
+        self.topo.refresh(self.mech, &self.state);
+        self.asm
+            .assemble(&self.mech.mesh, &self.topo.dofs, &self.state.config);
         for ((g, fi), fe) in self.nodal_r.iter_mut().zip(&self.asm.nodal).zip(&self.fext) {
             *g = fi - fe;
         }
-        self.dofs.reduce(&self.nodal_r, r);
-        self.dofs.reduce(&self.fext, &mut self.scratch);
+        self.topo.dofs.reduce(&self.nodal_r, r);
+        for (b, block) in self
+            .topo
+            .geometric_blocks(self.mech, &self.state, &self.nodal_r)
+            .iter()
+            .enumerate()
+        {
+            self.asm.add_block(b, block);
+        }
+        self.topo.dofs.reduce(&self.fext, &mut self.scratch);
         let f_ext = norm(&self.scratch);
-        self.dofs.reduce(&self.asm.nodal_abs, &mut self.scratch);
+        self.topo
+            .dofs
+            .reduce(&self.asm.nodal_abs, &mut self.scratch);
         f_ext.max(norm(&self.scratch))
     }
 
@@ -65,16 +79,7 @@ impl NewtonSystem for StaticProblem<'_> {
     }
 
     fn apply(&mut self, dq: &[f64]) {
-        for n in 0..self.config.x.len() {
-            let p = self.dofs.node_increment(n, dq);
-            if p != nalgebra::Vector6::zeros() {
-                self.config.increment(
-                    n,
-                    &p.fixed_rows::<3>(0).into_owned(),
-                    &p.fixed_rows::<3>(3).into_owned(),
-                );
-            }
-        }
+        self.topo.apply(self.mech, &mut self.state, dq);
     }
 }
 
@@ -98,12 +103,13 @@ pub fn strain_energy(mech: &Mechanism, config: &Configuration) -> f64 {
 /// which are not conservative in 3D, are left out of it).
 fn record(
     mech: &Mechanism,
-    config: &Configuration,
+    state: &MechanismState,
     fext: &[f64],
     time: f64,
     dt: f64,
     report: &newton::NewtonReport,
 ) -> StepRecord {
+    let config = &state.config;
     let strain = strain_energy(mech, config);
     let potential: f64 = -(0..config.x.len())
         .map(|n| {
@@ -133,7 +139,7 @@ fn record(
                 [q.x, q.y, q.z, q.w]
             })
             .collect(),
-        joints: Vec::new(),
+        joints: joint_records(mech, state),
     }
 }
 
@@ -149,16 +155,18 @@ pub fn solve_static(
             "load_steps must be at least 1".into(),
         ));
     }
-    let dofs = DofMap::independent(&mech.fixed);
-    let n = dofs.n_eq;
-    let asm = Assembler::new(&mech.mesh, &dofs);
+    let mut state = initial_state(mech);
+    let topo = Topology::new(mech, &state)?;
+    topo.impose(mech, &mut state, 0.0);
+    let n = topo.dofs.n_eq;
+    let asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
     let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
     let nodes = mech.mesh.node_count();
     let mut prob = StaticProblem {
         mech,
-        dofs: &dofs,
+        topo,
         asm,
-        config: Configuration::initial(&mech.mesh.positions),
+        state,
         fext: vec![0.0; 6 * nodes],
         nodal_r: vec![0.0; 6 * nodes],
         scratch: vec![0.0; n],
@@ -173,7 +181,8 @@ pub fn solve_static(
         let next_planned = ((lambda / nominal + 1e-9).floor() + 1.0) * nominal;
         let target = (lambda + step).min(next_planned);
         let target = if target > 1.0 - 1e-12 { 1.0 } else { target };
-        let saved = prob.config.clone();
+        let saved = prob.state.clone();
+        prob.topo.impose(mech, &mut prob.state, target);
         mech.external_forces(target, &mut prob.fext);
         match newton::solve(&mut prob, &mut lu, &settings.newton, &mut r, &mut dq) {
             Ok(report) => {
@@ -182,14 +191,14 @@ pub fn solve_static(
                 steps += 1;
                 halvings = 0;
                 easy += 1;
-                on_step(&record(mech, &prob.config, &prob.fext, lambda, dt, &report));
+                on_step(&record(mech, &prob.state, &prob.fext, lambda, dt, &report));
                 if easy >= 3 && step < nominal {
                     step = (2.0 * step).min(nominal);
                     easy = 0;
                 }
             }
             Err(reason) => {
-                prob.config = saved;
+                prob.state = saved;
                 if let NewtonFailure::LinearSolve(msg) = &reason {
                     if lambda == 0.0 && halvings == 0 {
                         // A singular tangent at the undeformed state will not be
@@ -211,7 +220,8 @@ pub fn solve_static(
         }
     }
     Ok(StaticOutcome {
-        config: prob.config,
+        config: prob.state.config.clone(),
+        state: prob.state,
         steps,
     })
 }

@@ -88,7 +88,7 @@ fn end_moment_rolls_the_cantilever_into_a_circle() {
 /// returns the reduced residual norm after the step.
 fn residual_after_one_step(mech: &Mechanism, converged: &Configuration, eps: f64) -> f64 {
     let dofs = DofMap::independent(&mech.fixed);
-    let mut asm = Assembler::new(&mech.mesh, &dofs);
+    let mut asm = Assembler::new(&mech.mesh, &dofs, &[]);
     let mut lu = SparseLu::new(asm.pattern().clone()).unwrap();
     let mut fext = vec![0.0; 6 * mech.mesh.node_count()];
     mech.external_forces(1.0, &mut fext);

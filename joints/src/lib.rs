@@ -1,1 +1,34 @@
+//! flexmech-joints: master–slave joints (paper §2–3).
+//!
+//! Every joint kind is one small file implementing either
+//! [`DependentJoint`] (one released rotation `ψ` about `t` and a released
+//! translation `r_R = f(ψ)`: revolute, screw, rack-and-pinion, cam, lobe, and
+//! any profile a user writes) or [`JointKinematics`] (rigid, spherical,
+//! prismatic, cylindrical). The shared mechanism in [`kinematics`] derives the
+//! variational map `N`, its derivative and the exact placement of the slave by
+//! automatic differentiation; [`dependent`] derives `f′`, the secant `G` and
+//! the incremental map `Ñ`.
 
+pub mod cam;
+pub mod cylindrical;
+pub mod dependent;
+pub mod kinematics;
+pub mod lobe;
+pub mod prismatic;
+pub mod rack_pinion;
+pub mod revolute;
+pub mod rigid;
+pub mod screw;
+pub mod spherical;
+
+pub use cam::Cam;
+pub use cylindrical::Cylindrical;
+pub use dependent::{DependentJoint, DependentJointMaps};
+pub use kinematics::{JointKinematics, JointMap, ReleasedState, LOCAL, MAX_RELEASED};
+pub use lobe::{Lift, Lobe, PeriodicSpline};
+pub use prismatic::Prismatic;
+pub use rack_pinion::RackPinion;
+pub use revolute::Revolute;
+pub use rigid::Rigid;
+pub use screw::Screw;
+pub use spherical::Spherical;

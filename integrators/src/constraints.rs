@@ -1,0 +1,311 @@
+//! Joints in the solvers: the order in which slaves are placed, the reduced
+//! unknowns (free nodal DOFs + released coordinates that are not driven), the
+//! node maps `Tₙ` (slaves: `T_s = N [T_m; E]`, paper eqs 5–8), the exact
+//! placement of every slave after an increment, and the configuration-dependent
+//! part of the tangent, `∂(Nᵀ g)/∂q`.
+
+use crate::dofs::{DofMap, NodeMap};
+use crate::error::SolveError;
+use crate::mechanism::Mechanism;
+use crate::record::JointRecord;
+use flexmech_core::Configuration;
+use flexmech_joints::{ReleasedState, LOCAL};
+use nalgebra::{DMatrix, Matrix3, Vector3, Vector6};
+
+/// Positions and rotations of every node and the released coordinates of
+/// every joint: the complete state of a mechanism.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MechanismState {
+    pub config: Configuration,
+    pub released: Vec<ReleasedState>,
+    /// Current value of every prescribed nodal DOF (same order as
+    /// [`Mechanism::prescribed`]).
+    pub prescribed: Vec<f64>,
+}
+
+/// The joint structure of a mechanism, fixed for a run.
+#[derive(Debug, Clone)]
+pub struct Topology {
+    /// Joints in placement order: every joint after the joint (if any) whose
+    /// slave is its master.
+    pub order: Vec<usize>,
+    /// For each node, the joint of which it is the slave.
+    pub slave_of: Vec<Option<usize>>,
+    /// For each joint and released coordinate, its equation (`None` if driven).
+    pub released_eqs: Vec<Vec<Option<usize>>>,
+    /// For each joint, its local equations: the master's, then its released ones.
+    pub local_eqs: Vec<Vec<usize>>,
+    /// The node maps (structure fixed; slave columns refreshed by [`Topology::refresh`]).
+    pub dofs: DofMap,
+}
+
+impl Topology {
+    /// Orders the joints, numbers the unknowns and builds the node maps at `state`.
+    pub fn new(mech: &Mechanism, state: &MechanismState) -> Result<Self, SolveError> {
+        let nodes = mech.mesh.node_count();
+        let mut slave_of: Vec<Option<usize>> = vec![None; nodes];
+        for (j, joint) in mech.joints.iter().enumerate() {
+            if joint.slave >= nodes || joint.master >= nodes {
+                return Err(SolveError::InvalidMechanism(format!(
+                    "joint `{}` names a node that does not exist",
+                    joint.name
+                )));
+            }
+            if let Some(other) = slave_of[joint.slave] {
+                return Err(SolveError::InvalidMechanism(format!(
+                    "node {} is the slave of joints `{}` and `{}`",
+                    joint.slave, mech.joints[other].name, joint.name
+                )));
+            }
+            slave_of[joint.slave] = Some(j);
+        }
+        // Depth of each joint along its chain of masters; a cycle never ends.
+        let mut depth = vec![0usize; mech.joints.len()];
+        for (j, d) in depth.iter_mut().enumerate() {
+            let mut node = mech.joints[j].master;
+            while let Some(k) = slave_of[node] {
+                *d += 1;
+                if *d > mech.joints.len() {
+                    return Err(SolveError::InvalidMechanism(format!(
+                        "joint `{}` is part of a cycle of joints",
+                        mech.joints[j].name
+                    )));
+                }
+                node = mech.joints[k].master;
+            }
+        }
+        let mut order: Vec<usize> = (0..mech.joints.len()).collect();
+        order.sort_by_key(|&j| (depth[j], j));
+
+        // Unknowns: free DOFs of independent nodes, then released coordinates.
+        let mut held = mech.fixed.clone();
+        for p in &mech.prescribed {
+            held[p.node][p.dof] = true;
+        }
+        let mut n_eq = 0;
+        let mut maps: Vec<NodeMap> = vec![NodeMap::default(); nodes];
+        for n in 0..nodes {
+            if slave_of[n].is_some() {
+                continue;
+            }
+            for d in 0..6 {
+                if !held[n][d] {
+                    maps[n].eqs.push(n_eq);
+                    maps[n].cols.push(Vector6::ith(d, 1.0));
+                    n_eq += 1;
+                }
+            }
+        }
+        let mut released_eqs: Vec<Vec<Option<usize>>> = Vec::with_capacity(mech.joints.len());
+        for joint in &mech.joints {
+            let eqs: Vec<Option<usize>> = (0..joint.map.released_count())
+                .map(|c| {
+                    if joint.driven.get(c).is_some_and(Option::is_some) {
+                        None
+                    } else {
+                        n_eq += 1;
+                        Some(n_eq - 1)
+                    }
+                })
+                .collect();
+            released_eqs.push(eqs);
+        }
+        let mut local_eqs = vec![Vec::new(); mech.joints.len()];
+        for &j in &order {
+            let joint = &mech.joints[j];
+            let mut eqs = maps[joint.master].eqs.clone();
+            eqs.extend(released_eqs[j].iter().flatten());
+            maps[joint.slave].eqs = eqs.clone();
+            maps[joint.slave].cols = vec![Vector6::zeros(); eqs.len()];
+            local_eqs[j] = eqs;
+        }
+        let mut topo = Self {
+            order,
+            slave_of,
+            released_eqs,
+            local_eqs,
+            dofs: DofMap { n_eq, nodes: maps },
+        };
+        topo.refresh(mech, state);
+        Ok(topo)
+    }
+
+    /// Recomputes the slaves' node maps `T_s = N [T_m; E]` at `state`.
+    pub fn refresh(&mut self, mech: &Mechanism, state: &MechanismState) {
+        for &j in &self.order {
+            let joint = &mech.joints[j];
+            let m = joint.master;
+            let n =
+                joint
+                    .map
+                    .variation(&state.config.x[m], &state.config.rot[m], &state.released[j]);
+            let nm = n.fixed_columns::<6>(0).into_owned();
+            let master_cols = self.dofs.nodes[m].cols.clone();
+            let mut cols: Vec<Vector6<f64>> = master_cols.iter().map(|c| nm * c).collect();
+            for (c, eq) in self.released_eqs[j].iter().enumerate() {
+                if eq.is_some() {
+                    cols.push(n.column(6 + c).into_owned());
+                }
+            }
+            self.dofs.nodes[joint.slave].cols = cols;
+        }
+    }
+
+    /// The local-to-global map of joint `j`: rows 0..6 the master's node map,
+    /// rows 6.. the released coordinates; columns follow `local_eqs[j]`.
+    fn local_map(&self, mech: &Mechanism, j: usize) -> DMatrix<f64> {
+        let joint = &mech.joints[j];
+        let eqs = &self.local_eqs[j];
+        let mut l = DMatrix::zeros(LOCAL, eqs.len());
+        let master = &self.dofs.nodes[joint.master];
+        for (k, col) in master.cols.iter().enumerate() {
+            l.fixed_view_mut::<6, 1>(0, k).copy_from(col);
+        }
+        let mut k = master.eqs.len();
+        for (c, eq) in self.released_eqs[j].iter().enumerate() {
+            if eq.is_some() {
+                l[(6 + c, k)] = 1.0;
+                k += 1;
+            }
+        }
+        l
+    }
+
+    /// The joints' contribution to the reduced tangent, `Σ_j L_jᵀ ∂(N_jᵀ g_s)/∂q L_j`,
+    /// for nodal residuals `g` (internal − external, 6 per node). Slaves deepest
+    /// in a chain go first and hand `N_{s,m}ᵀ g_s` to their master, whose own
+    /// joint then carries it on. Returns one dense block per joint, over
+    /// `local_eqs[j]`.
+    pub fn geometric_blocks(
+        &self,
+        mech: &Mechanism,
+        state: &MechanismState,
+        g: &[f64],
+    ) -> Vec<DMatrix<f64>> {
+        let mut acc = g.to_vec();
+        let mut blocks = vec![DMatrix::zeros(0, 0); mech.joints.len()];
+        for &j in self.order.iter().rev() {
+            let joint = &mech.joints[j];
+            let (m, s) = (joint.master, joint.slave);
+            let gs = Vector6::from_column_slice(&acc[6 * s..6 * s + 6]);
+            let (ntg, h) = joint.map.transfer(
+                &state.config.x[m],
+                &state.config.rot[m],
+                &state.released[j],
+                &gs,
+            );
+            for d in 0..6 {
+                acc[6 * m + d] += ntg[d];
+            }
+            let l = self.local_map(mech, j);
+            let hd = DMatrix::from_column_slice(LOCAL, LOCAL, h.as_slice());
+            blocks[j] = l.transpose() * hd * &l;
+        }
+        blocks
+    }
+
+    /// Applies a Newton increment: independent nodes, then released
+    /// coordinates and the exact placement of every slave.
+    pub fn apply(&self, mech: &Mechanism, state: &mut MechanismState, dq: &[f64]) {
+        for n in 0..state.config.x.len() {
+            if self.slave_of[n].is_none() {
+                let p = self.dofs.node_increment(n, dq);
+                if p != Vector6::zeros() {
+                    state.config.increment(
+                        n,
+                        &p.fixed_rows::<3>(0).into_owned(),
+                        &p.fixed_rows::<3>(3).into_owned(),
+                    );
+                }
+            }
+        }
+        for &j in &self.order {
+            let delta: Vec<f64> = self.released_eqs[j]
+                .iter()
+                .map(|eq| eq.map_or(0.0, |e| dq[e]))
+                .collect();
+            if delta.iter().any(|&d| d != 0.0) {
+                mech.joints[j].map.advance(&mut state.released[j], &delta);
+            }
+        }
+        self.place_slaves(mech, state);
+    }
+
+    /// Places every slave exactly by relation (1), masters first.
+    pub fn place_slaves(&self, mech: &Mechanism, state: &mut MechanismState) {
+        for &j in &self.order {
+            let joint = &mech.joints[j];
+            let (x, r) = joint.map.slave(
+                &state.config.x[joint.master],
+                &state.config.rot[joint.master],
+                &state.released[j],
+            );
+            state.config.x[joint.slave] = x;
+            state.config.rot[joint.slave] = r;
+        }
+    }
+
+    /// Moves driven coordinates and prescribed nodal DOFs to their values at
+    /// time `t` and re-places the slaves. A prescribed rotation DOF `d` turns
+    /// the node about the global axis `d` by the change of its value.
+    pub fn impose(&self, mech: &Mechanism, state: &mut MechanismState, t: f64) {
+        for (k, p) in mech.prescribed.iter().enumerate() {
+            let v = p.value.at(t);
+            if p.dof < 3 {
+                state.config.x[p.node][p.dof] = mech.mesh.positions[p.node][p.dof] + v;
+            } else {
+                let dv = v - state.prescribed[k];
+                if dv != 0.0 {
+                    let axis = Vector3::ith(p.dof - 3, dv);
+                    state.config.increment(p.node, &Vector3::zeros(), &axis);
+                }
+            }
+            state.prescribed[k] = v;
+        }
+        for (j, joint) in mech.joints.iter().enumerate() {
+            let mut delta = vec![0.0; joint.map.released_count()];
+            let mut any = false;
+            for (c, d) in joint.driven.iter().enumerate() {
+                if let Some(s) = d {
+                    delta[c] = s.at(t) - state.released[j].q[c];
+                    any |= delta[c] != 0.0;
+                }
+            }
+            if any {
+                joint.map.advance(&mut state.released[j], &delta);
+            }
+        }
+        self.place_slaves(mech, state);
+    }
+}
+
+/// The initial state: nodes as meshed, joints at their initial coordinates,
+/// prescribed values at their `t = 0` values (not yet imposed).
+pub fn initial_state(mech: &Mechanism) -> MechanismState {
+    MechanismState {
+        config: Configuration::initial(&mech.mesh.positions),
+        released: mech.joints.iter().map(|j| j.initial).collect(),
+        prescribed: vec![0.0; mech.prescribed.len()],
+    }
+}
+
+/// Joint outputs: released angle and translation, and the constraint error
+/// `‖r_s − r_m − Λ_m r_R‖ + ‖Λ_mᵀΛ_s − Λ_R‖_F` of relation (1).
+pub fn joint_records(mech: &Mechanism, state: &MechanismState) -> Vec<JointRecord> {
+    mech.joints
+        .iter()
+        .enumerate()
+        .map(|(j, joint)| {
+            let (m, s) = (joint.master, joint.slave);
+            let (rr, lr) = joint.map.released_placement(&state.released[j]);
+            let c = &state.config;
+            let pos = (c.x[s] - c.x[m] - c.rot[m] * rr).norm();
+            let rot: Matrix3<f64> = c.rot[m].transpose() * c.rot[s] - lr;
+            JointRecord {
+                angle: joint.map.reported_angle(&state.released[j]),
+                released_translation: [rr.x, rr.y, rr.z],
+                constraint_error: pos + rot.norm(),
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,33 @@
+//! Cylindrical joint: a released rotation `ψ` about `axis` and an independent
+//! released translation `s` along `slide`: `r_R = s t_r`, `Λ_R = exp((ψ−ψ₀) t̂)`.
+
+use crate::kinematics::{axis_rotation, Increments, JointKinematics, ReleasedState};
+use flexmech_core::{cst, Scalar};
+use nalgebra::{Matrix3, Vector3};
+
+/// The cylindrical joint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cylindrical {
+    pub axis: Vector3<f64>,
+    pub slide: Vector3<f64>,
+}
+
+impl JointKinematics for Cylindrical {
+    const RELEASED: usize = 2;
+
+    fn released<T: Scalar>(
+        &self,
+        state: &ReleasedState,
+        inc: Increments<'_, T>,
+    ) -> (Vector3<T>, Matrix3<T>) {
+        let psi = inc.coordinate(state, 0) - cst::<T>(state.q0[0]);
+        (
+            self.slide.map(cst::<T>) * inc.coordinate(state, 1),
+            axis_rotation(&self.axis, psi),
+        )
+    }
+
+    fn coordinate_names(&self) -> &'static [&'static str] {
+        &["angle", "slide"]
+    }
+}

@@ -1,0 +1,36 @@
+//! Prismatic (slider) joint: one released translation `s` along the unit
+//! `slide` direction, no released rotation: `r_R = s t_r`, `Λ_R = I`.
+
+use crate::kinematics::{Increments, JointKinematics, ReleasedState};
+use flexmech_core::{cst, Scalar};
+use nalgebra::{Matrix3, Vector3};
+
+/// The prismatic joint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prismatic {
+    pub slide: Vector3<f64>,
+}
+
+impl JointKinematics for Prismatic {
+    const RELEASED: usize = 1;
+
+    fn released<T: Scalar>(
+        &self,
+        state: &ReleasedState,
+        inc: Increments<'_, T>,
+    ) -> (Vector3<T>, Matrix3<T>) {
+        (
+            self.slide.map(cst::<T>) * inc.coordinate(state, 0),
+            Matrix3::identity(),
+        )
+    }
+
+    fn coordinate_names(&self) -> &'static [&'static str] {
+        &["slide"]
+    }
+
+    /// No released rotation.
+    fn reported_angle(&self, _: &ReleasedState) -> f64 {
+        0.0
+    }
+}

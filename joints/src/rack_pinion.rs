@@ -1,0 +1,30 @@
+//! Rack-and-pinion joint (paper eq. 12, `t_r ⊥ t`, `c = b`): the pinion of
+//! radius `b` turns about `t`; the rack slides along `t_r`:
+//! `f(ψ) = b (t_r × t) + b ψ t_r` — the constant term places the pinion's
+//! center at distance `b` from the rack.
+
+use crate::dependent::DependentJoint;
+use flexmech_core::{cst, Scalar};
+use nalgebra::Vector3;
+
+/// The rack-and-pinion joint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RackPinion {
+    /// Unit axis `t` of the pinion.
+    pub axis: Vector3<f64>,
+    /// Unit slide direction `t_r` of the rack, perpendicular to `t`.
+    pub slide: Vector3<f64>,
+    /// Pinion radius `b`.
+    pub radius: f64,
+}
+
+impl DependentJoint for RackPinion {
+    fn axis(&self) -> Vector3<f64> {
+        self.axis
+    }
+
+    fn translation<T: Scalar>(&self, psi: T) -> Vector3<T> {
+        let b = cst::<T>(self.radius);
+        self.slide.cross(&self.axis).map(cst::<T>) * b + self.slide.map(cst::<T>) * (b * psi)
+    }
+}

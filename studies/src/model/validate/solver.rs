@@ -1,0 +1,178 @@
+//! The `[solver]` and `[output]` tables.
+
+use super::{quoted_list, Ctx, Res};
+use crate::model::raw::{RawOutput, RawSolver, S};
+use crate::model::types::*;
+
+impl Ctx<'_> {
+    pub(super) fn solver(&self, raw: Option<&S<RawSolver>>) -> Res<SolverSpec> {
+        let Some(entry) = raw else {
+            return Ok(SolverSpec {
+                analysis: Analysis::Static { load_steps: 10 },
+                tolerance: 1e-10,
+                max_iterations: 25,
+                max_halvings: 10,
+                mass: MassKind::Consistent,
+            });
+        };
+        let hs = entry.span();
+        let s = entry.get_ref();
+        let dynamic = match &s.analysis {
+            None => false,
+            Some(a) => match a.get_ref().as_str() {
+                "static" => false,
+                "dynamic" => true,
+                other => {
+                    return Err(self.at(
+                        "solver.analysis",
+                        a,
+                        format!("expected \"static\" or \"dynamic\", found \"{other}\""),
+                    ))
+                }
+            },
+        };
+        let analysis = if dynamic {
+            if let Some(l) = &s.load_steps {
+                return Err(self.at(
+                    "solver.load_steps",
+                    l,
+                    "`load_steps` belongs to a static analysis, but analysis = \"dynamic\"; a \
+                     dynamic analysis steps with `dt` up to `t_end`: remove `load_steps`",
+                ));
+            }
+            let integrators = [
+                IntegratorKind::Newmark,
+                IntegratorKind::Momentum,
+                IntegratorKind::EnergyMomentum,
+            ];
+            let names = quoted_list(integrators.iter().map(|i| i.name()));
+            let int_s = self.need(
+                &s.integrator,
+                "solver.integrator",
+                &hs,
+                &format!("a dynamic analysis needs an integrator, one of {names}"),
+            )?;
+            let Some(&integrator) = integrators.iter().find(|i| i.name() == int_s.get_ref()) else {
+                return Err(self.at(
+                    "solver.integrator",
+                    int_s,
+                    format!(
+                        "unknown integrator \"{}\"; expected one of {names}",
+                        int_s.get_ref()
+                    ),
+                ));
+            };
+            let dt_s = self.need(
+                &s.dt,
+                "solver.dt",
+                &hs,
+                "a dynamic analysis needs the time step, e.g. dt = 0.01",
+            )?;
+            let dt = self.positive(dt_s, "solver.dt")?;
+            let t_end_s = self.need(
+                &s.t_end,
+                "solver.t_end",
+                &hs,
+                "a dynamic analysis needs the end time, e.g. t_end = 1.0",
+            )?;
+            let t_end = self.positive(t_end_s, "solver.t_end")?;
+            if dt > t_end {
+                return Err(self.at(
+                    "solver.dt",
+                    dt_s,
+                    format!("must be <= t_end = {t_end:?}, found {dt:?}"),
+                ));
+            }
+            Analysis::Dynamic {
+                integrator,
+                dt,
+                t_end,
+            }
+        } else {
+            let dynamic_only = [
+                ("dt", s.dt.as_ref().map(S::span)),
+                ("t_end", s.t_end.as_ref().map(S::span)),
+                ("integrator", s.integrator.as_ref().map(S::span)),
+            ];
+            if let Some((key, span)) = dynamic_only.iter().find(|(_, sp)| sp.is_some()) {
+                let default = if s.analysis.is_none() {
+                    " (the default)"
+                } else {
+                    ""
+                };
+                return Err(self.err(
+                    format!("solver.{key}"),
+                    span.clone(),
+                    format!(
+                        "`{key}` belongs to a dynamic analysis, but this analysis is static{default}; \
+                         set analysis = \"dynamic\", or remove `{key}` (a static analysis takes `load_steps`)"
+                    ),
+                ));
+            }
+            let load_steps = match &s.load_steps {
+                Some(l) => self.int_at_least(l, "solver.load_steps", 1)?,
+                None => 10,
+            };
+            Analysis::Static { load_steps }
+        };
+        let tolerance = match &s.tolerance {
+            Some(t) => self.positive(t, "solver.tolerance")?,
+            None => 1e-10,
+        };
+        let max_iterations = match &s.max_iterations {
+            Some(m) => self.int_at_least(m, "solver.max_iterations", 1)?,
+            None => 25,
+        };
+        let max_halvings = match &s.max_halvings {
+            Some(m) => self.int_at_least(m, "solver.max_halvings", 0)?,
+            None => 10,
+        };
+        let mass = match &s.mass {
+            None => MassKind::Consistent,
+            Some(m) => match m.get_ref().as_str() {
+                "consistent" => MassKind::Consistent,
+                "lumped" => MassKind::Lumped,
+                other => {
+                    return Err(self.at(
+                        "solver.mass",
+                        m,
+                        format!("expected \"consistent\" or \"lumped\", found \"{other}\""),
+                    ))
+                }
+            },
+        };
+        Ok(SolverSpec {
+            analysis,
+            tolerance,
+            max_iterations,
+            max_halvings,
+            mass,
+        })
+    }
+
+    pub(super) fn output(&self, raw: Option<&S<RawOutput>>, beams: &[BeamSpec]) -> Res<OutputSpec> {
+        let Some(entry) = raw else {
+            return Ok(OutputSpec {
+                every: 1,
+                track: Vec::new(),
+            });
+        };
+        let o = entry.get_ref();
+        let every = match &o.every {
+            Some(e) => self.int_at_least(e, "output.every", 1)?,
+            None => 1,
+        };
+        let mut track: Vec<(String, NodeRef)> = Vec::new();
+        if let Some(list) = &o.track {
+            for (n, item) in list.get_ref().iter().enumerate() {
+                let key = format!("output.track[{n}]");
+                let label = item.get_ref();
+                if track.iter().any(|(l, _)| l == label) {
+                    return Err(self.at(key, item, format!("node \"{label}\" is listed twice")));
+                }
+                track.push((label.clone(), self.node(item, &key, beams)?));
+            }
+        }
+        Ok(OutputSpec { every, track })
+    }
+}
