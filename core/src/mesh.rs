@@ -66,6 +66,14 @@ impl Element {
         }
     }
 
+    /// Magnitude of the element's internal forces before they cancel: the
+    /// largest stiffness times a unit strain, `max(C_N) + max(C_M)/L`. Their
+    /// rounding (`eps` times this) bounds how small a residual can be computed.
+    pub fn force_scale(&self) -> f64 {
+        let s = self.section();
+        s.c_n.max() + s.c_m.max() / self.length()
+    }
+
     /// Strain energy in a global configuration.
     pub fn energy(&self, x: &[Vector3<f64>], rot: &[Matrix3<f64>]) -> f64 {
         match self {

@@ -100,6 +100,20 @@ impl Mechanism {
         }
     }
 
+    /// The round-off floor of a residual norm: `64·eps·‖(force scale of each
+    /// element)‖₂` — an element force passes through some fifty rounded
+    /// operations (logarithm, exponentials, products) on quantities of the
+    /// size of its stiffness. Below it a residual is noise, whatever the loads.
+    pub fn round_off_floor(&self) -> f64 {
+        let sum: f64 = self
+            .mesh
+            .elements
+            .iter()
+            .map(|e| e.force_scale().powi(2))
+            .sum();
+        64.0 * f64::EPSILON * sum.sqrt()
+    }
+
     /// External nodal forces and moments at time `t` (6 per node:
     /// force, then spatial moment), including consistent nodal gravity
     /// forces `∫ρA g Iᵢ ds`.

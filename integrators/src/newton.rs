@@ -4,7 +4,10 @@
 //! `‖r‖₂ / max(‖f_ext‖₂, ‖Σₑ|rₑ|‖₂)`: the residual relative to the larger of
 //! the applied loads and the magnitude of the internal forces that cancel in
 //! it, so the tolerance means the same thing for any units and stays above
-//! round-off when large internal forces balance.
+//! round-off when large internal forces balance. A residual whose norm is at
+//! the system's round-off floor ([`NewtonSystem::floor`]) also counts as
+//! converged: no iteration can improve on it (this matters when the loads
+//! are tiny, e.g. the first steps of a ramp, and stiff internal forces round).
 
 use crate::error::NewtonFailure;
 use crate::linsolve::SparseLu;
@@ -27,6 +30,10 @@ pub trait NewtonSystem {
     fn tangent_values(&self) -> &[f64];
     /// Applies the increment `dq` to the current iterate.
     fn apply(&mut self, dq: &[f64]);
+    /// Absolute residual norm below which the residual is round-off.
+    fn floor(&self) -> f64 {
+        0.0
+    }
 }
 
 /// Outcome of a converged solve.
@@ -62,7 +69,7 @@ pub fn solve<S: NewtonSystem>(
         if !res.is_finite() {
             return Err(NewtonFailure::NotFinite { iteration: it });
         }
-        if res <= settings.tolerance {
+        if res <= settings.tolerance || norm <= sys.floor() {
             return Ok(NewtonReport {
                 iterations: it,
                 residual: res,

@@ -1,5 +1,6 @@
 //! Static equilibrium under proportional (or scheduled) loading: the load
-//! factor λ runs from 0 to 1; each step is solved by Newton with the exact
+//! factor λ runs from 0 to 1; each step (for driven mechanisms: from the
+//! secant prediction of the previous one) is solved by Newton with the exact
 //! tangent; a step that fails is retried with half the increment (up to
 //! `max_halvings` times in a row) and the increment grows back to nominal
 //! after three easy steps. Every planned level `k/load_steps` is reached
@@ -47,6 +48,8 @@ struct StaticProblem<'a> {
     fext: Vec<f64>,
     nodal_r: Vec<f64>,
     scratch: Vec<f64>,
+    /// Round-off floor of the residual norm.
+    floor: f64,
 }
 
 impl NewtonSystem for StaticProblem<'_> {
@@ -80,6 +83,10 @@ impl NewtonSystem for StaticProblem<'_> {
 
     fn apply(&mut self, dq: &[f64]) {
         self.topo.apply(self.mech, &mut self.state, dq);
+    }
+
+    fn floor(&self) -> f64 {
+        self.floor
     }
 }
 
@@ -170,11 +177,24 @@ pub fn solve_static(
         fext: vec![0.0; 6 * nodes],
         nodal_r: vec![0.0; 6 * nodes],
         scratch: vec![0.0; n],
+        floor: mech.round_off_floor(),
     };
     let (mut r, mut dq) = (vec![0.0; n], vec![0.0; n]);
     let nominal = 1.0 / settings.load_steps as f64;
     let (mut lambda, mut step, mut halvings, mut easy, mut steps) =
         (0.0f64, nominal, 0usize, 0usize, 0usize);
+    // Kinematically driven mechanisms start each step from the secant
+    // prediction, which carries the rigid motion downstream of a driven joint;
+    // under load control the last equilibrium is the better start (Newton's
+    // first iteration is the tangent predictor, and extrapolating positions and
+    // rotations separately would break their compatibility in slender beams).
+    let driven = !mech.prescribed.is_empty()
+        || mech
+            .joints
+            .iter()
+            .any(|j| j.driven.iter().any(Option::is_some));
+    // The state before the last converged step and that step's size.
+    let mut previous: Option<(MechanismState, f64)> = None;
     while lambda < 1.0 - 1e-12 {
         // Never step over a planned level k/load_steps: results are reported
         // at the load factors the user asked for; halvings only add levels.
@@ -182,11 +202,20 @@ pub fn solve_static(
         let target = (lambda + step).min(next_planned);
         let target = if target > 1.0 - 1e-12 { 1.0 } else { target };
         let saved = prob.state.clone();
+        if let (true, Some((before, before_step))) = (driven, &previous) {
+            prob.topo.extrapolate(
+                mech,
+                &mut prob.state,
+                before,
+                (target - lambda) / before_step,
+            );
+        }
         prob.topo.impose(mech, &mut prob.state, target);
         mech.external_forces(target, &mut prob.fext);
         match newton::solve(&mut prob, &mut lu, &settings.newton, &mut r, &mut dq) {
             Ok(report) => {
                 let dt = target - lambda;
+                previous = Some((saved, dt));
                 lambda = target;
                 steps += 1;
                 halvings = 0;

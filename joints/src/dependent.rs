@@ -92,7 +92,10 @@ pub trait DependentJointMaps {
     fn second_derivative(&self, psi: f64) -> Vector3<f64>;
     /// Mean slope `(f(ψ + ω) − f(ψ))/ω`, without cancellation for small `ω`
     /// (8-point Gauss–Legendre quadrature of `f′` below `|ω| = 10⁻²`, where it
-    /// is exact to round-off for smooth `f`; the difference quotient above).
+    /// is exact to round-off for smooth `f`; the difference quotient above, and
+    /// also below when the quadrature is not exact — a piecewise-smooth `f`
+    /// such as a tabulated lift whose knot lies in `[ψ, ψ+ω]` — detected by
+    /// comparing the rule on the whole interval with the rule on its halves).
     fn mean_slope(&self, psi: f64, omega: f64) -> Vector3<f64>;
     /// The secant `G` of paper eq. 22: `u_R = f(ψₙ + ω) − f(ψₙ) = G θ_R` with
     /// `θ_R = 2 tan(ω/2) t`, i.e. `G = (f(ψₙ₊₁) − f(ψₙ)) ⊗ t / (t·θ_R)`;
@@ -126,12 +129,32 @@ impl<J: DependentJoint> DependentJointMaps for J {
     }
 
     fn mean_slope(&self, psi: f64, omega: f64) -> Vector3<f64> {
+        let quotient = || (self.translation(psi + omega) - self.translation(psi)) / omega;
         if omega.abs() >= 1e-2 {
-            (self.translation(psi + omega) - self.translation(psi)) / omega
-        } else {
+            return quotient();
+        }
+        // Gauss–Legendre on [ψ, ψ+ω] and, as an error estimate, on its two halves.
+        let mut scale = 0.0;
+        let mut rule = |a: f64, w: f64| -> Vector3<f64> {
             GL8.iter()
-                .map(|&(s, w)| self.derivative(psi + s * omega) * w)
+                .map(|&(s, wt)| {
+                    let d = self.derivative(a + s * w) * wt;
+                    scale += d.norm();
+                    d
+                })
                 .sum()
+        };
+        let whole = rule(psi, omega);
+        let halves = (rule(psi, 0.5 * omega) + rule(psi + 0.5 * omega, 0.5 * omega)) * 0.5;
+        // For a smooth f both rules agree to round-off. A profile that is only
+        // piecewise smooth (a tabulated lift, C² at its knots) defeats the rule
+        // when [ψ, ψ+ω] straddles a knot; then G θ_R would miss
+        // f(ψ+ω) − f(ψ) by far more than round-off, and the difference quotient
+        // (exact increment, mild cancellation) is used instead.
+        if omega == 0.0 || (whole - halves).norm() <= 64.0 * f64::EPSILON * scale {
+            halves
+        } else {
+            quotient()
         }
     }
 

@@ -18,7 +18,10 @@
 //!
 //! Both are evaluated for any [`Scalar`], so `N`, `G`, `Ñ` and the tangents of
 //! [`crate::dependent`] follow by automatic differentiation like for every
-//! other [`DependentJoint`].
+//! other [`DependentJoint`]. A tabulated lift is C² but not C³ at its knots;
+//! the secant `G` still reproduces `f(ψₙ₊₁) − f(ψₙ)` to round-off when a step
+//! crosses a knot ([`crate::DependentJointMaps::mean_slope`] detects that its
+//! quadrature is not exact there and falls back to the difference quotient).
 
 use crate::dependent::DependentJoint;
 use flexmech_core::{cst, Scalar};
@@ -36,7 +39,11 @@ pub enum LobeError {
     NonFiniteRow { row: usize, angle: f64, lift: f64 },
     /// Angles must be strictly increasing.
     #[error("the angles of the lift table must be strictly increasing: row {row} has angle {angle} after {previous}")]
-    NonIncreasing { row: usize, previous: f64, angle: f64 },
+    NonIncreasing {
+        row: usize,
+        previous: f64,
+        angle: f64,
+    },
     /// The lift of the last row must equal the lift of the first (one full period).
     #[error("the lift table is not periodic: the first row has lift {first}, the last {last} (they must be equal)")]
     NotPeriodic { first: f64, last: f64 },
@@ -100,7 +107,11 @@ impl PeriodicSpline {
         }
         for (row, w) in rows.windows(2).enumerate() {
             if w[1].0 <= w[0].0 {
-                return Err(LobeError::NonIncreasing { row: row + 1, previous: w[0].0, angle: w[1].0 });
+                return Err(LobeError::NonIncreasing {
+                    row: row + 1,
+                    previous: w[0].0,
+                    angle: w[1].0,
+                });
             }
         }
         let first = rows[0].1;
@@ -125,10 +136,19 @@ impl PeriodicSpline {
         let coefficients = (0..n)
             .map(|i| {
                 let (mi, mj) = (m[i], m[(i + 1) % n]);
-                [y[i], slope[i] - h[i] * (2.0 * mi + mj) / 6.0, 0.5 * mi, (mj - mi) / (6.0 * h[i])]
+                [
+                    y[i],
+                    slope[i] - h[i] * (2.0 * mi + mj) / 6.0,
+                    0.5 * mi,
+                    (mj - mi) / (6.0 * h[i]),
+                ]
             })
             .collect();
-        Ok(Self { period: x[n] - x[0], knots: x, coefficients })
+        Ok(Self {
+            period: x[n] - x[0],
+            knots: x,
+            coefficients,
+        })
     }
 
     /// The period `P`.
@@ -148,12 +168,18 @@ impl PeriodicSpline {
     pub fn eval<T: Scalar>(&self, x: T) -> T {
         let x0 = self.knots[0];
         let turns = ((x.value() - x0) / self.period).floor();
-        let xr = if turns == 0.0 { x } else { x - cst::<T>(turns * self.period) };
+        let xr = if turns == 0.0 {
+            x
+        } else {
+            x - cst::<T>(turns * self.period)
+        };
         let v = xr.value();
         let n = self.coefficients.len();
         // Largest i with x_i ≤ v, clamped to a valid interval (round-off of the
         // reduction may leave v a hair outside [x₀, x₀ + P)).
-        let i = self.knots[..n].partition_point(|&k| k <= v).saturating_sub(1);
+        let i = self.knots[..n]
+            .partition_point(|&k| k <= v)
+            .saturating_sub(1);
         let s = xr - cst::<T>(self.knots[i]);
         let [a, b, c, d] = self.coefficients[i];
         ((cst::<T>(d) * s + cst::<T>(c)) * s + cst::<T>(b)) * s + cst::<T>(a)
@@ -168,7 +194,10 @@ fn solve_cyclic(h: &[f64], diag: &[f64], rhs: &[f64]) -> Vec<f64> {
         // Both off-diagonal couplings land on the same entry: h₀ + h₁.
         let off = h[0] + h[1];
         let det = diag[0] * diag[1] - off * off;
-        return vec![(rhs[0] * diag[1] - off * rhs[1]) / det, (diag[0] * rhs[1] - off * rhs[0]) / det];
+        return vec![
+            (rhs[0] * diag[1] - off * rhs[1]) / det,
+            (diag[0] * rhs[1] - off * rhs[0]) / det,
+        ];
     }
     // A = B + u vᵀ with u = (γ, 0, …, 0, c), v = (1, 0, …, 0, a/γ), where the
     // corner entries are A[0][n−1] = h[n−1] (= c, the sub-diagonal coupling of
@@ -226,10 +255,16 @@ impl Lift {
 
     /// A Fourier lift from `[a₀, a₁, b₁, a₂, b₂, …]` (odd count, finite).
     pub fn fourier(coefficients: &[f64]) -> Result<Self, LobeError> {
-        if coefficients.len() % 2 == 0 {
-            return Err(LobeError::FourierCount { count: coefficients.len() });
+        if coefficients.len() % 2 != 1 {
+            return Err(LobeError::FourierCount {
+                count: coefficients.len(),
+            });
         }
-        if let Some((index, &value)) = coefficients.iter().enumerate().find(|(_, c)| !c.is_finite()) {
+        if let Some((index, &value)) = coefficients
+            .iter()
+            .enumerate()
+            .find(|(_, c)| !c.is_finite())
+        {
             return Err(LobeError::NonFiniteCoefficient { index, value });
         }
         Ok(Lift::Fourier(coefficients.to_vec()))
@@ -305,7 +340,19 @@ mod tests {
 
     /// An irregular, non-uniformly spaced table over one turn starting at −1.
     fn irregular_rows() -> Vec<(f64, f64)> {
-        let angles = [-1.0, -0.6, 0.1, 0.35, 1.2, 2.0, 2.2, 3.5, 4.4, 5.0, -1.0 + 2.0 * PI];
+        let angles = [
+            -1.0,
+            -0.6,
+            0.1,
+            0.35,
+            1.2,
+            2.0,
+            2.2,
+            3.5,
+            4.4,
+            5.0,
+            -1.0 + 2.0 * PI,
+        ];
         let lifts = [0.3, 0.5, 0.45, 0.9, 1.4, 0.2, -0.1, 0.0, 0.25, 0.31, 0.3];
         angles.iter().copied().zip(lifts).collect()
     }
@@ -317,7 +364,11 @@ mod tests {
     /// Value, first and second derivative of interval `i`'s cubic at `s`.
     fn piece(spline: &PeriodicSpline, i: usize, s: f64) -> [f64; 3] {
         let [a, b, c, d] = spline.coefficients[i];
-        [a + s * (b + s * (c + s * d)), b + s * (2.0 * c + 3.0 * d * s), 2.0 * c + 6.0 * d * s]
+        [
+            a + s * (b + s * (c + s * d)),
+            b + s * (2.0 * c + 3.0 * d * s),
+            2.0 * c + 6.0 * d * s,
+        ]
     }
 
     #[test]
@@ -336,7 +387,10 @@ mod tests {
         for &(angle, lift) in &rows {
             for k in [-3.0, -1.0, 1.0, 4.0] {
                 let v = joint.lift.eval(angle + k * 2.0 * PI);
-                assert!((v - lift).abs() < 1e-13, "row at {angle} shifted by {k} periods: {v} vs {lift}");
+                assert!(
+                    (v - lift).abs() < 1e-13,
+                    "row at {angle} shifted by {k} periods: {v} vs {lift}"
+                );
             }
         }
     }
@@ -352,7 +406,10 @@ mod tests {
             let right = piece(&spline, j, 0.0);
             for (order, (l, r)) in left.iter().zip(&right).enumerate() {
                 let scale = 1.0 + r.abs();
-                assert!((l - r).abs() < 1e-13 * scale, "knot {j}, derivative {order}: {l} vs {r}");
+                assert!(
+                    (l - r).abs() < 1e-13 * scale,
+                    "knot {j}, derivative {order}: {l} vs {r}"
+                );
             }
         }
     }
@@ -369,7 +426,10 @@ mod tests {
                 let shifted = psi + k * p;
                 let (f0, f1) = (joint.translation(psi), joint.translation(shifted));
                 let (d0, d1) = (joint.derivative(psi), joint.derivative(shifted));
-                let (s0, s1) = (joint.second_derivative(psi), joint.second_derivative(shifted));
+                let (s0, s1) = (
+                    joint.second_derivative(psi),
+                    joint.second_derivative(shifted),
+                );
                 // The shifted argument carries round-off |ψ + kP|·ε, which the
                 // slope (≲ 5 here) and curvature (≲ 50) turn into these errors.
                 assert!((f0 - f1).norm() < 1e-13, "value at {psi} + {k}P");
@@ -400,7 +460,11 @@ mod tests {
         for k in 0..1000 {
             let psi = -9.0 + 0.0273 * k as f64;
             let exact = [amp * psi.sin(), amp * psi.cos(), -amp * psi.sin()];
-            let got = [joint.lift.eval(psi), joint.derivative(psi).x, joint.second_derivative(psi).x];
+            let got = [
+                joint.lift.eval(psi),
+                joint.derivative(psi).x,
+                joint.second_derivative(psi).x,
+            ];
             for o in 0..3 {
                 worst[o] = worst[o].max((got[o] - exact[o]).abs() / amp);
             }
@@ -414,7 +478,8 @@ mod tests {
     #[test]
     fn fourier_matches_its_closed_form_and_derivatives() {
         let c = [0.2, 0.5, -0.3, 0.05, 0.1, -0.02, 0.01];
-        let joint = Lobe::new(z(), Vector3::new(0.0, 0.6, 0.8), Lift::fourier(&c).unwrap()).unwrap();
+        let joint =
+            Lobe::new(z(), Vector3::new(0.0, 0.6, 0.8), Lift::fourier(&c).unwrap()).unwrap();
         for k in 0..200 {
             let psi = -20.0 + 0.2 * k as f64 + 0.01;
             let mut rho = c[0];
@@ -430,7 +495,10 @@ mod tests {
             let slide = joint.slide;
             assert!((joint.translation(psi) - slide * rho).norm() <= 1e-15 * (1.0 + rho.abs()));
             assert!((joint.derivative(psi) - slide * drho).norm() <= 1e-14 * (1.0 + drho.abs()));
-            assert!((joint.second_derivative(psi) - slide * ddrho).norm() <= 1e-14 * (1.0 + ddrho.abs()));
+            assert!(
+                (joint.second_derivative(psi) - slide * ddrho).norm()
+                    <= 1e-14 * (1.0 + ddrho.abs())
+            );
         }
     }
 
@@ -439,7 +507,12 @@ mod tests {
         // ρ(ψ) = R cos ψ − R − a.
         let (r, a) = (0.4, 0.1);
         let lobe = lobe(Lift::fourier(&[-r - a, r, 0.0]).unwrap());
-        let cam = crate::Cam { axis: z(), slide: x(), radius: r, offset: a };
+        let cam = crate::Cam {
+            axis: z(),
+            slide: x(),
+            radius: r,
+            offset: a,
+        };
         for k in 0..50 {
             let psi = -10.0 + 0.41 * k as f64;
             assert!((lobe.translation(psi) - cam.translation(psi)).norm() < 1e-15);
@@ -465,7 +538,10 @@ mod tests {
 
     #[test]
     fn bad_input_is_refused() {
-        assert_eq!(Lift::table(&[(0.0, 1.0), (1.0, 1.0)]), Err(LobeError::TooFewRows { rows: 2 }));
+        assert_eq!(
+            Lift::table(&[(0.0, 1.0), (1.0, 1.0)]),
+            Err(LobeError::TooFewRows { rows: 2 })
+        );
         assert!(matches!(
             Lift::table(&[(0.0, 1.0), (2.0, 0.0), (2.0, 0.5), (6.0, 1.0)]),
             Err(LobeError::NonIncreasing { row: 2, .. })
@@ -478,8 +554,14 @@ mod tests {
             Lift::table(&[(0.0, 1.0), (f64::NAN, 0.0), (6.0, 1.0)]),
             Err(LobeError::NonFiniteRow { row: 1, .. })
         ));
-        assert!(matches!(Lift::fourier(&[1.0, 2.0]), Err(LobeError::FourierCount { count: 2 })));
-        assert!(matches!(Lift::fourier(&[]), Err(LobeError::FourierCount { count: 0 })));
+        assert!(matches!(
+            Lift::fourier(&[1.0, 2.0]),
+            Err(LobeError::FourierCount { count: 2 })
+        ));
+        assert!(matches!(
+            Lift::fourier(&[]),
+            Err(LobeError::FourierCount { count: 0 })
+        ));
         assert!(matches!(
             Lift::fourier(&[1.0, f64::INFINITY, 0.0]),
             Err(LobeError::NonFiniteCoefficient { index: 1, .. })
@@ -489,7 +571,9 @@ mod tests {
             Lobe::new(Vector3::new(0.0, 0.0, 2.0), x(), lift),
             Err(LobeError::NotUnit { name: "axis", .. })
         ));
-        let msg = Lift::table(&[(0.0, 1.0), (1.0, 0.0), (6.0, 1.5)]).unwrap_err().to_string();
+        let msg = Lift::table(&[(0.0, 1.0), (1.0, 0.0), (6.0, 1.5)])
+            .unwrap_err()
+            .to_string();
         assert!(msg.contains("not periodic"), "{msg}");
     }
 }

@@ -1,10 +1,19 @@
 //! From a validated [`Model`] to the [`Mechanism`] the solvers work on: mesh
 //! the beams, number the nodes, apply supports, loads and gravity.
 
-use crate::model::{Analysis, BeamGeometry, Model, ModelError, NodeRef, TimeFunction};
+use crate::model::{
+    Analysis, BeamGeometry, JointKind, JointSpec, LiftSpec, Model, ModelError, NodeRef,
+    PrescribedSpec, TimeFunction,
+};
 use flexmech_core::{Mesh, Section};
-use flexmech_integrators::{Mechanism, NodalLoad, Schedule};
+use flexmech_integrators::{JointInstance, Mechanism, NodalLoad, PrescribedDof, Schedule};
+use flexmech_joints::{
+    lobe::{Lift, Lobe},
+    Cam, Cylindrical, JointMap, Prismatic, RackPinion, ReleasedState, Revolute, Rigid, Screw,
+    Spherical, MAX_RELEASED,
+};
 use nalgebra::Vector3;
+use std::sync::Arc;
 
 /// A mechanism with the numbering that relates it back to the model file.
 #[derive(Debug, Clone)]
@@ -30,10 +39,7 @@ fn v(a: [f64; 3]) -> Vector3<f64> {
 /// the load factor itself in statics (proportional loading) and 1 in dynamics.
 fn schedule(time: &Option<TimeFunction>, analysis: &Analysis) -> Schedule {
     match (time, analysis) {
-        (Some(f), _) => {
-            let f = f.clone();
-            Schedule::new(move |t| f.eval(t))
-        }
+        (Some(f), _) => schedule_of(f),
         (None, Analysis::Static { .. }) => Schedule::ramp(),
         (None, Analysis::Dynamic { .. }) => Schedule::constant(1.0),
     }
@@ -50,12 +56,6 @@ fn unsupported(model: &Model) -> Result<(), ModelError> {
             format!("{what} cannot be solved by this version of flexmech yet; remove it to run the rest"),
         ))
     };
-    if !model.joints.is_empty() {
-        return err("joint[0]", "joints");
-    }
-    if !model.prescribed.is_empty() {
-        return err("prescribed[0]", "prescribed motion");
-    }
     if let Analysis::Dynamic { .. } = model.solver.analysis {
         return err("solver.analysis", "dynamic analysis");
     }
@@ -63,6 +63,71 @@ fn unsupported(model: &Model) -> Result<(), ModelError> {
         return err("initial_velocity[0]", "initial velocities");
     }
     Ok(())
+}
+
+/// A time function as a schedule.
+fn schedule_of(f: &TimeFunction) -> Schedule {
+    let f = f.clone();
+    Schedule::new(move |t| f.eval(t))
+}
+
+/// The kinematics of a joint kind and its initial released coordinates.
+fn joint_map(
+    model: &Model,
+    j: usize,
+    spec: &JointSpec,
+) -> Result<(Arc<dyn JointMap>, ReleasedState), ModelError> {
+    let v = |a: &[f64; 3]| Vector3::from(*a);
+    let mut q0 = [0.0; MAX_RELEASED];
+    q0[0] = spec.angle;
+    let map: Arc<dyn JointMap> = match &spec.kind {
+        JointKind::Rigid => Arc::new(Rigid),
+        JointKind::Revolute { axis } => Arc::new(Revolute { axis: v(axis) }),
+        JointKind::Spherical => Arc::new(Spherical),
+        JointKind::Prismatic { slide } => Arc::new(Prismatic { slide: v(slide) }),
+        JointKind::Cylindrical { axis, slide } => Arc::new(Cylindrical {
+            axis: v(axis),
+            slide: v(slide),
+        }),
+        JointKind::Screw { axis, pitch } => Arc::new(Screw {
+            axis: v(axis),
+            pitch: *pitch,
+        }),
+        JointKind::RackPinion {
+            axis,
+            radius,
+            slide,
+        } => Arc::new(RackPinion {
+            axis: v(axis),
+            slide: v(slide),
+            radius: *radius,
+        }),
+        JointKind::Cam {
+            axis,
+            radius,
+            offset,
+            slide,
+        } => Arc::new(Cam {
+            axis: v(axis),
+            slide: v(slide),
+            radius: *radius,
+            offset: *offset,
+        }),
+        JointKind::Lobe { axis, slide, lift } => {
+            let lift = match lift {
+                LiftSpec::Table(rows) => Lift::table(rows),
+                LiftSpec::Fourier(c) => Lift::fourier(c),
+            };
+            let lobe = lift.and_then(|l| Lobe::new(v(axis), v(slide), l));
+            Arc::new(lobe.map_err(|e| {
+                ModelError::new(&model.path, format!("joint[{j}].lift"), None, e.to_string())
+            })?)
+        }
+    };
+    if let JointKind::Prismatic { .. } = spec.kind {
+        q0[0] = 0.0;
+    }
+    Ok((map, ReleasedState::new(q0)))
 }
 
 /// Builds the mechanism of `model`.
@@ -132,6 +197,63 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
     }
     mechanism.gravity = v(model.gravity);
     mechanism.gravity_scale = schedule(&None, &model.solver.analysis);
+    let scale = mechanism
+        .mesh
+        .positions
+        .iter()
+        .map(|x| x.norm())
+        .fold(1.0, f64::max);
+    for (j, spec) in model.joints.iter().enumerate() {
+        let (map, initial) = joint_map(model, j, spec)?;
+        let (master, slave) = (node(spec.master), node(spec.slave));
+        // The slave must start where relation (1) puts it.
+        let x0 = &mechanism.mesh.positions;
+        let (expected, _) = map.slave(&x0[master], &nalgebra::Matrix3::identity(), &initial);
+        let gap = (x0[slave] - expected).norm();
+        if gap > 1e-9 * scale {
+            let p = |x: &Vector3<f64>| format!("({:.6}, {:.6}, {:.6})", x.x, x.y, x.z);
+            return Err(ModelError::new(
+                &model.path,
+                format!("joint[{j}].slave"),
+                None,
+                format!(
+                    "joint `{}`: the slave `{}` starts at {} but the master `{}` plus the released translation at the initial angle puts it at {} (off by {gap:.3e}); move the beam, or set the joint's `angle`",
+                    spec.name,
+                    model.node_label(spec.slave),
+                    p(&x0[slave]),
+                    model.node_label(spec.master),
+                    p(&expected)
+                ),
+            ));
+        }
+        let driven = vec![None; map.released_count()];
+        mechanism.joints.push(JointInstance {
+            name: spec.name.clone(),
+            master,
+            slave,
+            map,
+            initial,
+            driven,
+        });
+    }
+    for p in &model.prescribed {
+        match p {
+            PrescribedSpec::JointAngle { joint, angle } => {
+                mechanism.joints[*joint].driven[0] = Some(schedule_of(angle));
+            }
+            PrescribedSpec::NodeDof {
+                node: r,
+                dof,
+                value,
+            } => {
+                mechanism.prescribed.push(PrescribedDof {
+                    node: node(*r),
+                    dof: *dof,
+                    value: schedule_of(value),
+                });
+            }
+        }
+    }
     Ok(Built {
         mechanism,
         beam_nodes,

@@ -74,11 +74,17 @@ impl Model {
         resolve_label(&self.beams, label)
     }
 
-    /// The canonical label `<beam>.<k>` of `node`.
+    /// The label of `node` as a user would write it: `<beam>.start`,
+    /// `<beam>.end`, or `<beam>.<k>` for an inner node.
     ///
     /// # Panics
     /// If `node.beam` is not a beam of the model.
     pub fn node_label(&self, node: NodeRef) -> String {
-        format!("{}.{}", self.beams[node.beam].name, node.node)
+        let beam = &self.beams[node.beam];
+        match node.node {
+            0 => format!("{}.start", beam.name),
+            k if k + 1 == beam.node_count() => format!("{}.end", beam.name),
+            k => format!("{}.{k}", beam.name),
+        }
     }
 }
