@@ -276,6 +276,11 @@ impl Topology {
                 state.config.increment(n, &u, &(phi * ratio));
             }
         }
+        // The prescribed values move with the nodes they belong to, so that
+        // imposing the new values adds only what the prediction missed.
+        for (now, before) in state.prescribed.iter_mut().zip(&previous.prescribed) {
+            *now += (*now - before) * ratio;
+        }
         for (j, joint) in mech.joints.iter().enumerate() {
             let k = joint.map.released_count();
             let (now, before) = (state.released[j], previous.released[j]);

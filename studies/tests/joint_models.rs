@@ -176,3 +176,61 @@ fn slave_out_of_place_is_a_clear_error() {
         "{err}"
     );
 }
+
+#[test]
+fn standard_joint_kinds_from_a_model_file() {
+    let model = load_model(&data("joint_kinds.toml")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let file = run_model(&model, dir.path()).unwrap().file;
+    for kind in ["rigid", "revolute", "spherical", "prismatic", "cylindrical"] {
+        let err = read(&file, &format!("/joints/{kind}/constraint_error"));
+        assert!(err.iter().all(|e| *e <= 1e-13), "{kind}: {err:?}");
+    }
+    // A rigid joint makes the pair one beam: same displacements as the
+    // continuous beam of the same mesh under the same loads.
+    let cont = read(&file, "/nodes/continuous.5/displacement");
+    let rigid = read(&file, "/nodes/rigid_b.1/displacement");
+    let scale = cont.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(
+        cont.iter()
+            .zip(&rigid)
+            .all(|(a, b)| (a - b).abs() <= 1e-9 * scale),
+        "{cont:?} vs {rigid:?}"
+    );
+    // Released coordinates open where they are released, and only there.
+    let last = |d: &str, w: usize| read(&file, d).chunks(w).last().unwrap().to_vec();
+    let prism = last("/joints/prismatic/released_translation", 3);
+    assert!(
+        prism[0].abs() > 1e-6 && prism[1] == 0.0 && prism[2] == 0.0,
+        "{prism:?}"
+    );
+    let cyl = last("/joints/cylindrical/released_translation", 3);
+    assert!(
+        cyl[0].abs() > 1e-6 && cyl[1] == 0.0 && cyl[2] == 0.0,
+        "{cyl:?}"
+    );
+    assert!(last("/joints/cylindrical/angle", 1)[0].abs() > 1e-6);
+    assert!(last("/joints/revolute/angle", 1)[0].abs() > 1e-6);
+    assert!(last("/joints/spherical/angle", 1)[0].abs() > 1e-6);
+    assert_eq!(last("/joints/rigid/released_translation", 3), vec![0.0; 3]);
+    // The hinge opens: master and slave rotate differently about y only.
+    let ra = last("/nodes/revolute_a.end/rotation", 3);
+    let rb = last("/nodes/revolute_b.start/rotation", 3);
+    assert!((ra[1] - rb[1]).abs() > 1e-6, "{ra:?} {rb:?}");
+}
+
+#[test]
+fn prescribed_end_rotation_rolls_the_strip_into_a_circle() {
+    // Driving the end's rotation to 2π (end free to move) gives the same
+    // circle as the end moment 2πEI/L: the tip returns to the clamp.
+    let model = load_model(&data("rollup_prescribed.toml")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let file = run_model(&model, dir.path()).unwrap().file;
+    let pos = read(&file, "/nodes/strip.end/position");
+    let tip = &pos[pos.len() - 3..];
+    let dist = (tip[0] * tip[0] + tip[1] * tip[1] + tip[2] * tip[2]).sqrt();
+    assert!(dist <= 1e-8 * 10.0, "tip {tip:?}");
+    let e = read(&file, "/energy/strain");
+    let exact = 0.5 * 100.0 * (2.0 * std::f64::consts::PI / 10.0f64).powi(2) * 10.0;
+    assert!((e.last().unwrap() - exact).abs() <= 1e-8 * exact);
+}
