@@ -66,12 +66,15 @@ impl Element {
         }
     }
 
-    /// Magnitude of the element's internal forces before they cancel: the
-    /// largest stiffness times a unit strain, `max(C_N) + max(C_M)/L`. Their
-    /// rounding (`eps` times this) bounds how small a residual can be computed.
-    pub fn force_scale(&self) -> f64 {
+    /// Scale of the rounding errors of the element's internal forces when its
+    /// nodes lie within `radius` of the origin: the chord `x₂ − x₁` is rounded
+    /// to `eps·radius`, so the axial and shear strains carry `eps·radius/L`
+    /// (times `C_N`), and the curvature `eps/L` (times `C_M`). Multiplied by
+    /// `eps`, this bounds how small the element's residual can be computed.
+    pub fn force_scale(&self, radius: f64) -> f64 {
         let s = self.section();
-        s.c_n.max() + s.c_m.max() / self.length()
+        let l = self.length();
+        s.c_n.max() * (1.0 + radius / l) + s.c_m.max() / l
     }
 
     /// Strain energy in a global configuration.

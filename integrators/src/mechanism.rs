@@ -100,18 +100,15 @@ impl Mechanism {
         }
     }
 
-    /// The round-off floor of a residual norm: `64·eps·‖(force scale of each
-    /// element)‖₂` — an element force passes through some fifty rounded
-    /// operations (logarithm, exponentials, products) on quantities of the
-    /// size of its stiffness. Below it a residual is noise, whatever the loads.
+    /// The round-off floor of a residual norm: `4·eps·‖(force scale of each
+    /// element)‖₂` (see [`flexmech_core::Element::force_scale`]), with the
+    /// model's size taken as twice its initial radius about the origin. Below it
+    /// a residual is rounding noise, whatever the loads: long meshes of short,
+    /// axially stiff elements far from the origin have the highest floors.
     pub fn round_off_floor(&self) -> f64 {
-        let sum: f64 = self
-            .mesh
-            .elements
-            .iter()
-            .map(|e| e.force_scale().powi(2))
-            .sum();
-        64.0 * f64::EPSILON * sum.sqrt()
+        let radius = 2.0 * self.mesh.positions.iter().map(|x| x.norm()).fold(0.0, f64::max);
+        let sum: f64 = self.mesh.elements.iter().map(|e| e.force_scale(radius).powi(2)).sum();
+        4.0 * f64::EPSILON * sum.sqrt()
     }
 
     /// External nodal forces and moments at time `t` (6 per node:
