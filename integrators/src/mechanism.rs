@@ -106,8 +106,19 @@ impl Mechanism {
     /// a residual is rounding noise, whatever the loads: long meshes of short,
     /// axially stiff elements far from the origin have the highest floors.
     pub fn round_off_floor(&self) -> f64 {
-        let radius = 2.0 * self.mesh.positions.iter().map(|x| x.norm()).fold(0.0, f64::max);
-        let sum: f64 = self.mesh.elements.iter().map(|e| e.force_scale(radius).powi(2)).sum();
+        let radius = 2.0
+            * self
+                .mesh
+                .positions
+                .iter()
+                .map(|x| x.norm())
+                .fold(0.0, f64::max);
+        let sum: f64 = self
+            .mesh
+            .elements
+            .iter()
+            .map(|e| e.force_scale(radius).powi(2))
+            .sum();
         4.0 * f64::EPSILON * sum.sqrt()
     }
 

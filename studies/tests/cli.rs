@@ -83,15 +83,28 @@ fn missing_file_and_unsupported_features_are_named() {
     // with the key named, and nothing half-solved.
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("dyn.toml");
-    let text = std::fs::read_to_string(bench("rollup_linear.toml")).unwrap().replace(
-        "analysis = \"static\"\nload_steps = 10",
-        "analysis = \"dynamic\"\nintegrator = \"newmark\"\ndt = 0.01\nt_end = 1.0",
-    );
+    let text = std::fs::read_to_string(bench("rollup_linear.toml"))
+        .unwrap()
+        .replace(
+            "analysis = \"static\"\nload_steps = 10",
+            "analysis = \"dynamic\"\nintegrator = \"newmark\"\ndt = 0.01\nt_end = 1.0",
+        );
     std::fs::write(&model, text).unwrap();
-    let out = flexmech().arg("run").arg(&model).arg("--out").arg(dir.path()).output().unwrap();
+    let out = flexmech()
+        .arg("run")
+        .arg(&model)
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("dyn.toml") && stderr.contains("solver.analysis") && stderr.contains("dynamic"), "{stderr}");
+    assert!(
+        stderr.contains("dyn.toml")
+            && stderr.contains("solver.analysis")
+            && stderr.contains("dynamic"),
+        "{stderr}"
+    );
     assert!(!dir.path().join("rollup-linear.h5").exists());
 }
 
