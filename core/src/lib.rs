@@ -7,10 +7,12 @@ pub mod scalar;
 
 pub use scalar::{cst, Scalar};
 pub mod element;
+pub mod inertia;
 pub mod section;
 pub mod shape;
 
 pub use element::BeamElement;
+pub use inertia::{Inertia, MassKind};
 pub use section::Section;
 pub mod mesh;
 pub mod state;
