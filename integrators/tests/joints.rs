@@ -52,29 +52,35 @@ fn soft() -> Section {
     Section::new([1.0e4, 4.0e3, 4.0e3], [8.0, 10.0, 10.0], 0.0, [0.0; 3])
 }
 
+/// Two straight 4-element beams `a0 → a1` and `b0 → b1`; their node numbers.
+fn two_beams(
+    ends: [[f64; 3]; 4],
+    e2: [Vector3<f64>; 2],
+    sec: Section,
+) -> (Mesh, Vec<usize>, Vec<usize>) {
+    let mut mesh = Mesh::default();
+    let v = Vector3::from;
+    let a = mesh
+        .add_straight_beam(v(ends[0]), v(ends[1]), e2[0], 4, 2, sec)
+        .unwrap();
+    let b = mesh
+        .add_straight_beam(v(ends[2]), v(ends[3]), e2[1], 4, 2, sec)
+        .unwrap();
+    (mesh, a, b)
+}
+
 /// A clamped post with an arm on its top joined by `map`; arm tip loaded.
 fn post_and_arm(map: Arc<dyn JointMap>, driven: Option<Schedule>) -> Mechanism {
-    let mut mesh = Mesh::default();
-    let post = mesh
-        .add_straight_beam(
-            Vector3::zeros(),
-            Vector3::new(0.0, 0.0, 2.0),
-            Vector3::x(),
-            4,
-            2,
-            rod(),
-        )
-        .unwrap();
-    let arm = mesh
-        .add_straight_beam(
-            Vector3::new(0.0, 0.0, 2.0),
-            Vector3::new(1.0, 0.0, 2.0),
-            Vector3::y(),
-            4,
-            2,
-            rod(),
-        )
-        .unwrap();
+    let (mesh, post, arm) = two_beams(
+        [
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, 2.0],
+            [0.0, 0.0, 2.0],
+            [1.0, 0.0, 2.0],
+        ],
+        [Vector3::x(), Vector3::y()],
+        rod(),
+    );
     let mut mech = Mechanism::new(mesh);
     mech.fixed[post[0]] = [true; 6];
     mech.loads.push(NodalLoad {
@@ -148,27 +154,16 @@ fn one_step_residual(mech: &Mechanism, converged: &MechanismState, eps: f64) -> 
 /// the elasticity of both beams — no zero-stiffness mode (unlike a free
 /// pendulum, whose unstressed tangent is singular in statics).
 fn clamped_pair(map: Arc<dyn JointMap>) -> Mechanism {
-    let mut mesh = Mesh::default();
-    let a = mesh
-        .add_straight_beam(
-            Vector3::zeros(),
-            Vector3::new(1.0, 0.0, 0.0),
-            Vector3::y(),
-            4,
-            2,
-            soft(),
-        )
-        .unwrap();
-    let b = mesh
-        .add_straight_beam(
-            Vector3::new(1.0, 0.0, 0.0),
-            Vector3::new(2.0, 0.0, 0.0),
-            Vector3::y(),
-            4,
-            2,
-            soft(),
-        )
-        .unwrap();
+    let (mesh, a, b) = two_beams(
+        [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+        ],
+        [Vector3::y(), Vector3::y()],
+        soft(),
+    );
     let mut mech = Mechanism::new(mesh);
     mech.fixed[a[0]] = [true; 6];
     mech.fixed[*b.last().unwrap()] = [true; 6];
@@ -211,31 +206,18 @@ fn newton_is_quadratic_with_dependent_joints() {
     // The rack-and-pinion's slave starts at b (t_r × t) from the master.
     let slave = driven.joints[0].slave;
     let offset = Vector3::y().cross(&Vector3::x()) * 0.5;
-    driven.mesh = {
-        let mut mesh = Mesh::default();
-        let a = mesh
-            .add_straight_beam(
-                Vector3::zeros(),
-                Vector3::new(1.0, 0.0, 0.0),
-                Vector3::y(),
-                4,
-                2,
-                soft(),
-            )
-            .unwrap();
-        let b = mesh
-            .add_straight_beam(
-                Vector3::new(1.0, 0.0, 0.0) + offset,
-                Vector3::new(2.0, 0.0, 0.0) + offset,
-                Vector3::y(),
-                4,
-                2,
-                soft(),
-            )
-            .unwrap();
-        assert_eq!((a.len(), b[0]), (5, slave));
-        mesh
-    };
+    let (mesh, a, b) = two_beams(
+        [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, offset.y, offset.z],
+            [2.0, offset.y, offset.z],
+        ],
+        [Vector3::y(), Vector3::y()],
+        soft(),
+    );
+    assert_eq!((a.len(), b[0]), (5, slave));
+    driven.mesh = mesh;
     for mech in [free, driven] {
         let mut last = None;
         let out = solve_static(&mech, &settings(8), |s| last = Some(s.clone())).unwrap();

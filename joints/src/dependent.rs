@@ -9,7 +9,8 @@
 //! * the kinematics `Λ_R = exp((ψ − ψ₀) t̂)`, `r_R = f(ψ)`, hence the variation
 //!   map `N` of eqs 10–11 (`δr_s = δr_m − (Λ_m r_R)^ δφ_m + Λ_m f′(ψ) δψ`,
 //!   `δφ_s = δφ_m + Λ_m t δψ`) and its derivative (see [`crate::kinematics`]);
-//! * `f′(ψ)` and `f″(ψ)` ([`DependentJointMaps::derivative`], […`second_derivative`]);
+//! * `f′(ψ)` and `f″(ψ)` ([`DependentJointMaps::derivative`],
+//!   [`DependentJointMaps::second_derivative`]);
 //! * the secant `G` of eq. 22 with `u_R = f(ψₙ₊₁) − f(ψₙ) = G θ_R`
 //!   ([`DependentJointMaps::secant`]), robust as the increment tends to zero;
 //! * the exact incremental map `Ñ` of eqs 21–22
