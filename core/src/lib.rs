@@ -6,6 +6,7 @@ pub mod rotation;
 pub mod scalar;
 
 pub use scalar::{cst, Scalar};
+pub mod conserving;
 pub mod element;
 pub mod inertia;
 pub mod section;
