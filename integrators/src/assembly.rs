@@ -9,7 +9,7 @@
 
 use crate::dofs::DofMap;
 use faer::sparse::SymbolicSparseColMat;
-use flexmech_core::{Configuration, Mesh};
+use flexmech_core::{Configuration, Element, Mesh};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
@@ -133,17 +133,24 @@ impl Assembler {
     /// Evaluates every element at `config`: fills [`Self::nodal`],
     /// [`Self::nodal_abs`] and the tangent [`Self::values`].
     pub fn assemble(&mut self, mesh: &Mesh, dofs: &DofMap, config: &Configuration) {
+        self.assemble_with(mesh, dofs, |el, _, r, k| {
+            el.residual_tangent(&config.x, &config.rot, r, k)
+        });
+    }
+
+    /// As [`Assembler::assemble`], with any element kernel: `kernel(element,
+    /// index, r, k)` writes the element's residual (`6N`) and tangent
+    /// (`6N × 6N`, column-major) with respect to its nodal increments.
+    pub fn assemble_with<F>(&mut self, mesh: &Mesh, dofs: &DofMap, kernel: F)
+    where
+        F: Fn(&Element, usize, &mut [f64], &mut [f64]) + Sync,
+    {
         self.work
             .par_iter_mut()
-            .zip(mesh.elements.par_iter())
+            .zip(mesh.elements.par_iter().enumerate())
             .zip(self.slots.par_iter())
-            .for_each(|((w, el), s)| {
-                el.residual_tangent(
-                    &config.x,
-                    &config.rot,
-                    w.r.as_mut_slice(),
-                    w.k.as_mut_slice(),
-                );
+            .for_each(|((w, (index, el)), s)| {
+                kernel(el, index, w.r.as_mut_slice(), w.k.as_mut_slice());
                 w.g.fill(0.0);
                 for (a, &nd) in el.nodes().iter().enumerate() {
                     let map = &dofs.nodes[nd];
@@ -183,5 +190,16 @@ impl Assembler {
         for (&p, &v) in self.blocks[b].pos.iter().zip(m.as_slice()) {
             self.values[p] += v;
         }
+    }
+
+    /// Adds `v` to the tangent entry (`row`, `col`), which must be in the
+    /// pattern (any two equations of one element, or of one joint block).
+    pub fn add_entry(&mut self, row: usize, col: usize, v: f64) {
+        let (cp, ri) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        let rows = &ri[cp[col]..cp[col + 1]];
+        let p = rows
+            .binary_search(&row)
+            .expect("entry in the sparsity pattern");
+        self.values[cp[col] + p] += v;
     }
 }

@@ -5,6 +5,7 @@
 pub mod assembly;
 pub mod constraints;
 pub mod dofs;
+pub mod dynamics;
 pub mod error;
 pub mod linsolve;
 pub mod mechanism;

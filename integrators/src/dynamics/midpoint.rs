@@ -1,0 +1,412 @@
+//! The midpoint machinery shared by the momentum-conserving and
+//! energy–momentum schemes (paper eqs 16–17, FORMULATION §4):
+//!
+//! * translations `(xₙ₊₁ − xₙ)/Δt = ½(vₙ + vₙ₊₁)`, inertial force `M(vₙ₊₁ − vₙ)/Δt`;
+//! * rotations `Rₙ₊₁ = cay(θ)Rₙ`, `θ = (Δt/2) Rₙ(Wₙ + Wₙ₊₁)`, inertial moment
+//!   `(πₙ₊₁ − πₙ)/Δt` with `π = R J₀ W` — so that `θ·(πₙ₊₁ − πₙ)/Δt` and
+//!   `u·M(vₙ₊₁ − vₙ)/Δt` are exactly the kinetic energy changes;
+//! * internal force `q_k(Nₙ₊½, Mₙ₊½)` with the mid rotation of the scheme;
+//! * external loads at `tₙ₊½`.
+
+use super::{DynamicSettings, Motion};
+use crate::assembly::Assembler;
+use crate::dofs::DofMap;
+use crate::error::SolveError;
+use crate::linsolve::SparseLu;
+use crate::mechanism::Mechanism;
+use crate::newton::{self, NewtonReport, NewtonSystem};
+use crate::record::{Energies, StepRecord};
+use crate::statics::strain_energy;
+use flexmech_core::conserving::{MidRotation, Pose};
+use flexmech_core::rotation::{cayley_inverse, exp};
+use flexmech_core::{Configuration, Element, Inertia};
+use nalgebra::{Const, Matrix3, Vector3, U1};
+use num_dual::DualSVec64;
+
+/// Velocities at the end of a step from the configurations at both ends.
+pub fn end_motion(
+    start: &Configuration,
+    end: &Configuration,
+    v_n: &[Vector3<f64>],
+    w_n: &[Vector3<f64>],
+    dt: f64,
+) -> (Vec<Vector3<f64>>, Vec<Vector3<f64>>) {
+    let v = (0..end.x.len())
+        .map(|i| (end.x[i] - start.x[i]) * (2.0 / dt) - v_n[i])
+        .collect();
+    let w = (0..end.x.len())
+        .map(|i| {
+            let theta = cayley_inverse(&(end.rot[i] * start.rot[i].transpose()));
+            start.rot[i].transpose() * theta * (2.0 / dt) - w_n[i]
+        })
+        .collect();
+    (v, w)
+}
+
+/// Element kernel of the midpoint schemes: `q_k(Nₙ₊½, Mₙ₊½)` and its
+/// derivative with respect to spatial increments of the end pose
+/// (`x ← x + η`, `R ← exp(η̂)R`), by forward-mode AD.
+fn element_kernel(
+    el: &Element,
+    start: &Configuration,
+    end: &Configuration,
+    mid: MidRotation,
+    r: &mut [f64],
+    k: &mut [f64],
+) {
+    let Element::Linear(e) = el else {
+        unreachable!("the midpoint schemes are checked to run on 2-node elements")
+    };
+    type D = DualSVec64<12>;
+    let n = e.nodes;
+    let s: Pose<f64> = (
+        [start.x[n[0]], start.x[n[1]]],
+        [start.rot[n[0]], start.rot[n[1]]],
+    );
+    let (n0, m0) = e.resultants(&s.0, &s.1);
+    let seed = |j: usize| D::from_re(0.0).derivative(j);
+    let v = |j: usize| Vector3::new(seed(j), seed(j + 1), seed(j + 2));
+    let sd: Pose<D> = (
+        s.0.map(|x| x.map(D::from_re)),
+        s.1.map(|q| q.map(D::from_re)),
+    );
+    let ed: Pose<D> = (
+        [
+            end.x[n[0]].map(D::from_re) + v(0),
+            end.x[n[1]].map(D::from_re) + v(6),
+        ],
+        [
+            exp(&v(3)) * end.rot[n[0]].map(D::from_re),
+            exp(&v(9)) * end.rot[n[1]].map(D::from_re),
+        ],
+    );
+    let (n1, m1) = e.resultants(&ed.0, &ed.1);
+    let half = D::from_re(0.5);
+    let nbar = (n0.map(D::from_re) + n1) * half;
+    let mbar = (m0.map(D::from_re) + m1) * half;
+    let q = e.midpoint_force(&sd, &ed, &nbar, &mbar, mid);
+    for i in 0..12 {
+        r[i] = q[i].re;
+        let row = q[i].eps.unwrap_generic(Const::<12>, U1);
+        for j in 0..12 {
+            k[j * 12 + i] = row[j];
+        }
+    }
+}
+
+/// Inertial moment `(πₙ₊₁ − πₙ)/Δt` of one node and its derivative with
+/// respect to a spatial spin of the end rotation.
+fn inertial_moment(
+    j0: &Matrix3<f64>,
+    r_n: &Matrix3<f64>,
+    r_end: &Matrix3<f64>,
+    w_n: &Vector3<f64>,
+    dt: f64,
+) -> (Vector3<f64>, Matrix3<f64>) {
+    type D = DualSVec64<3>;
+    let eta = Vector3::new(
+        D::from_re(0.0).derivative(0),
+        D::from_re(0.0).derivative(1),
+        D::from_re(0.0).derivative(2),
+    );
+    let r1 = exp(&eta) * r_end.map(D::from_re);
+    let rn = r_n.map(D::from_re);
+    let theta = cayley_inverse(&(r1 * rn.transpose()));
+    let w1 = rn.transpose() * theta * D::from_re(2.0 / dt) - w_n.map(D::from_re);
+    let pi_n = r_n * (j0 * w_n);
+    let m = (r1 * (j0.map(D::from_re) * w1) - pi_n.map(D::from_re)) / D::from_re(dt);
+    let mut k = Matrix3::zeros();
+    let mut val = Vector3::zeros();
+    for i in 0..3 {
+        val[i] = m[i].re;
+        k.set_row(i, &m[i].eps.unwrap_generic(Const::<3>, U1).transpose());
+    }
+    (val, k)
+}
+
+/// One step of a midpoint scheme, as the [`NewtonSystem`] Newton solves.
+pub struct MidpointStep<'a> {
+    pub mech: &'a Mechanism,
+    pub dofs: &'a DofMap,
+    pub inertia: &'a Inertia,
+    pub asm: &'a mut Assembler,
+    pub start: &'a Configuration,
+    pub v_n: &'a [Vector3<f64>],
+    pub w_n: &'a [Vector3<f64>],
+    /// The current iterate of the end configuration.
+    pub end: Configuration,
+    pub dt: f64,
+    pub mid: MidRotation,
+    /// External nodal forces at `tₙ₊½`.
+    pub fext: Vec<f64>,
+    pub nodal: Vec<f64>,
+    /// Magnitudes of the internal and inertial contributions (residual scale).
+    pub inertia_abs: Vec<f64>,
+    pub scratch: Vec<f64>,
+    pub floor: f64,
+}
+
+impl NewtonSystem for MidpointStep<'_> {
+    fn evaluate(&mut self, r: &mut [f64]) -> f64 {
+        let (start, end, mid) = (self.start, &self.end, self.mid);
+        self.asm
+            .assemble_with(&self.mech.mesh, self.dofs, |el, _, re, ke| {
+                element_kernel(el, start, end, mid, re, ke)
+            });
+        let dt = self.dt;
+        for (g, (fi, fe)) in self
+            .nodal
+            .iter_mut()
+            .zip(self.asm.nodal.iter().zip(&self.fext))
+        {
+            *g = fi - fe;
+        }
+        // Translational inertia: Σⱼ m_ij (vⱼ,ₙ₊₁ − vⱼ,ₙ)/Δt, vₙ₊₁ = 2(xₙ₊₁ − xₙ)/Δt − vₙ.
+        self.inertia_abs.iter_mut().for_each(|v| *v = 0.0);
+        for &(i, j, m) in &self.inertia.mass {
+            let dv = (end.x[j] - start.x[j]) * (2.0 / dt) - self.v_n[j] * 2.0;
+            for c in 0..3 {
+                self.nodal[6 * i + c] += m * dv[c] / dt;
+                self.inertia_abs[6 * i + c] += (m * dv[c] / dt).abs();
+            }
+            let k = 2.0 * m / (dt * dt);
+            let (mi, mj) = (&self.dofs.nodes[i], &self.dofs.nodes[j]);
+            for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
+                for (ej, cj) in mj.eqs.iter().zip(&mj.cols) {
+                    let v = k * ci.fixed_rows::<3>(0).dot(&cj.fixed_rows::<3>(0));
+                    if v != 0.0 {
+                        self.asm.add_entry(*ei, *ej, v);
+                    }
+                }
+            }
+        }
+        // Rotational inertia, node by node.
+        for (i, j0) in self.inertia.rotational.iter().enumerate() {
+            if *j0 == Matrix3::zeros() {
+                continue;
+            }
+            let (m, k) = inertial_moment(j0, &start.rot[i], &end.rot[i], &self.w_n[i], dt);
+            for c in 0..3 {
+                self.nodal[6 * i + 3 + c] += m[c];
+                self.inertia_abs[6 * i + 3 + c] += m[c].abs();
+            }
+            let map = &self.dofs.nodes[i];
+            for (ei, ci) in map.eqs.iter().zip(&map.cols) {
+                for (ej, cj) in map.eqs.iter().zip(&map.cols) {
+                    let v = ci.fixed_rows::<3>(3).dot(&(k * cj.fixed_rows::<3>(3)));
+                    if v != 0.0 {
+                        self.asm.add_entry(*ei, *ej, v);
+                    }
+                }
+            }
+        }
+        self.dofs.reduce(&self.nodal, r);
+        self.dofs.reduce(&self.fext, &mut self.scratch);
+        let f_ext = norm(&self.scratch);
+        for (a, b) in self.inertia_abs.iter_mut().zip(&self.asm.nodal_abs) {
+            *a += b;
+        }
+        self.dofs.reduce(&self.inertia_abs, &mut self.scratch);
+        f_ext.max(norm(&self.scratch))
+    }
+
+    fn tangent_values(&self) -> &[f64] {
+        &self.asm.values
+    }
+
+    fn apply(&mut self, dq: &[f64]) {
+        for n in 0..self.end.x.len() {
+            let p = self.dofs.node_increment(n, dq);
+            if p != nalgebra::Vector6::zeros() {
+                self.end.increment(
+                    n,
+                    &p.fixed_rows::<3>(0).into_owned(),
+                    &p.fixed_rows::<3>(3).into_owned(),
+                );
+            }
+        }
+    }
+
+    fn floor(&self) -> f64 {
+        self.floor
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// Runs a midpoint scheme from `initial` over `[0, t_end]`, reporting a record
+/// at t = 0 and after every converged step. Beams of 2-node elements without
+/// joints or prescribed motion (joints in dynamics come with the exact
+/// incremental maps `Ñ`).
+pub fn solve(
+    mech: &Mechanism,
+    settings: &DynamicSettings,
+    initial: &Motion,
+    mid: MidRotation,
+    mut on_step: impl FnMut(&StepRecord),
+) -> Result<Configuration, SolveError> {
+    if !mech.joints.is_empty() || !mech.prescribed.is_empty() {
+        return Err(SolveError::InvalidMechanism(
+            "joints and prescribed motion are not available in dynamic analyses yet".into(),
+        ));
+    }
+    if mech
+        .mesh
+        .elements
+        .iter()
+        .any(|e| !matches!(e, Element::Linear(_)))
+    {
+        return Err(SolveError::InvalidMechanism(
+            "the conserving schemes need 2-node elements".into(),
+        ));
+    }
+    if !(settings.dt > 0.0 && settings.t_end > 0.0) {
+        return Err(SolveError::InvalidMechanism(
+            "dt and t_end must be positive".into(),
+        ));
+    }
+    let nodes = mech.mesh.node_count();
+    let dofs = DofMap::independent(&mech.fixed);
+    let inertia = Inertia::new(&mech.mesh, settings.mass);
+    let mut asm = Assembler::new(&mech.mesh, &dofs, &[]);
+    let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
+    let (mut r, mut dq) = (vec![0.0; dofs.n_eq], vec![0.0; dofs.n_eq]);
+    let mut config = Configuration::initial(&mech.mesh.positions);
+    let (mut v, mut w) = (initial.v.clone(), initial.w.clone());
+    let mut fext = vec![0.0; 6 * nodes];
+    mech.external_forces(0.0, &mut fext);
+    on_step(&dynamic_record(
+        mech, &inertia, &config, &v, &w, &fext, 0.0, 0.0, None,
+    ));
+    let (mut t, mut step, mut halvings, mut easy) = (0.0f64, settings.dt, 0usize, 0usize);
+    while t < settings.t_end * (1.0 - 1e-12) {
+        let dt = step.min(settings.t_end - t);
+        // Predictor: constant velocities over the step.
+        let mut end = config.clone();
+        for i in 0..nodes {
+            let spin = config.rot[i] * w[i] * dt;
+            end.increment(i, &(v[i] * dt), &spin);
+        }
+        for (i, f) in mech.fixed.iter().enumerate() {
+            if f.iter().any(|&h| h) {
+                end.x[i] = config.x[i];
+                end.rot[i] = config.rot[i];
+            }
+        }
+        let mut fmid = vec![0.0; 6 * nodes];
+        mech.external_forces(t + 0.5 * dt, &mut fmid);
+        let mut sys = MidpointStep {
+            mech,
+            dofs: &dofs,
+            inertia: &inertia,
+            asm: &mut asm,
+            start: &config,
+            v_n: &v,
+            w_n: &w,
+            end,
+            dt,
+            mid,
+            fext: fmid,
+            nodal: vec![0.0; 6 * nodes],
+            inertia_abs: vec![0.0; 6 * nodes],
+            scratch: vec![0.0; dofs.n_eq],
+            floor: mech.round_off_floor(),
+        };
+        match newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq) {
+            Ok(report) => {
+                let end = sys.end;
+                let (v1, w1) = end_motion(&config, &end, &v, &w, dt);
+                config = end;
+                v = v1;
+                w = w1;
+                t += dt;
+                mech.external_forces(t, &mut fext);
+                on_step(&dynamic_record(
+                    mech,
+                    &inertia,
+                    &config,
+                    &v,
+                    &w,
+                    &fext,
+                    t,
+                    dt,
+                    Some(&report),
+                ));
+                halvings = 0;
+                easy += 1;
+                if easy >= 4 && step < settings.dt {
+                    step = (2.0 * step).min(settings.dt);
+                    easy = 0;
+                }
+            }
+            Err(reason) => {
+                if halvings >= settings.max_halvings {
+                    return Err(SolveError::NoConvergence {
+                        time: t + dt,
+                        halvings,
+                        reason,
+                    });
+                }
+                halvings += 1;
+                easy = 0;
+                step *= 0.5;
+            }
+        }
+    }
+    Ok(config)
+}
+
+/// A record with energies (kinetic, strain, potential of the external forces
+/// `−Σ f·u` — gravity included — and their sum) and momenta.
+#[allow(clippy::too_many_arguments)]
+pub fn dynamic_record(
+    mech: &Mechanism,
+    inertia: &Inertia,
+    config: &Configuration,
+    v: &[Vector3<f64>],
+    w: &[Vector3<f64>],
+    fext: &[f64],
+    time: f64,
+    dt: f64,
+    report: Option<&NewtonReport>,
+) -> StepRecord {
+    let kinetic = inertia.kinetic_energy(v, w);
+    let strain = strain_energy(mech, config);
+    let potential: f64 = -(0..config.x.len())
+        .map(|n| {
+            (config.x[n] - mech.mesh.positions[n]).dot(&Vector3::new(
+                fext[6 * n],
+                fext[6 * n + 1],
+                fext[6 * n + 2],
+            ))
+        })
+        .sum::<f64>();
+    let lin = inertia.linear_momentum(v);
+    let ang = inertia.angular_momentum(&config.x, &config.rot, v, w);
+    StepRecord {
+        time,
+        dt,
+        iterations: report.map_or(0, |r| r.iterations),
+        residual: report.map_or(0.0, |r| r.residual),
+        residual_history: report.map_or_else(Vec::new, |r| r.history.clone()),
+        beta: f64::NAN,
+        energy: Energies {
+            kinetic,
+            strain,
+            potential,
+            total: kinetic + strain + potential,
+        },
+        momentum_linear: [lin.x, lin.y, lin.z],
+        momentum_angular: [ang.x, ang.y, ang.z],
+        positions: config.x.iter().map(|x| [x.x, x.y, x.z]).collect(),
+        quaternions: (0..config.x.len())
+            .map(|i| {
+                let q = config.quaternion(i);
+                [q.x, q.y, q.z, q.w]
+            })
+            .collect(),
+        joints: Vec::new(),
+    }
+}
