@@ -89,3 +89,43 @@ fn momentum_scheme_conserves_linear_and_angular_momentum() {
         assert!(de < 0.1);
     }
 }
+
+#[test]
+fn energy_momentum_scheme_conserves_energy_and_momenta_with_a_large_step() {
+    use flexmech_integrators::dynamics::energy_momentum;
+    for mass in [MassKind::Consistent, MassKind::Lumped] {
+        let (mech, motion, mut settings) = spinning_beam(mass);
+        // A step four times the momentum test's: about a fifth of a turn.
+        settings.dt = 0.2;
+        settings.t_end = 40.0;
+        let mut steps: Vec<StepRecord> = Vec::new();
+        energy_momentum::solve(&mech, &settings, &motion, |s| steps.push(s.clone())).unwrap();
+        assert!(steps.len() >= 201);
+        let e0 = steps[0].energy.total;
+        let de = steps
+            .iter()
+            .map(|s| (s.energy.total - e0).abs() / e0)
+            .fold(0.0, f64::max);
+        let lin: Vec<_> = steps.iter().map(|s| s.momentum_linear).collect();
+        let ang: Vec<_> = steps.iter().map(|s| s.momentum_angular).collect();
+        let (dl, dh) = (rel_drift(&lin), rel_drift(&ang));
+        let betas: Vec<f64> = steps[1..].iter().map(|s| s.beta).collect();
+        let determined = betas.iter().filter(|b| b.is_finite()).count();
+        eprintln!(
+            "{mass:?}: energy drift {de:.2e}, momentum drift {dl:.2e} / {dh:.2e}, β determined in {determined} of {} steps, max |β| {:.3e}",
+            betas.len(),
+            betas.iter().filter(|b| b.is_finite()).fold(0.0f64, |m, b| m.max(b.abs()))
+        );
+        assert!(de <= 1e-9, "{mass:?}: energy drift {de:e}");
+        assert!(
+            dl <= 1e-9 && dh <= 1e-9,
+            "{mass:?}: momentum drift {dl:e} / {dh:e}"
+        );
+        assert!(
+            determined * 10 >= betas.len() * 9,
+            "β undetermined too often"
+        );
+        let strain = steps.iter().map(|s| s.energy.strain).fold(0.0, f64::max);
+        assert!(strain > 1e-6);
+    }
+}

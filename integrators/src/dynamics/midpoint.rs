@@ -43,7 +43,8 @@ pub fn end_motion(
     (v, w)
 }
 
-/// Element kernel of the midpoint schemes: `q_k(Nₙ₊½, Mₙ₊½)` and its
+/// Element kernel of the midpoint schemes: `q_k(Nₙ₊½, Mₙ₊½)` (plus
+/// `β q_k(N_d, 0)` for the energy–momentum scheme) and its
 /// derivative with respect to spatial increments of the end pose
 /// (`x ← x + η`, `R ← exp(η̂)R`), by forward-mode AD.
 fn element_kernel(
@@ -51,6 +52,7 @@ fn element_kernel(
     start: &Configuration,
     end: &Configuration,
     mid: MidRotation,
+    beta: f64,
     r: &mut [f64],
     k: &mut [f64],
 ) {
@@ -84,7 +86,12 @@ fn element_kernel(
     let half = D::from_re(0.5);
     let nbar = (n0.map(D::from_re) + n1) * half;
     let mbar = (m0.map(D::from_re) + m1) * half;
-    let q = e.midpoint_force(&sd, &ed, &nbar, &mbar, mid);
+    let mut q = e.midpoint_force(&sd, &ed, &nbar, &mbar, mid);
+    if beta != 0.0 {
+        // Energy–momentum correction β q_k(N_d, 0), N_d = Nₙ₊₁ − Nₙ.
+        let nd = n1 - n0.map(D::from_re);
+        q += e.midpoint_force(&sd, &ed, &nd, &Vector3::zeros(), mid) * D::from_re(beta);
+    }
     for i in 0..12 {
         r[i] = q[i].re;
         let row = q[i].eps.unwrap_generic(Const::<12>, U1);
@@ -137,6 +144,8 @@ pub struct MidpointStep<'a> {
     pub end: Configuration,
     pub dt: f64,
     pub mid: MidRotation,
+    /// Energy–momentum β (0 for the momentum scheme).
+    pub beta: f64,
     /// External nodal forces at `tₙ₊½`.
     pub fext: Vec<f64>,
     pub nodal: Vec<f64>,
@@ -148,10 +157,10 @@ pub struct MidpointStep<'a> {
 
 impl NewtonSystem for MidpointStep<'_> {
     fn evaluate(&mut self, r: &mut [f64]) -> f64 {
-        let (start, end, mid) = (self.start, &self.end, self.mid);
+        let (start, end, mid, beta) = (self.start, &self.end, self.mid, self.beta);
         self.asm
             .assemble_with(&self.mech.mesh, self.dofs, |el, _, re, ke| {
-                element_kernel(el, start, end, mid, re, ke)
+                element_kernel(el, start, end, mid, beta, re, ke)
             });
         let dt = self.dt;
         for (g, (fi, fe)) in self
@@ -308,14 +317,24 @@ pub fn solve(
             end,
             dt,
             mid,
+            beta: 0.0,
             fext: fmid,
             nodal: vec![0.0; 6 * nodes],
             inertia_abs: vec![0.0; 6 * nodes],
             scratch: vec![0.0; dofs.n_eq],
             floor: mech.round_off_floor(),
         };
-        match newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq) {
-            Ok(report) => {
+        let outcome = match mid {
+            MidRotation::Geodesic => {
+                newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq)
+                    .map(|rep| (rep, f64::NAN))
+            }
+            MidRotation::Algebraic => {
+                super::energy_momentum::solve_step(&mut sys, &mut lu, &settings.newton)
+            }
+        };
+        match outcome {
+            Ok((report, beta)) => {
                 let end = sys.end;
                 let (v1, w1) = end_motion(&config, &end, &v, &w, dt);
                 config = end;
@@ -323,17 +342,10 @@ pub fn solve(
                 w = w1;
                 t += dt;
                 mech.external_forces(t, &mut fext);
-                on_step(&dynamic_record(
-                    mech,
-                    &inertia,
-                    &config,
-                    &v,
-                    &w,
-                    &fext,
-                    t,
-                    dt,
-                    Some(&report),
-                ));
+                let mut rec =
+                    dynamic_record(mech, &inertia, &config, &v, &w, &fext, t, dt, Some(&report));
+                rec.beta = beta;
+                on_step(&rec);
                 halvings = 0;
                 easy += 1;
                 if easy >= 4 && step < settings.dt {

@@ -5,7 +5,10 @@
 //!
 //! * [`momentum`]: the midpoint scheme with the geodesic mid rotation —
 //!   conserves linear and angular momentum exactly.
+//! * [`energy_momentum`]: the algebraic mid rotation and the β correction —
+//!   conserves momenta and the total energy of conservative systems.
 
+pub mod energy_momentum;
 pub mod midpoint;
 pub mod momentum;
 
