@@ -3,6 +3,7 @@
 //! generic kernels), halves the step on failure, and reports a
 //! [`StepRecord`](crate::record::StepRecord) per converged step.
 //!
+//! * [`newmark`]: the trapezoidal rule on SO(3) (Simo & Vu-Quoc).
 //! * [`momentum`]: the midpoint scheme with the geodesic mid rotation —
 //!   conserves linear and angular momentum exactly.
 //! * [`energy_momentum`]: the algebraic mid rotation and the β correction —
@@ -11,6 +12,7 @@
 pub mod energy_momentum;
 pub mod midpoint;
 pub mod momentum;
+pub mod newmark;
 
 use crate::newton::NewtonSettings;
 use flexmech_core::MassKind;
