@@ -6,6 +6,7 @@ use crate::model::{
     PrescribedSpec, TimeFunction,
 };
 use flexmech_core::{Mesh, Section};
+use flexmech_integrators::dynamics::Motion;
 use flexmech_integrators::{JointInstance, Mechanism, NodalLoad, PrescribedDof, Schedule};
 use flexmech_joints::{
     lobe::{Lift, Lobe},
@@ -22,6 +23,8 @@ pub struct Built {
     pub mechanism: Mechanism,
     /// Global node numbers of every beam's nodes (`beam_nodes[b][k]`).
     pub beam_nodes: Vec<Vec<usize>>,
+    /// Initial velocities (dynamic analyses).
+    pub motion: Motion,
 }
 
 impl Built {
@@ -57,12 +60,32 @@ fn unsupported(model: &Model) -> Result<(), ModelError> {
         ))
     };
     if let Analysis::Dynamic { .. } = model.solver.analysis {
-        return err("solver.analysis", "dynamic analysis");
-    }
-    if !model.initial_velocities.is_empty() {
-        return err("initial_velocity[0]", "initial velocities");
+        if !model.joints.is_empty() {
+            return err("joint[0]", "joints in a dynamic analysis");
+        }
+        if !model.prescribed.is_empty() {
+            return err("prescribed[0]", "prescribed motion in a dynamic analysis");
+        }
     }
     Ok(())
+}
+
+/// Initial nodal velocities from the `[[initial_velocity]]` fields
+/// (`v = v₀ + ω × (x − origin)`, body angular velocity `W = ω` since every
+/// node starts at the identity); a later field overrides an earlier one on
+/// the nodes they share; nodes in no field start at rest.
+fn initial_motion(model: &Model, built: &Built) -> Motion {
+    let x0 = &built.mechanism.mesh.positions;
+    let mut motion = Motion::rest(x0.len());
+    for field in &model.initial_velocities {
+        let (v0, om, o) = (v(field.linear), v(field.angular), v(field.origin));
+        for r in &field.nodes {
+            let n = built.node(*r);
+            motion.v[n] = v0 + om.cross(&(x0[n] - o));
+            motion.w[n] = om;
+        }
+    }
+    motion
 }
 
 /// A time function as a schedule.
@@ -254,8 +277,11 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
             }
         }
     }
-    Ok(Built {
+    let mut built = Built {
         mechanism,
         beam_nodes,
-    })
+        motion: Motion::rest(0),
+    };
+    built.motion = initial_motion(model, &built);
+    Ok(built)
 }

@@ -3,8 +3,9 @@
 //! `status = "failed: …"` and every step computed before the failure.
 
 use crate::build::{build, Built};
-use crate::model::{Analysis, Model, ModelError};
+use crate::model::{Analysis, IntegratorKind, MassKind, Model, ModelError};
 use crate::results::{layout, ResultError, ResultWriter, RunMeta};
+use flexmech_integrators::dynamics::{energy_momentum, momentum, newmark, DynamicSettings};
 use flexmech_integrators::{solve_static, NewtonSettings, SolveError, StaticSettings, StepRecord};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -136,7 +137,34 @@ pub fn run_model(model: &Model, out_dir: &Path) -> Result<RunSummary, RunError> 
             };
             solve_static(mech, &settings, |s| sink.push(s)).map(|_| ())
         }
-        Analysis::Dynamic { .. } => unreachable!("rejected by build"),
+        Analysis::Dynamic {
+            integrator,
+            dt,
+            t_end,
+        } => {
+            let settings = DynamicSettings {
+                dt,
+                t_end,
+                newton: NewtonSettings {
+                    tolerance: model.solver.tolerance,
+                    max_iterations: model.solver.max_iterations,
+                },
+                max_halvings: model.solver.max_halvings,
+                mass: match model.solver.mass {
+                    MassKind::Consistent => flexmech_core::MassKind::Consistent,
+                    MassKind::Lumped => flexmech_core::MassKind::Lumped,
+                },
+            };
+            let push = |s: &StepRecord| sink.push(s);
+            match integrator {
+                IntegratorKind::Newmark => newmark::solve(mech, &settings, &built.motion, push),
+                IntegratorKind::Momentum => momentum::solve(mech, &settings, &built.motion, push),
+                IntegratorKind::EnergyMomentum => {
+                    energy_momentum::solve(mech, &settings, &built.motion, push)
+                }
+            }
+            .map(|_| ())
+        }
     };
     let wall = start.elapsed().as_secs_f64();
     sink.flush_last();
