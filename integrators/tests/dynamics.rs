@@ -37,6 +37,7 @@ fn spinning_beam(mass: MassKind) -> (Mechanism, Motion, DynamicSettings) {
             .map(|x| v0 + om.cross(x))
             .collect(),
         w: vec![om; mech.mesh.node_count()],
+        joint_rates: Vec::new(),
     };
     let settings = DynamicSettings {
         dt: 0.05,
@@ -140,6 +141,7 @@ fn newmark_translates_exactly_and_reports_its_energy_error() {
     let still = Motion {
         v: vec![v0; mech.mesh.node_count()],
         w: vec![Vector3::zeros(); mech.mesh.node_count()],
+        joint_rates: Vec::new(),
     };
     let mut last = None;
     newmark::solve(&mech, &settings, &still, |s| last = Some(s.clone())).unwrap();

@@ -39,6 +39,10 @@ pub struct DynamicSettings {
 pub struct Motion {
     pub v: Vec<Vector3<f64>>,
     pub w: Vec<Vector3<f64>>,
+    /// Initial rate of each joint's first released coordinate (missing
+    /// entries are zero). Slave velocities follow from their master's and
+    /// these rates through `N`; the `v`, `w` given for slave nodes are ignored.
+    pub joint_rates: Vec<f64>,
 }
 
 impl Motion {
@@ -47,6 +51,7 @@ impl Motion {
         Self {
             v: vec![Vector3::zeros(); nodes],
             w: vec![Vector3::zeros(); nodes],
+            joint_rates: Vec::new(),
         }
     }
 }

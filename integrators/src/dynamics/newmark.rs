@@ -15,15 +15,16 @@
 use super::midpoint::dynamic_record;
 use super::{DynamicSettings, Motion};
 use crate::assembly::Assembler;
-use crate::dofs::DofMap;
+use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::SolveError;
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
-use crate::newton::{self, NewtonSystem};
+use crate::newton::{self, NewtonReport, NewtonSystem};
 use crate::record::StepRecord;
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::{Configuration, Inertia};
-use nalgebra::{Const, Matrix3, Vector3, U1};
+use flexmech_joints::LOCAL;
+use nalgebra::{Const, Matrix3, SVector, Vector3, Vector6, U1};
 use num_dual::DualSVec64;
 
 const BETA: f64 = 0.25;
@@ -53,12 +54,13 @@ fn angular_acceleration<T: flexmech_core::Scalar>(
 
 struct NewmarkStep<'a> {
     mech: &'a Mechanism,
-    dofs: &'a DofMap,
+    topo: &'a mut Topology,
     inertia: &'a Inertia,
     asm: &'a mut Assembler,
     start: &'a Configuration,
     prev: &'a Kinematics,
-    end: Configuration,
+    /// The current iterate at `tₙ₊₁` (slaves placed exactly).
+    end: MechanismState,
     dt: f64,
     fext: Vec<f64>,
     nodal: Vec<f64>,
@@ -67,10 +69,27 @@ struct NewmarkStep<'a> {
     floor: f64,
 }
 
+impl NewmarkStep<'_> {
+    /// Adds the 3×3 block `k` (rows: component `ri..ri+3` of node `i`; columns:
+    /// `cj..cj+3` of node `j`) to the tangent through the node maps.
+    fn add_block(&mut self, i: usize, ri: usize, j: usize, cj: usize, k: &Matrix3<f64>) {
+        let (mi, mj) = (&self.topo.dofs.nodes[i], &self.topo.dofs.nodes[j]);
+        for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
+            for (ej, cjv) in mj.eqs.iter().zip(&mj.cols) {
+                let v = ci.fixed_rows::<3>(ri).dot(&(k * cjv.fixed_rows::<3>(cj)));
+                if v != 0.0 {
+                    self.asm.add_entry(*ei, *ej, v);
+                }
+            }
+        }
+    }
+}
+
 impl NewtonSystem for NewmarkStep<'_> {
     fn evaluate(&mut self, r: &mut [f64]) -> f64 {
-        let end = &self.end;
-        self.asm.assemble(&self.mech.mesh, self.dofs, end);
+        self.topo.refresh(self.mech, &self.end);
+        self.asm
+            .assemble(&self.mech.mesh, &self.topo.dofs, &self.end.config);
         let (dt, start, prev) = (self.dt, self.start, self.prev);
         for (g, (fi, fe)) in self
             .nodal
@@ -81,28 +100,21 @@ impl NewtonSystem for NewmarkStep<'_> {
         }
         self.abs.copy_from_slice(&self.asm.nodal_abs);
         // Translational inertia M aₙ₊₁, aₙ₊₁ = (u − Δt vₙ − Δt²(½−β)aₙ)/(βΔt²).
-        for &(i, j, m) in &self.inertia.mass {
-            let u = end.x[j] - start.x[j];
+        for k in 0..self.inertia.mass.len() {
+            let (i, j, m) = self.inertia.mass[k];
+            let u = self.end.config.x[j] - start.x[j];
             let a1 = (u - prev.v[j] * dt - prev.a[j] * (dt * dt * (0.5 - BETA))) / (BETA * dt * dt);
             for c in 0..3 {
                 self.nodal[6 * i + c] += m * a1[c];
                 self.abs[6 * i + c] += (m * a1[c]).abs();
             }
-            let k = m / (BETA * dt * dt);
-            let (mi, mj) = (&self.dofs.nodes[i], &self.dofs.nodes[j]);
-            for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
-                for (ej, cj) in mj.eqs.iter().zip(&mj.cols) {
-                    let v = k * ci.fixed_rows::<3>(0).dot(&cj.fixed_rows::<3>(0));
-                    if v != 0.0 {
-                        self.asm.add_entry(*ei, *ej, v);
-                    }
-                }
-            }
+            self.add_block(i, 0, j, 0, &(Matrix3::identity() * (m / (BETA * dt * dt))));
         }
         // Rotational inertia Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), by AD in a spin of Rₙ₊₁.
         type D = DualSVec64<3>;
-        for (i, j0) in self.inertia.rotational.iter().enumerate() {
-            if *j0 == Matrix3::zeros() {
+        for i in 0..self.inertia.rotational.len() {
+            let j0 = self.inertia.rotational[i];
+            if j0 == Matrix3::zeros() {
                 continue;
             }
             let eta = Vector3::new(
@@ -110,7 +122,7 @@ impl NewtonSystem for NewmarkStep<'_> {
                 D::from_re(0.0).derivative(1),
                 D::from_re(0.0).derivative(2),
             );
-            let r1 = exp(&eta) * end.rot[i].map(D::from_re);
+            let r1 = exp(&eta) * self.end.config.rot[i].map(D::from_re);
             let a1 = angular_acceleration(&start.rot[i], &r1, &prev.w[i], &prev.alpha[i], dt);
             let w1 = (prev.w[i] + prev.alpha[i] * (dt * (1.0 - GAMMA))).map(D::from_re)
                 + a1 * D::from_re(dt * GAMMA);
@@ -122,20 +134,20 @@ impl NewtonSystem for NewmarkStep<'_> {
                 self.abs[6 * i + 3 + c] += m[c].re.abs();
                 k.set_row(c, &m[c].eps.unwrap_generic(Const::<3>, U1).transpose());
             }
-            let map = &self.dofs.nodes[i];
-            for (ei, ci) in map.eqs.iter().zip(&map.cols) {
-                for (ej, cj) in map.eqs.iter().zip(&map.cols) {
-                    let v = ci.fixed_rows::<3>(3).dot(&(k * cj.fixed_rows::<3>(3)));
-                    if v != 0.0 {
-                        self.asm.add_entry(*ei, *ej, v);
-                    }
-                }
-            }
+            self.add_block(i, 3, i, 3, &k);
         }
-        self.dofs.reduce(&self.nodal, r);
-        self.dofs.reduce(&self.fext, &mut self.scratch);
+        self.topo.dofs.reduce(&self.nodal, r);
+        // Joints: the derivative of Nᵀg with the slave's full residual
+        // (internal + inertial − external).
+        let blocks = self
+            .topo
+            .geometric_blocks(self.mech, &self.end, &self.nodal);
+        for (b, block) in blocks.iter().enumerate() {
+            self.asm.add_block(b, block);
+        }
+        self.topo.dofs.reduce(&self.fext, &mut self.scratch);
         let f_ext = norm(&self.scratch);
-        self.dofs.reduce(&self.abs, &mut self.scratch);
+        self.topo.dofs.reduce(&self.abs, &mut self.scratch);
         f_ext.max(norm(&self.scratch))
     }
 
@@ -144,16 +156,7 @@ impl NewtonSystem for NewmarkStep<'_> {
     }
 
     fn apply(&mut self, dq: &[f64]) {
-        for n in 0..self.end.x.len() {
-            let p = self.dofs.node_increment(n, dq);
-            if p != nalgebra::Vector6::zeros() {
-                self.end.increment(
-                    n,
-                    &p.fixed_rows::<3>(0).into_owned(),
-                    &p.fixed_rows::<3>(3).into_owned(),
-                );
-            }
-        }
+        self.topo.apply(self.mech, &mut self.end, dq);
     }
 
     fn floor(&self) -> f64 {
@@ -165,99 +168,173 @@ fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// Integrates `mech` from `initial` with Newmark's trapezoidal rule. Initial
-/// accelerations come from the equations of motion at t = 0 with the lumped
-/// (row-sum) masses: `a₀ = (f_ext − f_int)/mᵢ`, `A₀ = J₀⁻¹(R₀ᵀm_ext − W₀ × J₀W₀)`
-/// (zero where a node carries no mass or rotational inertia).
+/// Initial velocities, every slave's derived from its master's and the
+/// joint's released rate through `N` (spatial spin `w = R W`).
+fn slave_velocities(
+    mech: &Mechanism,
+    topo: &Topology,
+    state: &MechanismState,
+    initial: &Motion,
+) -> (Vec<Vector3<f64>>, Vec<Vector3<f64>>) {
+    let (mut v, mut w) = (initial.v.clone(), initial.w.clone());
+    for &j in &topo.order {
+        let joint = &mech.joints[j];
+        let (m, s) = (joint.master, joint.slave);
+        let n = joint
+            .map
+            .variation(&state.config.x[m], &state.config.rot[m], &state.released[j]);
+        let mut p = SVector::<f64, LOCAL>::zeros();
+        p.fixed_rows_mut::<3>(0).copy_from(&v[m]);
+        p.fixed_rows_mut::<3>(3)
+            .copy_from(&(state.config.rot[m] * w[m]));
+        if joint.map.released_count() > 0 {
+            p[6] = initial.joint_rates.get(j).copied().unwrap_or(0.0);
+        }
+        let ps: Vector6<f64> = n * p;
+        v[s] = ps.fixed_rows::<3>(0).into_owned();
+        w[s] = state.config.rot[s].transpose() * ps.fixed_rows::<3>(3);
+    }
+    (v, w)
+}
+
+/// Initial accelerations from the reduced equations of motion at t = 0,
+/// `(Tᵀ M T) q̈ = −Tᵀ r` (translational and rotational inertia through the
+/// node maps, joints included); nodal accelerations `pᵢ = Tᵢ q̈`, body angular
+/// `A = Rᵀ α`. Velocity-dependent terms (gyroscopic, `Ṫ q̇`) are left out, so
+/// a system that starts spinning begins with a small acceleration error that
+/// the trapezoidal rule carries as an O(Δt) velocity offset. If the reduced
+/// mass is singular (massless DOFs) the accelerations start at zero.
+#[allow(clippy::too_many_arguments)]
+fn initial_accelerations(
+    mech: &Mechanism,
+    topo: &Topology,
+    inertia: &Inertia,
+    asm: &mut Assembler,
+    lu: &mut SparseLu,
+    state: &MechanismState,
+    residual: &[f64],
+) -> (Vec<Vector3<f64>>, Vec<Vector3<f64>>) {
+    let nodes = mech.mesh.node_count();
+    let zero = (vec![Vector3::zeros(); nodes], vec![Vector3::zeros(); nodes]);
+    asm.values.iter_mut().for_each(|v| *v = 0.0);
+    let mut add = |i: usize, ri: usize, j: usize, cj: usize, k: &Matrix3<f64>| {
+        let (mi, mj) = (&topo.dofs.nodes[i], &topo.dofs.nodes[j]);
+        for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
+            for (ej, cjv) in mj.eqs.iter().zip(&mj.cols) {
+                let v = ci.fixed_rows::<3>(ri).dot(&(k * cjv.fixed_rows::<3>(cj)));
+                if v != 0.0 {
+                    asm.add_entry(*ei, *ej, v);
+                }
+            }
+        }
+    };
+    for &(i, j, m) in &inertia.mass {
+        add(i, 0, j, 0, &(Matrix3::identity() * m));
+    }
+    for (i, j0) in inertia.rotational.iter().enumerate() {
+        let r = state.config.rot[i];
+        add(i, 3, i, 3, &(r * j0 * r.transpose()));
+    }
+    let mut q = vec![0.0; topo.dofs.n_eq];
+    topo.dofs.reduce(residual, &mut q);
+    q.iter_mut().for_each(|v| *v = -*v);
+    if lu.factor(&asm.values).is_err() || lu.solve(&mut q).is_err() {
+        return zero;
+    }
+    let mut a = Vec::with_capacity(nodes);
+    let mut alpha = Vec::with_capacity(nodes);
+    for i in 0..nodes {
+        let p = topo.dofs.node_increment(i, &q);
+        a.push(p.fixed_rows::<3>(0).into_owned());
+        alpha.push(state.config.rot[i].transpose() * p.fixed_rows::<3>(3));
+    }
+    (a, alpha)
+}
+
+/// Integrates `mech` from `initial` with Newmark's trapezoidal rule. Joints
+/// enter through `N` (as in statics); driven coordinates and prescribed DOFs
+/// follow their schedules.
 pub fn solve(
     mech: &Mechanism,
     settings: &DynamicSettings,
     initial: &Motion,
     mut on_step: impl FnMut(&StepRecord),
 ) -> Result<Configuration, SolveError> {
-    if !mech.joints.is_empty() || !mech.prescribed.is_empty() {
-        return Err(SolveError::InvalidMechanism(
-            "joints and prescribed motion are not available in dynamic analyses yet".into(),
-        ));
-    }
     if !(settings.dt > 0.0 && settings.t_end > 0.0) {
         return Err(SolveError::InvalidMechanism(
             "dt and t_end must be positive".into(),
         ));
     }
     let nodes = mech.mesh.node_count();
-    let dofs = DofMap::independent(&mech.fixed);
+    let mut state = initial_state(mech);
+    let mut topo = Topology::new(mech, &state)?;
+    topo.impose(mech, &mut state, 0.0);
+    let n_eq = topo.dofs.n_eq;
     let inertia = Inertia::new(&mech.mesh, settings.mass);
-    let mut asm = Assembler::new(&mech.mesh, &dofs, &[]);
+    let mut asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
     let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
-    let (mut r, mut dq) = (vec![0.0; dofs.n_eq], vec![0.0; dofs.n_eq]);
-    let mut config = Configuration::initial(&mech.mesh.positions);
+    let (mut r, mut dq) = (vec![0.0; n_eq], vec![0.0; n_eq]);
     let mut fext = vec![0.0; 6 * nodes];
     mech.external_forces(0.0, &mut fext);
-    asm.assemble(&mech.mesh, &dofs, &config);
+    asm.assemble(&mech.mesh, &topo.dofs, &state.config);
+    let residual: Vec<f64> = asm.nodal.iter().zip(&fext).map(|(a, b)| a - b).collect();
+    let (v0, w0) = slave_velocities(mech, &topo, &state, initial);
+    let (a0, alpha0) =
+        initial_accelerations(mech, &topo, &inertia, &mut asm, &mut lu, &state, &residual);
     let mut kin = Kinematics {
-        v: initial.v.clone(),
-        w: initial.w.clone(),
-        a: (0..nodes)
-            .map(|i| {
-                let f = Vector3::new(
-                    fext[6 * i] - asm.nodal[6 * i],
-                    fext[6 * i + 1] - asm.nodal[6 * i + 1],
-                    fext[6 * i + 2] - asm.nodal[6 * i + 2],
-                );
-                if inertia.row_mass[i] > 0.0 && !mech.fixed[i][..3].iter().any(|&h| h) {
-                    f / inertia.row_mass[i]
-                } else {
-                    Vector3::zeros()
-                }
-            })
-            .collect(),
-        alpha: (0..nodes)
-            .map(|i| {
-                let m = Vector3::new(
-                    fext[6 * i + 3] - asm.nodal[6 * i + 3],
-                    fext[6 * i + 4] - asm.nodal[6 * i + 4],
-                    fext[6 * i + 5] - asm.nodal[6 * i + 5],
-                );
-                let j0 = inertia.rotational[i];
-                let w = initial.w[i];
-                match j0.try_inverse() {
-                    Some(ji) if !mech.fixed[i][3..].iter().any(|&h| h) => {
-                        ji * (m - w.cross(&(j0 * w)))
-                    }
-                    _ => Vector3::zeros(),
-                }
-            })
-            .collect(),
+        v: v0,
+        w: w0,
+        a: a0,
+        alpha: alpha0,
     };
-    on_step(&dynamic_record(
-        mech, &inertia, &config, &kin.v, &kin.w, &fext, 0.0, 0.0, None,
-    ));
+    let record = |state: &MechanismState,
+                  kin: &Kinematics,
+                  fext: &[f64],
+                  t: f64,
+                  dt: f64,
+                  rep: Option<&NewtonReport>| {
+        let mut rec = dynamic_record(
+            mech,
+            &inertia,
+            &state.config,
+            &kin.v,
+            &kin.w,
+            fext,
+            t,
+            dt,
+            rep,
+        );
+        rec.joints = joint_records(mech, state);
+        rec
+    };
+    on_step(&record(&state, &kin, &fext, 0.0, 0.0, None));
     let (mut t, mut step, mut halvings, mut easy) = (0.0f64, settings.dt, 0usize, 0usize);
     while t < settings.t_end * (1.0 - 1e-12) {
         let dt = step.min(settings.t_end - t);
-        let mut end = config.clone();
+        let start = state.config.clone();
+        let mut end = state.clone();
         for i in 0..nodes {
-            if !mech.fixed[i].iter().any(|&h| h) {
-                let spin = config.rot[i] * kin.w[i] * dt;
-                end.increment(i, &(kin.v[i] * dt), &spin);
+            if !mech.fixed[i].iter().any(|&h| h) && topo.slave_of[i].is_none() {
+                let spin = start.rot[i] * kin.w[i] * dt;
+                end.config.increment(i, &(kin.v[i] * dt), &spin);
             }
         }
+        topo.impose(mech, &mut end, t + dt);
         let mut f1 = vec![0.0; 6 * nodes];
         mech.external_forces(t + dt, &mut f1);
         let mut sys = NewmarkStep {
             mech,
-            dofs: &dofs,
+            topo: &mut topo,
             inertia: &inertia,
             asm: &mut asm,
-            start: &config,
+            start: &start,
             prev: &kin,
             end,
             dt,
             fext: f1,
             nodal: vec![0.0; 6 * nodes],
             abs: vec![0.0; 6 * nodes],
-            scratch: vec![0.0; dofs.n_eq],
+            scratch: vec![0.0; n_eq],
             floor: mech.round_off_floor(),
         };
         match newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq) {
@@ -270,15 +347,15 @@ pub fn solve(
                     alpha: Vec::new(),
                 };
                 for i in 0..nodes {
-                    let u = end.x[i] - config.x[i];
+                    let u = end.config.x[i] - start.x[i];
                     let a1 = (u - kin.v[i] * dt - kin.a[i] * (dt * dt * (0.5 - BETA)))
                         / (BETA * dt * dt);
                     next.v
                         .push(kin.v[i] + (kin.a[i] * (1.0 - GAMMA) + a1 * GAMMA) * dt);
                     next.a.push(a1);
                     let al: Vector3<f64> = angular_acceleration(
-                        &config.rot[i],
-                        &end.rot[i],
+                        &start.rot[i],
+                        &end.config.rot[i],
                         &kin.w[i],
                         &kin.alpha[i],
                         dt,
@@ -287,21 +364,11 @@ pub fn solve(
                         .push(kin.w[i] + (kin.alpha[i] * (1.0 - GAMMA) + al * GAMMA) * dt);
                     next.alpha.push(al);
                 }
-                config = end;
+                state = end;
                 kin = next;
                 t += dt;
                 mech.external_forces(t, &mut fext);
-                on_step(&dynamic_record(
-                    mech,
-                    &inertia,
-                    &config,
-                    &kin.v,
-                    &kin.w,
-                    &fext,
-                    t,
-                    dt,
-                    Some(&report),
-                ));
+                on_step(&record(&state, &kin, &fext, t, dt, Some(&report)));
                 halvings = 0;
                 easy += 1;
                 if easy >= 4 && step < settings.dt {
@@ -323,5 +390,5 @@ pub fn solve(
             }
         }
     }
-    Ok(config)
+    Ok(state.config)
 }
