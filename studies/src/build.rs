@@ -2,8 +2,8 @@
 //! the beams, number the nodes, apply supports, loads and gravity.
 
 use crate::model::{
-    Analysis, BeamGeometry, JointKind, JointSpec, LiftSpec, Model, ModelError, NodeRef,
-    PrescribedSpec, TimeFunction,
+    Analysis, BeamGeometry, IntegratorKind, JointKind, JointSpec, LiftSpec, Model, ModelError,
+    NodeRef, PrescribedSpec, TimeFunction,
 };
 use flexmech_core::{Mesh, Section};
 use flexmech_integrators::dynamics::Motion;
@@ -51,20 +51,25 @@ fn schedule(time: &Option<TimeFunction>, analysis: &Analysis) -> Schedule {
 /// Features of the model format that this version cannot run yet are reported
 /// as errors naming the key, never silently ignored.
 fn unsupported(model: &Model) -> Result<(), ModelError> {
-    let err = |key: &str, what: &str| {
-        Err(ModelError::new(
-            &model.path,
-            key,
-            None,
-            format!("{what} cannot be solved by this version of flexmech yet; remove it to run the rest"),
-        ))
-    };
-    if let Analysis::Dynamic { .. } = model.solver.analysis {
-        if !model.joints.is_empty() {
-            return err("joint[0]", "joints in a dynamic analysis");
-        }
-        if !model.prescribed.is_empty() {
-            return err("prescribed[0]", "prescribed motion in a dynamic analysis");
+    if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
+        if integrator != IntegratorKind::Newmark {
+            let refuse = |key: &str, what: &str| {
+                Err(ModelError::new(
+                    &model.path,
+                    key,
+                    None,
+                    format!(
+                        "{what} in a dynamic analysis with integrator = \"{}\" cannot be solved by this version of flexmech yet (the conserving schemes need the exact incremental joint maps); use integrator = \"newmark\", or remove them",
+                        integrator.name()
+                    ),
+                ))
+            };
+            if !model.joints.is_empty() {
+                return refuse("joint[0]", "joints");
+            }
+            if !model.prescribed.is_empty() {
+                return refuse("prescribed[0]", "prescribed motion");
+            }
         }
     }
     Ok(())
@@ -73,7 +78,8 @@ fn unsupported(model: &Model) -> Result<(), ModelError> {
 /// Initial nodal velocities from the `[[initial_velocity]]` fields
 /// (`v = v₀ + ω × (x − origin)`, body angular velocity `W = ω` since every
 /// node starts at the identity); a later field overrides an earlier one on
-/// the nodes they share; nodes in no field start at rest.
+/// the nodes they share; nodes in no field start at rest. Joints' `rate`s set
+/// the released rates (slave velocities follow from them).
 fn initial_motion(model: &Model, built: &Built) -> Motion {
     let x0 = &built.mechanism.mesh.positions;
     let mut motion = Motion::rest(x0.len());
@@ -85,6 +91,7 @@ fn initial_motion(model: &Model, built: &Built) -> Motion {
             motion.w[n] = om;
         }
     }
+    motion.joint_rates = model.joints.iter().map(|j| j.rate).collect();
     motion
 }
 

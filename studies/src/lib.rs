@@ -2,6 +2,7 @@
 //! results into HDF5 files, and the `flexmech` command line.
 
 pub mod build;
+pub mod charts;
 pub mod model;
 pub mod results;
 pub mod run;

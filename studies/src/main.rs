@@ -2,6 +2,7 @@
 //! and turns errors into messages that name the file, the key and the fix.
 
 use clap::{Parser, Subcommand};
+use flexmech_studies::charts::plot_datasets;
 use flexmech_studies::model::load_model;
 use flexmech_studies::run_model;
 use std::path::PathBuf;
@@ -28,6 +29,24 @@ enum Command {
         /// Output directory for the result files.
         #[arg(long, short, default_value = "results")]
         out: PathBuf,
+    },
+    /// Draw line charts (PNG and SVG) of result datasets over /time.
+    ///
+    /// Writes `<out>/<dataset path with / as _>.png` (1600x1000 px) and `.svg`
+    /// per dataset, e.g. `plots/nodes_arm.end_displacement.png`.
+    Plot {
+        /// Result file written by `flexmech run`.
+        result: PathBuf,
+        /// Dataset paths, e.g. /energy/total or /nodes/<label>/displacement
+        /// (shape T: one curve; T x 3: x, y and z curves).
+        #[arg(required = true)]
+        datasets: Vec<String>,
+        /// Output directory for the charts.
+        #[arg(long, short, default_value = "plots")]
+        out: PathBuf,
+        /// Logarithmic y axis (non-positive values are left out).
+        #[arg(long)]
+        log: bool,
     },
 }
 
@@ -63,5 +82,22 @@ fn main() -> ExitCode {
                 ExitCode::SUCCESS
             }
         }
+        Command::Plot {
+            result,
+            datasets,
+            out,
+            log,
+        } => match plot_datasets(&result, &datasets, &out, log) {
+            Ok(files) => {
+                for f in files {
+                    println!("{}", f.display());
+                }
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::FAILURE
+            }
+        },
     }
 }

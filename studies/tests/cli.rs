@@ -79,14 +79,14 @@ fn missing_file_and_unsupported_features_are_named() {
         stderr.contains("/nonexistent/model.toml") && stderr.contains("cannot read"),
         "{stderr}"
     );
-    // Joints in a dynamic analysis are valid model syntax but not solvable
-    // yet: refused with the key named, and nothing half-solved.
+    // Joints in the conserving schemes are valid model syntax but not
+    // solvable yet: refused with the key named, and nothing half-solved.
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("dyn.toml");
     let statics = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/statics/screw_driven.toml");
     let text = std::fs::read_to_string(statics).unwrap().replace(
         "analysis = \"static\"                # the load factor is the driving parameter\nload_steps = 80",
-        "analysis = \"dynamic\"\nintegrator = \"newmark\"\ndt = 0.01\nt_end = 1.0",
+        "analysis = \"dynamic\"\nintegrator = \"momentum\"\ndt = 0.01\nt_end = 1.0",
     );
     assert!(text.contains("dynamic"));
     std::fs::write(&model, text).unwrap();

@@ -1,0 +1,16 @@
+//! Publication-quality line charts (PNG and SVG) of result files.
+//!
+//! [`LineChart`] draws curves with a journal look: white background, framed
+//! plot with a thin grid, axis labels as given (with their units), a framed
+//! legend, colour-blind-safe colours with distinct dash patterns, and tick
+//! labels with a common `×10ⁿ` factor or decades `10ⁿ` on a logarithmic axis.
+//! Text uses only the DejaVu Sans face embedded through [`font`], never a
+//! system font. [`plot_datasets`] is the `flexmech plot` command: charts of
+//! HDF5 result datasets over `/time`.
+
+pub mod font;
+mod line;
+mod plot;
+
+pub use line::{ChartError, LineChart, Series, HEIGHT, WIDTH};
+pub use plot::{plot_datasets, PlotError};

@@ -1,0 +1,268 @@
+//! `flexmech plot`: one line chart per result-file dataset, over `/time`.
+//!
+//! A dataset of shape T (one value per stored step) gives one curve, a T×3
+//! dataset three (its x, y and z components). The y axis is labelled with the
+//! dataset's path, the x axis "time", or "time (load factor in statics)" when
+//! the root attribute `integrator` is `"static"`. A run that stopped early
+//! (`status` `"failed: …"` or still `"running"`) gets a marker line at its
+//! last stored time.
+
+use std::path::{Path, PathBuf};
+
+use hdf5::types::VarLenUnicode;
+
+use super::line::{ChartError, LineChart, Series};
+use crate::results::layout;
+
+/// Why `plot_datasets` could not draw the charts; every variant names the
+/// result file (and the dataset where one is involved).
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// The HDF5 library reported an error.
+    #[error("{}: HDF5 error while {what}: {source}", .path.display())]
+    Hdf5 {
+        /// The result file.
+        path: PathBuf,
+        /// What was being done, naming the dataset or attribute.
+        what: String,
+        /// The library's error.
+        #[source]
+        source: hdf5::Error,
+    },
+    /// The dataset does not exist (or is a group).
+    #[error(
+        "{}: no dataset {dataset}; datasets under {group}: {}",
+        .path.display(),
+        if .available.is_empty() { "(none)".to_owned() } else { .available.join(", ") }
+    )]
+    UnknownDataset {
+        /// The result file.
+        path: PathBuf,
+        /// The dataset asked for.
+        dataset: String,
+        /// The nearest existing group above it.
+        group: String,
+        /// Every dataset below that group.
+        available: Vec<String>,
+    },
+    /// The dataset is neither T nor T×3 (T = length of `/time`).
+    #[error(
+        "{}: dataset {dataset} has shape {}, but a chart needs {steps} (one value per step) \
+         or {steps}×3 (T = {steps} steps in /time)",
+        .path.display(),
+        shape_text(.shape)
+    )]
+    BadShape {
+        /// The result file.
+        path: PathBuf,
+        /// The dataset.
+        dataset: String,
+        /// Its shape.
+        shape: Vec<usize>,
+        /// Length of `/time`.
+        steps: usize,
+    },
+    /// The output directory could not be created.
+    #[error("{}: {source}", .path.display())]
+    Io {
+        /// The directory.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The chart could not be drawn or written (e.g. every value is NaN).
+    #[error("{}: dataset {dataset}: {source}", .path.display())]
+    Chart {
+        /// The result file.
+        path: PathBuf,
+        /// The dataset.
+        dataset: String,
+        /// The chart's error, naming the output file.
+        #[source]
+        source: ChartError,
+    },
+}
+
+fn shape_text(shape: &[usize]) -> String {
+    if shape.is_empty() {
+        return "scalar".to_owned();
+    }
+    let dims: Vec<String> = shape.iter().map(ToString::to_string).collect();
+    dims.join("×")
+}
+
+/// Draws `<out_dir>/<stem>.png` and `.svg` for each dataset path in
+/// `datasets` (leading `/` optional), where the stem is the path with `/`
+/// replaced by `_` (`/nodes/arm.end/displacement` →
+/// `nodes_arm.end_displacement`). Returns the written files, PNG then SVG
+/// for each dataset, in argument order. Every dataset is read and checked
+/// before the first chart is written.
+pub fn plot_datasets(
+    file: &Path,
+    datasets: &[String],
+    out_dir: &Path,
+    log_y: bool,
+) -> Result<Vec<PathBuf>, PlotError> {
+    let hdf5_err = |what: String| {
+        move |source| PlotError::Hdf5 {
+            path: file.to_path_buf(),
+            what,
+            source,
+        }
+    };
+    let h5 = hdf5::File::open(file).map_err(hdf5_err("opening the file".into()))?;
+    let time = open_dataset(&h5, file, layout::TIME)?
+        .read_raw::<f64>()
+        .map_err(hdf5_err(format!("reading {}", layout::TIME)))?;
+    let steps = time.len();
+
+    let integrator = string_attr(&h5, layout::ATTR_INTEGRATOR);
+    let x_label = if integrator.as_deref() == Some("static") {
+        "time (load factor in statics)"
+    } else {
+        "time"
+    };
+    let markers = stop_marker(string_attr(&h5, layout::ATTR_STATUS), &time);
+    let file_name = file
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| file.display().to_string());
+
+    let mut charts = Vec::with_capacity(datasets.len());
+    for requested in datasets {
+        let name = format!("/{}", requested.trim_start_matches('/'));
+        let ds = open_dataset(&h5, file, &name)?;
+        let shape = ds.shape();
+        let bad_shape = || PlotError::BadShape {
+            path: file.to_path_buf(),
+            dataset: name.clone(),
+            shape: shape.clone(),
+            steps,
+        };
+        let values = match shape.as_slice() {
+            [n] | [n, 3] if *n == steps => ds
+                .read_raw::<f64>()
+                .map_err(hdf5_err(format!("reading {name}")))?,
+            _ => return Err(bad_shape()),
+        };
+        let series = if shape.len() == 1 {
+            let label = name.rsplit('/').next().unwrap_or(&name).to_owned();
+            vec![Series::new(label, time.clone(), values)]
+        } else {
+            ["x", "y", "z"]
+                .iter()
+                .enumerate()
+                .map(|(c, label)| {
+                    let y = values.iter().skip(c).step_by(3).copied().collect();
+                    Series::new(*label, time.clone(), y)
+                })
+                .collect()
+        };
+        let title = match string_attr(&ds, layout::ATTR_DESCRIPTION) {
+            Some(d) if !d.is_empty() => format!("{file_name}: {d}"),
+            _ => file_name.clone(),
+        };
+        let chart = LineChart {
+            title,
+            x_label: x_label.to_owned(),
+            y_label: name.clone(),
+            log_y,
+            series,
+            markers: markers.clone(),
+        };
+        let stem = out_dir.join(name.trim_start_matches('/').replace('/', "_"));
+        charts.push((name, chart, stem));
+    }
+
+    std::fs::create_dir_all(out_dir).map_err(|source| PlotError::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    let mut written = Vec::with_capacity(2 * charts.len());
+    for (name, chart, stem) in charts {
+        let (png, svg) = chart.render(&stem).map_err(|source| PlotError::Chart {
+            path: file.to_path_buf(),
+            dataset: name,
+            source,
+        })?;
+        written.push(png);
+        written.push(svg);
+    }
+    Ok(written)
+}
+
+/// A marker at the last stored time of a run that did not complete.
+fn stop_marker(status: Option<String>, time: &[f64]) -> Vec<(f64, String)> {
+    let Some(status) = status else {
+        return Vec::new();
+    };
+    let Some(&last) = time.iter().rev().find(|t| t.is_finite()) else {
+        return Vec::new();
+    };
+    let label = if status.starts_with(layout::STATUS_FAILED_PREFIX) {
+        const MAX: usize = 60;
+        if status.chars().count() > MAX {
+            let cut: String = status.chars().take(MAX - 1).collect();
+            format!("{cut}…")
+        } else {
+            status
+        }
+    } else if status == layout::STATUS_RUNNING {
+        "run stopped (status \"running\")".to_owned()
+    } else {
+        return Vec::new();
+    };
+    vec![(last, label)]
+}
+
+fn string_attr(loc: &hdf5::Location, name: &str) -> Option<String> {
+    let attr = loc.attr(name).ok()?;
+    let value = attr.read_scalar::<VarLenUnicode>().ok()?;
+    Some(value.as_str().to_owned())
+}
+
+/// Opens a dataset by absolute path; if there is none, the error lists the
+/// datasets below the nearest existing group.
+fn open_dataset(h5: &hdf5::File, file: &Path, name: &str) -> Result<hdf5::Dataset, PlotError> {
+    let parts: Vec<&str> = name.split('/').filter(|p| !p.is_empty()).collect();
+    let mut group = h5.group("/").map_err(|source| PlotError::Hdf5 {
+        path: file.to_path_buf(),
+        what: "opening the root group".into(),
+        source,
+    })?;
+    for (i, part) in parts.iter().enumerate() {
+        if !group.link_exists(part) {
+            break;
+        }
+        if i + 1 == parts.len() {
+            if let Ok(ds) = group.dataset(part) {
+                return Ok(ds);
+            }
+        }
+        match group.group(part) {
+            Ok(g) => group = g,
+            Err(_) => break,
+        }
+    }
+    let mut available = Vec::new();
+    datasets_under(&group, &mut available);
+    available.sort();
+    Err(PlotError::UnknownDataset {
+        path: file.to_path_buf(),
+        dataset: name.to_owned(),
+        group: group.name(),
+        available,
+    })
+}
+
+fn datasets_under(group: &hdf5::Group, out: &mut Vec<String>) {
+    if let Ok(datasets) = group.datasets() {
+        out.extend(datasets.iter().map(|d| d.name()));
+    }
+    if let Ok(groups) = group.groups() {
+        for g in &groups {
+            datasets_under(g, out);
+        }
+    }
+}
