@@ -5,8 +5,8 @@
 //! the applied loads and the magnitude of the internal forces that cancel in
 //! it, so the tolerance means the same thing for any units and stays above
 //! round-off when large internal forces balance. A residual whose norm is at
-//! the system's round-off floor ([`NewtonSystem::floor`]) also counts as
-//! converged: no iteration can improve on it (this matters when the loads
+//! the system's round-off floor ([`NewtonSystem::floor`]) and has stopped
+//! falling also counts as converged: no iteration can improve on it (this matters when the loads
 //! are tiny, e.g. the first steps of a ramp, and stiff internal forces round).
 
 use crate::error::NewtonFailure;
@@ -57,6 +57,7 @@ pub fn solve<S: NewtonSystem>(
     dq: &mut [f64],
 ) -> Result<NewtonReport, NewtonFailure> {
     let mut history = Vec::with_capacity(settings.max_iterations + 1);
+    let mut previous_norm = f64::INFINITY;
     for it in 0..=settings.max_iterations {
         let scale = sys.evaluate(r);
         let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -69,7 +70,11 @@ pub fn solve<S: NewtonSystem>(
         if !res.is_finite() {
             return Err(NewtonFailure::NotFinite { iteration: it });
         }
-        if res <= settings.tolerance || norm <= sys.floor() {
+        // At the round-off floor, accept once the residual stops falling
+        // (while it still drops fast, one more iteration is cheap accuracy).
+        let stalled = history.len() >= 2 && norm >= 0.5 * previous_norm;
+        previous_norm = norm;
+        if res <= settings.tolerance || (norm <= sys.floor() && (stalled || norm == 0.0)) {
             return Ok(NewtonReport {
                 iterations: it,
                 residual: res,

@@ -132,6 +132,7 @@ pub(super) fn solve_step(
     let mut history = Vec::with_capacity(settings.max_iterations + 1);
     let mut beta = 0.0;
     let mut determined = true;
+    let mut previous_norm = f64::INFINITY;
     for it in 0..=settings.max_iterations {
         sys.beta = beta;
         let scale = sys.evaluate(&mut r);
@@ -171,10 +172,22 @@ pub(super) fn solve_step(
         if !res.is_finite() {
             return Err(NewtonFailure::NotFinite { iteration: it });
         }
-        let g_ok = res_g <= settings.tolerance || norm <= sys.floor();
+        let stalled = history.len() >= 2 && norm >= 0.5 * previous_norm;
+        previous_norm = norm;
+        let g_ok = res_g <= settings.tolerance || (norm <= sys.floor() && (stalled || norm == 0.0));
+        // The energy residual's own round-off floor: forces rounded at the
+        // system's force floor, times the size of the step's increments.
+        let increments: f64 = (0..nodes)
+            .map(|i| {
+                let u = sys.end.x[i] - sys.start.x[i];
+                let th = cayley_inverse(&(sys.end.rot[i] * sys.start.rot[i].transpose()));
+                u.norm_squared() + th.norm_squared()
+            })
+            .sum::<f64>()
+            .sqrt();
         let e_ok = !determined
             || res_e <= settings.tolerance
-            || energy.abs() <= 64.0 * f64::EPSILON * e_scale;
+            || energy.abs() <= 64.0 * f64::EPSILON * e_scale + sys.floor() * increments;
         if g_ok && e_ok {
             let beta_out = if determined { beta } else { f64::NAN };
             return Ok((
