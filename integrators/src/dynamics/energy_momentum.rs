@@ -16,18 +16,17 @@
 //! `d − cᵀK⁻¹b` vanishes (no strain change in the step: β has no effect) the
 //! step is solved without the correction and `β` is reported as NaN.
 
-use super::midpoint::MidpointStep;
+use super::midpoint::{seeded_poses, Dual12, MidpointStep};
 use super::{midpoint, DynamicSettings, Motion};
 use crate::error::{NewtonFailure, SolveError};
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::newton::{NewtonReport, NewtonSettings, NewtonSystem};
 use crate::record::StepRecord;
-use flexmech_core::conserving::{MidRotation, Pose};
-use flexmech_core::rotation::{cayley_inverse, exp};
+use flexmech_core::conserving::MidRotation;
+use flexmech_core::rotation::cayley_inverse;
 use flexmech_core::{Configuration, Element};
 use nalgebra::{Const, SVector, Vector3, U1};
-use num_dual::DualSVec64;
 
 /// Integrates `mech` from `initial` with the energy–momentum scheme.
 pub fn solve(
@@ -54,28 +53,8 @@ fn energy_terms(el: &Element, start: &Configuration, end: &Configuration) -> Ene
     let Element::Linear(e) = el else {
         unreachable!("the midpoint schemes are checked to run on 2-node elements")
     };
-    type D = DualSVec64<12>;
-    let n = e.nodes;
-    let s: Pose<f64> = (
-        [start.x[n[0]], start.x[n[1]]],
-        [start.rot[n[0]], start.rot[n[1]]],
-    );
-    let seed = |j: usize| D::from_re(0.0).derivative(j);
-    let v = |j: usize| Vector3::new(seed(j), seed(j + 1), seed(j + 2));
-    let sd: Pose<D> = (
-        s.0.map(|x| x.map(D::from_re)),
-        s.1.map(|q| q.map(D::from_re)),
-    );
-    let ed: Pose<D> = (
-        [
-            end.x[n[0]].map(D::from_re) + v(0),
-            end.x[n[1]].map(D::from_re) + v(6),
-        ],
-        [
-            exp(&v(3)) * end.rot[n[0]].map(D::from_re),
-            exp(&v(9)) * end.rot[n[1]].map(D::from_re),
-        ],
-    );
+    type D = Dual12;
+    let (s, sd, ed) = seeded_poses(e, start, end);
     let (n0, m0) = e.resultants(&s.0, &s.1);
     let (n1, m1) = e.resultants(&ed.0, &ed.1);
     let half = D::from_re(0.5);

@@ -8,7 +8,7 @@
 //! * internal force `q_k(Nₙ₊½, Mₙ₊½)` with the mid rotation of the scheme;
 //! * external loads at `tₙ₊½`.
 
-use super::{DynamicSettings, Motion};
+use super::{DynamicSettings, Motion, StepControl};
 use crate::assembly::Assembler;
 use crate::dofs::DofMap;
 use crate::error::SolveError;
@@ -19,7 +19,7 @@ use crate::record::{Energies, StepRecord};
 use crate::statics::strain_energy;
 use flexmech_core::conserving::{MidRotation, Pose};
 use flexmech_core::rotation::{cayley_inverse, exp};
-use flexmech_core::{Configuration, Element, Inertia};
+use flexmech_core::{BeamElement, Configuration, Element, Inertia};
 use nalgebra::{Const, Matrix3, Vector3, U1};
 use num_dual::DualSVec64;
 
@@ -43,29 +43,24 @@ pub fn end_motion(
     (v, w)
 }
 
-/// Element kernel of the midpoint schemes: `q_k(Nₙ₊½, Mₙ₊½)` (plus
-/// `β q_k(N_d, 0)` for the energy–momentum scheme) and its
-/// derivative with respect to spatial increments of the end pose
-/// (`x ← x + η`, `R ← exp(η̂)R`), by forward-mode AD.
-fn element_kernel(
-    el: &Element,
+/// Dual numbers for derivatives with respect to an element's 12 increments.
+pub(super) type Dual12 = DualSVec64<12>;
+
+/// An element's pose at the step's start, and its start and end poses as
+/// [`Dual12`] numbers with the end seeded by spatial increments
+/// (`x ← x + η`, `R ← exp(η̂)R`), so that any function of them carries its
+/// derivative with respect to the end pose.
+pub(super) fn seeded_poses(
+    e: &BeamElement<2>,
     start: &Configuration,
     end: &Configuration,
-    mid: MidRotation,
-    beta: f64,
-    r: &mut [f64],
-    k: &mut [f64],
-) {
-    let Element::Linear(e) = el else {
-        unreachable!("the midpoint schemes are checked to run on 2-node elements")
-    };
-    type D = DualSVec64<12>;
+) -> (Pose<f64>, Pose<Dual12>, Pose<Dual12>) {
+    type D = Dual12;
     let n = e.nodes;
     let s: Pose<f64> = (
         [start.x[n[0]], start.x[n[1]]],
         [start.rot[n[0]], start.rot[n[1]]],
     );
-    let (n0, m0) = e.resultants(&s.0, &s.1);
     let seed = |j: usize| D::from_re(0.0).derivative(j);
     let v = |j: usize| Vector3::new(seed(j), seed(j + 1), seed(j + 2));
     let sd: Pose<D> = (
@@ -82,6 +77,28 @@ fn element_kernel(
             exp(&v(9)) * end.rot[n[1]].map(D::from_re),
         ],
     );
+    (s, sd, ed)
+}
+
+/// Element kernel of the midpoint schemes: `q_k(Nₙ₊½, Mₙ₊½)` (plus
+/// `β q_k(N_d, 0)` for the energy–momentum scheme) and its
+/// derivative with respect to spatial increments of the end pose
+/// (`x ← x + η`, `R ← exp(η̂)R`), by forward-mode AD.
+fn element_kernel(
+    el: &Element,
+    start: &Configuration,
+    end: &Configuration,
+    mid: MidRotation,
+    beta: f64,
+    r: &mut [f64],
+    k: &mut [f64],
+) {
+    let Element::Linear(e) = el else {
+        unreachable!("the midpoint schemes are checked to run on 2-node elements")
+    };
+    type D = Dual12;
+    let (s, sd, ed) = seeded_poses(e, start, end);
+    let (n0, m0) = e.resultants(&s.0, &s.1);
     let (n1, m1) = e.resultants(&ed.0, &ed.1);
     let half = D::from_re(0.5);
     let nbar = (n0.map(D::from_re) + n1) * half;
@@ -289,9 +306,9 @@ pub fn solve(
     on_step(&dynamic_record(
         mech, &inertia, &config, &v, &w, &fext, 0.0, 0.0, None,
     ));
-    let (mut t, mut step, mut halvings, mut easy) = (0.0f64, settings.dt, 0usize, 0usize);
+    let (mut t, mut control) = (0.0f64, StepControl::new(settings));
     while t < settings.t_end * (1.0 - 1e-12) {
-        let dt = step.min(settings.t_end - t);
+        let dt = control.next(t, settings.t_end);
         // Predictor: constant velocities over the step.
         let mut end = config.clone();
         for i in 0..nodes {
@@ -346,25 +363,9 @@ pub fn solve(
                     dynamic_record(mech, &inertia, &config, &v, &w, &fext, t, dt, Some(&report));
                 rec.beta = beta;
                 on_step(&rec);
-                halvings = 0;
-                easy += 1;
-                if easy >= 4 && step < settings.dt {
-                    step = (2.0 * step).min(settings.dt);
-                    easy = 0;
-                }
+                control.succeeded();
             }
-            Err(reason) => {
-                if halvings >= settings.max_halvings {
-                    return Err(SolveError::NoConvergence {
-                        time: t + dt,
-                        halvings,
-                        reason,
-                    });
-                }
-                halvings += 1;
-                easy = 0;
-                step *= 0.5;
-            }
+            Err(reason) => control.failed(t + dt, reason)?,
         }
     }
     Ok(config)

@@ -14,6 +14,7 @@ pub mod midpoint;
 pub mod momentum;
 pub mod newmark;
 
+use crate::error::{NewtonFailure, SolveError};
 use crate::newton::NewtonSettings;
 use flexmech_core::MassKind;
 use nalgebra::Vector3;
@@ -53,5 +54,59 @@ impl Motion {
             w: vec![Vector3::zeros(); nodes],
             joint_rates: Vec::new(),
         }
+    }
+}
+
+/// Step-size control shared by the integrators: halve on failure (at most
+/// `max_halvings` times in a row, then a typed error), grow back towards the
+/// nominal step after four easy steps in a row.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepControl {
+    nominal: f64,
+    step: f64,
+    halvings: usize,
+    easy: usize,
+    max_halvings: usize,
+}
+
+impl StepControl {
+    pub(crate) fn new(settings: &DynamicSettings) -> Self {
+        Self {
+            nominal: settings.dt,
+            step: settings.dt,
+            halvings: 0,
+            easy: 0,
+            max_halvings: settings.max_halvings,
+        }
+    }
+
+    /// The step to try from time `t` (never past `t_end`).
+    pub(crate) fn next(&self, t: f64, t_end: f64) -> f64 {
+        self.step.min(t_end - t)
+    }
+
+    /// A step converged.
+    pub(crate) fn succeeded(&mut self) {
+        self.halvings = 0;
+        self.easy += 1;
+        if self.easy >= 4 && self.step < self.nominal {
+            self.step = (2.0 * self.step).min(self.nominal);
+            self.easy = 0;
+        }
+    }
+
+    /// A step to `time` failed: halve, or give up with the reason.
+    pub(crate) fn failed(&mut self, time: f64, reason: NewtonFailure) -> Result<(), SolveError> {
+        if self.halvings >= self.max_halvings {
+            return Err(SolveError::NoConvergence {
+                time,
+                halvings: self.halvings,
+                reason,
+            });
+        }
+        self.halvings += 1;
+        self.easy = 0;
+        self.step *= 0.5;
+        Ok(())
     }
 }

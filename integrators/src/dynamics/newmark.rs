@@ -13,7 +13,7 @@
 //! screw example shows its energy growing until it fails.
 
 use super::midpoint::dynamic_record;
-use super::{DynamicSettings, Motion};
+use super::{DynamicSettings, Motion, StepControl};
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::SolveError;
@@ -308,9 +308,9 @@ pub fn solve(
         rec
     };
     on_step(&record(&state, &kin, &fext, 0.0, 0.0, None));
-    let (mut t, mut step, mut halvings, mut easy) = (0.0f64, settings.dt, 0usize, 0usize);
+    let (mut t, mut control) = (0.0f64, StepControl::new(settings));
     while t < settings.t_end * (1.0 - 1e-12) {
-        let dt = step.min(settings.t_end - t);
+        let dt = control.next(t, settings.t_end);
         let start = state.config.clone();
         let mut end = state.clone();
         for i in 0..nodes {
@@ -369,25 +369,9 @@ pub fn solve(
                 t += dt;
                 mech.external_forces(t, &mut fext);
                 on_step(&record(&state, &kin, &fext, t, dt, Some(&report)));
-                halvings = 0;
-                easy += 1;
-                if easy >= 4 && step < settings.dt {
-                    step = (2.0 * step).min(settings.dt);
-                    easy = 0;
-                }
+                control.succeeded();
             }
-            Err(reason) => {
-                if halvings >= settings.max_halvings {
-                    return Err(SolveError::NoConvergence {
-                        time: t + dt,
-                        halvings,
-                        reason,
-                    });
-                }
-                halvings += 1;
-                easy = 0;
-                step *= 0.5;
-            }
+            Err(reason) => control.failed(t + dt, reason)?,
         }
     }
     Ok(state.config)
