@@ -250,3 +250,31 @@ fn tumbling_rigid_body_keeps_its_exact_energy_and_momentum() {
     let q_end = em.last().unwrap().quaternions[0];
     assert!(q_end[0].abs() < 0.999, "{q_end:?}");
 }
+
+#[test]
+fn energy_momentum_is_bitwise_deterministic_across_thread_counts() {
+    use flexmech_integrators::dynamics::energy_momentum;
+    let (mech, motion, mut settings) = spinning_beam(MassKind::Consistent);
+    settings.dt = 0.2;
+    settings.t_end = 2.0;
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut steps: Vec<StepRecord> = Vec::new();
+        pool.install(|| {
+            energy_momentum::solve(&mech, &settings, &motion, |s| steps.push(s.clone())).unwrap()
+        });
+        steps
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.len(), two.len());
+    for (a, b) in one.iter().zip(&two) {
+        assert_eq!(a.beta.to_bits(), b.beta.to_bits());
+        assert_eq!(a.energy.total.to_bits(), b.energy.total.to_bits());
+        for (p, q) in a.positions.iter().zip(&b.positions) {
+            assert_eq!(p.map(f64::to_bits), q.map(f64::to_bits));
+        }
+    }
+}

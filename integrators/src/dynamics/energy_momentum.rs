@@ -27,6 +27,7 @@ use flexmech_core::conserving::MidRotation;
 use flexmech_core::rotation::cayley_inverse;
 use flexmech_core::{Configuration, Element};
 use nalgebra::{Const, SVector, Vector3, U1};
+use rayon::prelude::*;
 
 /// Integrates `mech` from `initial` with the energy–momentum scheme.
 pub fn solve(
@@ -122,8 +123,16 @@ pub(super) fn solve_step(
             vec![0.0; 6 * nodes],
             vec![0.0; 6 * nodes],
         ];
-        for el in &sys.mech.mesh.elements {
-            let t = energy_terms(el, sys.start, &sys.end);
+        // Element terms in parallel, summed in element order (deterministic).
+        let (start, end) = (sys.start, &sys.end);
+        let terms: Vec<EnergyTerms> = sys
+            .mech
+            .mesh
+            .elements
+            .par_iter()
+            .map(|el| energy_terms(el, start, end))
+            .collect();
+        for (el, t) in sys.mech.mesh.elements.iter().zip(&terms) {
             e_tot += t.e;
             c_tot += t.c;
             e_scale += t.e.abs() + t.c.abs();
