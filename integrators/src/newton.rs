@@ -70,23 +70,16 @@ pub fn solve<S: NewtonSystem>(
         if !res.is_finite() {
             return Err(NewtonFailure::NotFinite { iteration: it });
         }
-        // At the round-off floor, accept once the residual stops falling
-        // (while it still drops fast, one more iteration is cheap accuracy).
-        let stalled = history.len() >= 2 && norm >= 0.5 * previous_norm;
-        previous_norm = norm;
-        if res <= settings.tolerance || (norm <= sys.floor() && (stalled || norm == 0.0)) {
+        let floored = at_floor(norm, &mut previous_norm, sys.floor());
+        if res <= settings.tolerance || floored {
             return Ok(NewtonReport {
                 iterations: it,
                 residual: res,
                 history,
             });
         }
-        if it > 0 && res > 1e8 * history[0].max(settings.tolerance) {
-            return Err(NewtonFailure::Diverged {
-                iteration: it,
-                residual: res,
-                initial: history[0],
-            });
+        if let Some(failure) = diverged(it, res, &history, settings) {
+            return Err(failure);
         }
         if it == settings.max_iterations {
             break;
@@ -102,5 +95,30 @@ pub fn solve<S: NewtonSystem>(
     Err(NewtonFailure::MaxIterations {
         iterations: settings.max_iterations,
         residual: *history.last().unwrap_or(&f64::NAN),
+    })
+}
+
+/// Whether a residual of norm `norm` sits at the round-off floor and has
+/// stopped falling (less than halved since the previous iterate, whose norm
+/// `previous` is updated); while it still drops fast, one more iteration is
+/// cheap accuracy.
+pub(crate) fn at_floor(norm: f64, previous: &mut f64, floor: f64) -> bool {
+    let stalled = norm >= 0.5 * *previous;
+    *previous = norm;
+    norm <= floor && (stalled || norm == 0.0)
+}
+
+/// A divergence failure when the scaled residual has grown by 10⁸ over the
+/// first iterate's (or the tolerance).
+pub(crate) fn diverged(
+    it: usize,
+    res: f64,
+    history: &[f64],
+    settings: &NewtonSettings,
+) -> Option<NewtonFailure> {
+    (it > 0 && res > 1e8 * history[0].max(settings.tolerance)).then(|| NewtonFailure::Diverged {
+        iteration: it,
+        residual: res,
+        initial: history[0],
     })
 }

@@ -16,17 +16,17 @@
 //! `d − cᵀK⁻¹b` vanishes (no strain change in the step: β has no effect) the
 //! step is solved without the correction and `β` is reported as NaN.
 
-use super::midpoint::{seeded_poses, Dual12, MidpointStep};
+use super::midpoint::{midpoint_forces, seeded_poses, Dual12, MidpointStep};
 use super::{midpoint, DynamicSettings, Motion};
 use crate::error::{NewtonFailure, SolveError};
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
-use crate::newton::{NewtonReport, NewtonSettings, NewtonSystem};
+use crate::newton::{at_floor, diverged, NewtonReport, NewtonSettings, NewtonSystem};
 use crate::record::StepRecord;
 use flexmech_core::conserving::MidRotation;
 use flexmech_core::rotation::cayley_inverse;
 use flexmech_core::{Configuration, Element};
-use nalgebra::{Const, SVector, Vector3, U1};
+use nalgebra::{Const, SVector, U1};
 use rayon::prelude::*;
 
 /// Integrates `mech` from `initial` with the energy–momentum scheme.
@@ -56,23 +56,8 @@ fn energy_terms(el: &Element, start: &Configuration, end: &Configuration) -> Ene
     };
     type D = Dual12;
     let (s, sd, ed) = seeded_poses(e, start, end);
-    let (n0, m0) = e.resultants(&s.0, &s.1);
-    let (n1, m1) = e.resultants(&ed.0, &ed.1);
-    let half = D::from_re(0.5);
-    let qk = e.midpoint_force(
-        &sd,
-        &ed,
-        &((n0.map(D::from_re) + n1) * half),
-        &((m0.map(D::from_re) + m1) * half),
-        MidRotation::Algebraic,
-    );
-    let qd = e.midpoint_force(
-        &sd,
-        &ed,
-        &(n1 - n0.map(D::from_re)),
-        &Vector3::zeros(),
-        MidRotation::Algebraic,
-    );
+    let (qk, qd) = midpoint_forces(e, &s, &sd, &ed, MidRotation::Algebraic, true);
+    let qd = qd.expect("the correction was asked for");
     // The step's increments: uᵢ and the tangent-scaled θᵢ with Rₙ₊₁ = cay(θᵢ)Rₙ.
     let mut work_k = D::from_re(0.0);
     let mut work_d = D::from_re(0.0);
@@ -160,9 +145,7 @@ pub(super) fn solve_step(
         if !res.is_finite() {
             return Err(NewtonFailure::NotFinite { iteration: it });
         }
-        let stalled = history.len() >= 2 && norm >= 0.5 * previous_norm;
-        previous_norm = norm;
-        let g_ok = res_g <= settings.tolerance || (norm <= sys.floor() && (stalled || norm == 0.0));
+        let g_ok = res_g <= settings.tolerance || at_floor(norm, &mut previous_norm, sys.floor());
         // The energy residual's own round-off floor: forces rounded at the
         // system's force floor, times the size of the step's increments.
         let increments: f64 = (0..nodes)
@@ -187,12 +170,8 @@ pub(super) fn solve_step(
                 beta_out,
             ));
         }
-        if it > 0 && res > 1e8 * history[0].max(settings.tolerance) {
-            return Err(NewtonFailure::Diverged {
-                iteration: it,
-                residual: res,
-                initial: history[0],
-            });
+        if let Some(failure) = diverged(it, res, &history, settings) {
+            return Err(failure);
         }
         if it == settings.max_iterations {
             break;

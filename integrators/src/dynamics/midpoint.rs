@@ -20,7 +20,7 @@ use crate::statics::strain_energy;
 use flexmech_core::conserving::{MidRotation, Pose};
 use flexmech_core::rotation::{cayley_inverse, exp};
 use flexmech_core::{BeamElement, Configuration, Element, Inertia};
-use nalgebra::{Const, Matrix3, Vector3, U1};
+use nalgebra::{Const, Matrix3, SVector, Vector3, U1};
 use num_dual::DualSVec64;
 
 /// Velocities at the end of a step from the configurations at both ends.
@@ -80,6 +80,30 @@ pub(super) fn seeded_poses(
     (s, sd, ed)
 }
 
+/// `q_k(Nₙ₊½, Mₙ₊½)` and, when `correction` is asked for, the energy–momentum
+/// correction's `q_k(N_d, 0)`, `N_d = Nₙ₊₁ − Nₙ`, of one element between its
+/// start pose `s` and the seeded poses `sd`, `ed` (see [`seeded_poses`]), as
+/// dual numbers.
+pub(super) fn midpoint_forces(
+    e: &BeamElement<2>,
+    s: &Pose<f64>,
+    sd: &Pose<Dual12>,
+    ed: &Pose<Dual12>,
+    mid: MidRotation,
+    correction: bool,
+) -> (SVector<Dual12, 12>, Option<SVector<Dual12, 12>>) {
+    type D = Dual12;
+    let (n0, m0) = e.resultants(&s.0, &s.1);
+    let (n1, m1) = e.resultants(&ed.0, &ed.1);
+    let half = D::from_re(0.5);
+    let nbar = (n0.map(D::from_re) + n1) * half;
+    let mbar = (m0.map(D::from_re) + m1) * half;
+    let qk = e.midpoint_force(sd, ed, &nbar, &mbar, mid);
+    let qd = correction
+        .then(|| e.midpoint_force(sd, ed, &(n1 - n0.map(D::from_re)), &Vector3::zeros(), mid));
+    (qk, qd)
+}
+
 /// Element kernel of the midpoint schemes: `q_k(Nₙ₊½, Mₙ₊½)` (plus
 /// `β q_k(N_d, 0)` for the energy–momentum scheme) and its
 /// derivative with respect to spatial increments of the end pose
@@ -98,16 +122,9 @@ fn element_kernel(
     };
     type D = Dual12;
     let (s, sd, ed) = seeded_poses(e, start, end);
-    let (n0, m0) = e.resultants(&s.0, &s.1);
-    let (n1, m1) = e.resultants(&ed.0, &ed.1);
-    let half = D::from_re(0.5);
-    let nbar = (n0.map(D::from_re) + n1) * half;
-    let mbar = (m0.map(D::from_re) + m1) * half;
-    let mut q = e.midpoint_force(&sd, &ed, &nbar, &mbar, mid);
-    if beta != 0.0 {
-        // Energy–momentum correction β q_k(N_d, 0), N_d = Nₙ₊₁ − Nₙ.
-        let nd = n1 - n0.map(D::from_re);
-        q += e.midpoint_force(&sd, &ed, &nd, &Vector3::zeros(), mid) * D::from_re(beta);
+    let (mut q, qd) = midpoint_forces(e, &s, &sd, &ed, mid, beta != 0.0);
+    if let Some(qd) = qd {
+        q += qd * D::from_re(beta);
     }
     for i in 0..12 {
         r[i] = q[i].re;
