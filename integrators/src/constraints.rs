@@ -10,7 +10,7 @@ use crate::mechanism::Mechanism;
 use crate::record::JointRecord;
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::Configuration;
-use flexmech_joints::{ReleasedState, LOCAL};
+use flexmech_joints::{JointStep, ReleasedState, LOCAL};
 use nalgebra::{DMatrix, Matrix3, Vector3, Vector6};
 
 /// Positions and rotations of every node and the released coordinates of
@@ -203,6 +203,55 @@ impl Topology {
             blocks[j] = l.transpose() * hd * &l;
         }
         blocks
+    }
+
+    /// The reduced residual of the conserving schemes, `Ñᵀ g` (paper eqs
+    /// 21–23): every slave's nodal residual goes to its master and its
+    /// released equations through the exact incremental map of the step
+    /// `start → end` ([`JointStep`]), deepest slaves first; independent nodes
+    /// reduce as usual. With these equations `Σ pᵢ·gᵢ = 0` over all nodes, so
+    /// the beams' energy balance and momentum conservation hold for the
+    /// joined system.
+    pub fn reduce_incremental(
+        &self,
+        mech: &Mechanism,
+        start: &MechanismState,
+        end: &MechanismState,
+        g: &[f64],
+        out: &mut [f64],
+    ) {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        let mut acc = g.to_vec();
+        for &j in self.order.iter().rev() {
+            let joint = &mech.joints[j];
+            let (m, s) = (joint.master, joint.slave);
+            let step = JointStep::new(
+                joint.map.as_ref(),
+                [
+                    (&start.config.x[m], &start.config.rot[m]),
+                    (&end.config.x[m], &end.config.rot[m]),
+                ],
+                [&start.released[j], &end.released[j]],
+            );
+            let t = step.transfer(&Vector6::from_column_slice(&acc[6 * s..6 * s + 6]));
+            for d in 0..6 {
+                acc[6 * m + d] += t[d];
+            }
+            for (c, eq) in self.released_eqs[j].iter().enumerate() {
+                if let Some(e) = eq {
+                    out[*e] += t[6 + c];
+                }
+            }
+        }
+        for (n, map) in self.dofs.nodes.iter().enumerate() {
+            if self.slave_of[n].is_some() {
+                continue;
+            }
+            let gn = Vector6::from_column_slice(&acc[6 * n..6 * n + 6]);
+            for (&e, c) in map.eqs.iter().zip(&map.cols) {
+                out[e] += c.dot(&gn);
+            }
+        }
     }
 
     /// Applies a Newton increment: independent nodes, then released

@@ -97,6 +97,20 @@ pub trait JointKinematics: Send + Sync + Debug {
     /// Names of the released coordinates (for messages and outputs).
     fn coordinate_names(&self) -> &'static [&'static str];
 
+    /// The released increments of a step as linear functions of the
+    /// coordinates' increments `τ`: `(u_R, θ_R) = B τ` exactly, with
+    /// `u_R = r_R,ₙ₊₁ − r_R,ₙ` and `θ_R = cay⁻¹(Λ_R,ₙ₊₁ Λ_R,ₙᵀ)` (paper eq. 22;
+    /// see [`crate::incremental`]). The default, for additive coordinates
+    /// (`τ = qₙ₊₁ − qₙ`), is [`crate::incremental::additive_step_map`]; a kind
+    /// with a multiplicative rotation overrides it.
+    fn step_map(
+        &self,
+        start: &ReleasedState,
+        end: &ReleasedState,
+    ) -> SMatrix<f64, 6, MAX_RELEASED> {
+        crate::incremental::additive_step_map(self, start, end)
+    }
+
     /// The released rotation angle reported as `/joints/<name>/angle`.
     fn reported_angle(&self, state: &ReleasedState) -> f64 {
         if Self::RELEASED > 0 {
@@ -143,6 +157,9 @@ pub trait JointMap: Send + Sync + Debug {
         state: &ReleasedState,
         g: &Vector6<f64>,
     ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>);
+    /// `B` with `(u_R, θ_R) = B τ` over a step (see [`JointKinematics::step_map`]).
+    fn step_map(&self, start: &ReleasedState, end: &ReleasedState)
+        -> SMatrix<f64, 6, MAX_RELEASED>;
     /// Advances the released state by `delta` (length `released_count`).
     fn advance(&self, state: &mut ReleasedState, delta: &[f64]);
     /// The angle reported in results.
@@ -263,6 +280,14 @@ impl<J: JointKinematics> JointMap for J {
             k.column_mut(c).fill(0.0);
         }
         (ntg, k)
+    }
+
+    fn step_map(
+        &self,
+        start: &ReleasedState,
+        end: &ReleasedState,
+    ) -> SMatrix<f64, 6, MAX_RELEASED> {
+        JointKinematics::step_map(self, start, end)
     }
 
     fn advance(&self, state: &mut ReleasedState, delta: &[f64]) {

@@ -7,11 +7,13 @@
 //! prismatic, cylindrical). The shared mechanism in [`kinematics`] derives the
 //! variational map `N`, its derivative and the exact placement of the slave by
 //! automatic differentiation; [`dependent`] derives `f′`, the secant `G` and
-//! the incremental map `Ñ`.
+//! the paper's incremental map `Ñ`; [`incremental`] gives every kind its exact
+//! step map for the conserving schemes.
 
 pub mod cam;
 pub mod cylindrical;
 pub mod dependent;
+pub mod incremental;
 pub mod kinematics;
 pub mod lobe;
 pub mod prismatic;
@@ -24,6 +26,7 @@ pub mod spherical;
 pub use cam::Cam;
 pub use cylindrical::Cylindrical;
 pub use dependent::{DependentJoint, DependentJointMaps};
+pub use incremental::JointStep;
 pub use kinematics::{JointKinematics, JointMap, ReleasedState, LOCAL, MAX_RELEASED};
 pub use lobe::{Lift, Lobe, PeriodicSpline};
 pub use prismatic::Prismatic;

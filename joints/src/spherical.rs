@@ -3,10 +3,10 @@
 //! `Λ_R ← exp(ω̂) Λ_R` with `ω` in the master body frame, so the slave's spin
 //! is `δφ_s = δφ_m + Λ_m δω`.
 
-use crate::kinematics::{Increments, JointKinematics, ReleasedState};
+use crate::kinematics::{Increments, JointKinematics, ReleasedState, MAX_RELEASED};
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::{cst, Scalar};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, SMatrix, Vector3};
 
 /// The spherical joint.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -26,6 +26,19 @@ impl JointKinematics for Spherical {
             Vector3::zeros(),
             exp(&a) * exp(&b) * state.rot.map(cst::<T>),
         )
+    }
+
+    /// The released increment is the rotation increment itself: `τ = θ_R`,
+    /// `B = [0; I]`.
+    fn step_map(
+        &self,
+        _start: &ReleasedState,
+        _end: &ReleasedState,
+    ) -> SMatrix<f64, 6, MAX_RELEASED> {
+        let mut b = SMatrix::<f64, 6, MAX_RELEASED>::zeros();
+        b.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&Matrix3::identity());
+        b
     }
 
     fn advance(&self, state: &mut ReleasedState, delta: &[f64]) {

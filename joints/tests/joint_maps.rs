@@ -20,8 +20,8 @@
 use flexmech_core::rotation::{cayley, cayley_inverse, cayley_mid, exp, log, skew};
 use flexmech_core::{cst, Scalar};
 use flexmech_joints::{
-    Cam, Cylindrical, DependentJoint, DependentJointMaps, JointMap, Lift, Lobe, Prismatic,
-    RackPinion, ReleasedState, Revolute, Rigid, Screw, Spherical, LOCAL,
+    Cam, Cylindrical, DependentJoint, DependentJointMaps, JointMap, JointStep, Lift, Lobe,
+    Prismatic, RackPinion, ReleasedState, Revolute, Rigid, Screw, Spherical, LOCAL,
 };
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector6};
 use proptest::prelude::*;
@@ -996,6 +996,129 @@ fn incremental_map_reproduces_the_exact_increments() {
                     let value = c.value + c.slope * (psi.abs() + omega.abs());
                     let tol = 1e-13 * hand.norm() + from_values(value, omega);
                     w.check(&format!("{}: Ntilde vs hand-built, rel. tolerance", dep.name), (nt - hand).norm() / tol, 1.0)?;
+                }
+            }
+            Ok(())
+        },
+    );
+}
+
+/// Released increments of a kind: a random increment per additive coordinate,
+/// a random rotation vector for the spherical one.
+fn step_of(kind: &Kind, d: &[f64; 3]) -> ReleasedState {
+    let mut end = kind.state;
+    let k = kind.map.released_count();
+    kind.map.advance(&mut end, &d[..k.min(3)]);
+    end
+}
+
+#[test]
+fn every_kind_steps_exactly_through_its_incremental_map() {
+    property(
+        "6b. JointStep: exact increments (u_m, theta_m, tau) -> (u_s, theta_s), every kind",
+        CASES,
+        (
+            params(),
+            released(),
+            pose(),
+            vec3(-1.0, 1.0),
+            vec3(-0.7, 0.7),
+            (
+                released_increment(),
+                released_increment(),
+                released_increment(),
+            ),
+        ),
+        |(p, q, m, u_m, w_m, (d0, d1, d2)), w| {
+            let theta_m = flexmech_core::rotation::tan_scaled(&w_m);
+            let (x1, r1) = (m.x + u_m, cayley(&theta_m) * m.r);
+            for kind in all_kinds(&p, &q) {
+                let end = step_of(&kind, &[d0, d1, d2]);
+                let (xs0, rs0) = kind.map.slave(&m.x, &m.r, &kind.state);
+                let (xs1, rs1) = kind.map.slave(&x1, &r1, &end);
+                let u_s = xs1 - xs0;
+                let theta_s = cayley_inverse(&(rs1 * rs0.transpose()));
+                let step = JointStep::new(
+                    kind.map.as_ref(),
+                    [(&m.x, &m.r), (&x1, &r1)],
+                    [&kind.state, &end],
+                );
+                // τ: coordinate increments, or the released rotation increment (spherical).
+                let mut xi = SVector::<f64, LOCAL>::zeros();
+                xi.fixed_rows_mut::<3>(0).copy_from(&u_m);
+                xi.fixed_rows_mut::<3>(3).copy_from(&theta_m);
+                if kind.spherical {
+                    let t = cayley_inverse(&(end.rot * kind.state.rot.transpose()));
+                    xi.fixed_rows_mut::<3>(6).copy_from(&t);
+                } else {
+                    for c in 0..kind.map.released_count() {
+                        xi[6 + c] = end.q[c] - kind.state.q[c];
+                    }
+                }
+                let out = step.matrix() * xi;
+                let u_scale = u_s.norm() + xs0.norm() + xs1.norm();
+                w.check(
+                    &format!("{}: u_s, rel.", kind.name),
+                    (out.fixed_rows::<3>(0) - u_s).norm() / u_scale,
+                    1e-13,
+                )?;
+                w.check(
+                    &format!("{}: theta_s, rel.", kind.name),
+                    (out.fixed_rows::<3>(3) - theta_s).norm() / (1.0 + theta_s.norm()),
+                    1e-13,
+                )?;
+                // The lever is the mid-step offset of the slave from the master.
+                let d = (xs0 + xs1 - m.x - x1) * 0.5;
+                w.check(
+                    &format!("{}: offset = mid slave - mid master", kind.name),
+                    (step.offset - d).norm() / (1.0 + d.norm()),
+                    1e-14,
+                )?;
+                // Ñᵀg is the transpose of Ñ applied to g.
+                let g = Vector6::new(d0, 1.0, -2.0, 0.5, d1 + 0.3, -0.7);
+                let t = step.transfer(&g);
+                w.check(
+                    &format!("{}: transfer = Ntilde^T g", kind.name),
+                    (t - step.matrix().transpose() * g).norm() / (1.0 + t.norm()),
+                    1e-14,
+                )?;
+            }
+            Ok(())
+        },
+    );
+}
+
+#[test]
+fn step_map_tends_to_the_variation_as_the_step_vanishes() {
+    property(
+        "6c. B(tau) continuous across the Taylor switch and B(0) = N's released columns (master = I)",
+        CASES,
+        (params(), released()),
+        |(p, q), w| {
+            let (x, r) = (Vector3::zeros(), Matrix3::identity());
+            for kind in all_kinds(&p, &q) {
+                let k = kind.map.released_count();
+                if k == 0 || kind.spherical {
+                    continue;
+                }
+                let n = kind.map.variation(&x, &r, &kind.state);
+                let b0 = kind.map.step_map(&kind.state, &kind.state);
+                for c in 0..k {
+                    let col_n = n.column(6 + c);
+                    let scale = 1.0 + col_n.norm();
+                    w.check(&format!("{}: B(0) vs N", kind.name), (b0.column(c) - col_n).norm() / scale, 1e-14)?;
+                    // Just above and below the switch from difference quotient to Taylor.
+                    let mut d = [0.0; 3];
+                    d[c] = 1.0001e-6;
+                    let above = kind.map.step_map(&kind.state, &step_of(&kind, &d));
+                    d[c] = 0.9999e-6;
+                    let below = kind.map.step_map(&kind.state, &step_of(&kind, &d));
+                    // Quotient error ≤ a few eps·|F|/1e-6 with F formed from
+                    // r_R and from rotations about angles of size |q| (rounded
+                    // at eps·|q|).
+                    let (rr, _) = kind.map.released_placement(&kind.state);
+                    let tol = 1e-9 * (1.0 + rr.norm() + kind.state.q[c].abs()) + 1e-9 * scale;
+                    w.check(&format!("{}: B continuous at 1e-6", kind.name), (above.column(c) - below.column(c)).norm(), tol)?;
                 }
             }
             Ok(())

@@ -48,33 +48,6 @@ fn schedule(time: &Option<TimeFunction>, analysis: &Analysis) -> Schedule {
     }
 }
 
-/// Features of the model format that this version cannot run yet are reported
-/// as errors naming the key, never silently ignored.
-fn unsupported(model: &Model) -> Result<(), ModelError> {
-    if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
-        if integrator != IntegratorKind::Newmark {
-            let refuse = |key: &str, what: &str| {
-                Err(ModelError::new(
-                    &model.path,
-                    key,
-                    None,
-                    format!(
-                        "{what} in a dynamic analysis with integrator = \"{}\" cannot be solved by this version of flexmech yet (the conserving schemes need the exact incremental joint maps); use integrator = \"newmark\", or remove them",
-                        integrator.name()
-                    ),
-                ))
-            };
-            if !model.joints.is_empty() {
-                return refuse("joint[0]", "joints");
-            }
-            if !model.prescribed.is_empty() {
-                return refuse("prescribed[0]", "prescribed motion");
-            }
-        }
-    }
-    Ok(())
-}
-
 /// Initial nodal velocities from the `[[initial_velocity]]` fields
 /// (`v = v₀ + ω × (x − origin)`, body angular velocity `W = ω` since every
 /// node starts at the identity); a later field overrides an earlier one on
@@ -162,10 +135,22 @@ fn joint_map(
 
 /// Builds the mechanism of `model`.
 pub fn build(model: &Model) -> Result<Built, ModelError> {
-    unsupported(model)?;
     let mut mesh = Mesh::default();
     let mut beam_nodes = Vec::with_capacity(model.beams.len());
     for (b, beam) in model.beams.iter().enumerate() {
+        if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
+            if integrator != IntegratorKind::Newmark && beam.nodes_per_element != 2 {
+                return Err(ModelError::new(
+                    &model.path,
+                    format!("beam[{b}].nodes_per_element"),
+                    None,
+                    format!(
+                        "integrator = \"{}\" runs on 2-node elements (its internal force is the midpoint form of the linear element); use nodes_per_element = 2 with more elements, or integrator = \"newmark\"",
+                        integrator.name()
+                    ),
+                ));
+            }
+        }
         let s = &model.sections[beam.section];
         let section = Section::new(
             [s.ea, s.ga[0], s.ga[1]],

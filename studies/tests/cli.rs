@@ -79,16 +79,16 @@ fn missing_file_and_unsupported_features_are_named() {
         stderr.contains("/nonexistent/model.toml") && stderr.contains("cannot read"),
         "{stderr}"
     );
-    // Joints in the conserving schemes are valid model syntax but not
-    // solvable yet: refused with the key named, and nothing half-solved.
+    // Quadratic elements in a conserving scheme are valid model syntax but
+    // not solvable: refused with the key named, and nothing half-solved.
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("dyn.toml");
-    let statics = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/statics/screw_driven.toml");
-    let text = std::fs::read_to_string(statics).unwrap().replace(
-        "analysis = \"static\"                # the load factor is the driving parameter\nload_steps = 80",
-        "analysis = \"dynamic\"\nintegrator = \"momentum\"\ndt = 0.01\nt_end = 1.0",
-    );
-    assert!(text.contains("dynamic"));
+    let spinning =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/dynamics/spinning_beam.toml");
+    let text = std::fs::read_to_string(spinning)
+        .unwrap()
+        .replace("elements = 10", "elements = 5\nnodes_per_element = 3");
+    assert!(text.contains("nodes_per_element = 3"));
     std::fs::write(&model, text).unwrap();
     let out = flexmech()
         .arg("run")
@@ -100,10 +100,12 @@ fn missing_file_and_unsupported_features_are_named() {
     assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("dyn.toml") && stderr.contains("joint[0]") && stderr.contains("dynamic"),
+        stderr.contains("dyn.toml")
+            && stderr.contains("beam[0].nodes_per_element")
+            && stderr.contains("energy-momentum"),
         "{stderr}"
     );
-    assert!(!dir.path().join("screw-driven.h5").exists());
+    assert!(!dir.path().join("spinning-beam.h5").exists());
 }
 
 #[test]

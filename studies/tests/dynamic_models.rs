@@ -74,3 +74,89 @@ fn momentum_and_newmark_from_the_same_file() {
     let e = read(&file, "/energy/total");
     assert!(e.iter().all(|v| v.is_finite()));
 }
+
+/// `data/dynamics/free_chain.toml` (ten links joined by every joint kind,
+/// floating free) with a given integrator.
+fn run_chain(integrator: &str) -> (PathBuf, tempfile::TempDir) {
+    let path = data("free_chain.toml");
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        "integrator = \"energy-momentum\"",
+        &format!("integrator = \"{integrator}\""),
+    );
+    let model = parse_model(&text, &path).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let file = run_model(&model, dir.path())
+        .unwrap_or_else(|e| panic!("{integrator}: {e}"))
+        .file;
+    (file, dir)
+}
+
+#[test]
+fn every_joint_kind_runs_with_every_integrator_from_a_model_file() {
+    const JOINTS: [&str; 9] = [
+        "rigid",
+        "revolute",
+        "spherical",
+        "prismatic",
+        "cylindrical",
+        "screw",
+        "rack_pinion",
+        "cam",
+        "lobe",
+    ];
+    for integrator in ["newmark", "momentum", "energy-momentum"] {
+        let (file, _dir) = run_chain(integrator);
+        assert!((read(&file, "/time").last().unwrap() - 1.0).abs() < 1e-9);
+        for joint in JOINTS {
+            let c = read(&file, &format!("/joints/{joint}/constraint_error"));
+            let worst = c.iter().copied().fold(0.0, f64::max);
+            assert!(
+                worst <= 1e-12,
+                "{integrator}, {joint}: constraint {worst:e}"
+            );
+        }
+        let (dl, dh) = (
+            drift(&read(&file, "/momentum/linear"), 3),
+            drift(&read(&file, "/momentum/angular"), 3),
+        );
+        let e = read(&file, "/energy/total");
+        let de = e
+            .iter()
+            .map(|v| (v - e[0]).abs() / e[0])
+            .fold(0.0, f64::max);
+        eprintln!("free chain, {integrator}: momentum drift {dl:.1e} / {dh:.1e}, energy {de:.1e}");
+        if integrator != "newmark" {
+            // Newton's tolerance 1e-11 per step, 100 steps.
+            assert!(
+                dl <= 1e-9 && dh <= 1e-9,
+                "{integrator}: momenta {dl:e} / {dh:e}"
+            );
+        }
+        if integrator == "energy-momentum" {
+            assert!(de <= 1e-9, "energy drift {de:e}");
+        }
+    }
+}
+
+#[test]
+fn quadratic_elements_in_a_conserving_scheme_are_refused_by_key() {
+    let path = data("spinning_beam.toml");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("elements = 10", "elements = 5\nnodes_per_element = 3");
+    let model = parse_model(&text, Path::new("quadratic.toml")).unwrap();
+    let err = flexmech_studies::build(&model).unwrap_err().to_string();
+    assert!(
+        err.contains("quadratic.toml")
+            && err.contains("beam[0].nodes_per_element")
+            && err.contains("nodes_per_element = 2"),
+        "{err}"
+    );
+    // Newmark takes them.
+    let newmark = text.replace(
+        "integrator = \"energy-momentum\"",
+        "integrator = \"newmark\"",
+    );
+    let model = parse_model(&newmark, Path::new("quadratic.toml")).unwrap();
+    assert!(flexmech_studies::build(&model).is_ok());
+}

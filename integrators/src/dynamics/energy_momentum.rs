@@ -85,8 +85,8 @@ pub(super) fn solve_step(
     lu: &mut SparseLu,
     settings: &NewtonSettings,
 ) -> Result<(NewtonReport, f64), NewtonFailure> {
-    let n_eq = sys.dofs.n_eq;
-    let nodes = sys.end.x.len();
+    let n_eq = sys.topo.dofs.n_eq;
+    let nodes = sys.end.config.x.len();
     let (mut r, mut b, mut ge, mut gc) = (
         vec![0.0; n_eq],
         vec![0.0; n_eq],
@@ -109,7 +109,7 @@ pub(super) fn solve_step(
             vec![0.0; 6 * nodes],
         ];
         // Element terms in parallel, summed in element order (deterministic).
-        let (start, end) = (sys.start, &sys.end);
+        let (start, end) = (&sys.start.config, &sys.end.config);
         let terms: Vec<EnergyTerms> = sys
             .mech
             .mesh
@@ -129,9 +129,11 @@ pub(super) fn solve_step(
                 }
             }
         }
-        sys.dofs.reduce(&nodal[0], &mut b);
-        sys.dofs.reduce(&nodal[1], &mut ge);
-        sys.dofs.reduce(&nodal[2], &mut gc);
+        // b = ∂(Ñᵀg)/∂β is a residual (through Ñ); the gradients of the
+        // energy terms are derivatives (through the end-point maps).
+        sys.reduce_residual(&nodal[0], &mut b);
+        sys.topo.dofs.reduce(&nodal[1], &mut ge);
+        sys.topo.dofs.reduce(&nodal[2], &mut gc);
         let energy = e_tot + beta * c_tot;
         let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
         let res_g = if norm == 0.0 {
@@ -150,8 +152,9 @@ pub(super) fn solve_step(
         // system's force floor, times the size of the step's increments.
         let increments: f64 = (0..nodes)
             .map(|i| {
-                let u = sys.end.x[i] - sys.start.x[i];
-                let th = cayley_inverse(&(sys.end.rot[i] * sys.start.rot[i].transpose()));
+                let (s0, s1) = (&sys.start.config, &sys.end.config);
+                let u = s1.x[i] - s0.x[i];
+                let th = cayley_inverse(&(s1.rot[i] * s0.rot[i].transpose()));
                 u.norm_squared() + th.norm_squared()
             })
             .sum::<f64>()

@@ -6,11 +6,24 @@
 //!   `(πₙ₊₁ − πₙ)/Δt` with `π = R J₀ W` — so that `θ·(πₙ₊₁ − πₙ)/Δt` and
 //!   `u·M(vₙ₊₁ − vₙ)/Δt` are exactly the kinetic energy changes;
 //! * internal force `q_k(Nₙ₊½, Mₙ₊½)` with the mid rotation of the scheme;
-//! * external loads at `tₙ₊½`.
+//! * external loads at `tₙ₊½`;
+//! * joints through the exact incremental map `Ñ` (paper eqs 21–23,
+//!   [`flexmech_joints::incremental`]): slaves are placed exactly by relation
+//!   (1) after every Newton update, and the reduced equations are `Ñᵀ g = 0`,
+//!   so the conservation properties of the beams hold for the joined system.
+//!
+//! Newton's tangent for a joined system is the derivative of the end-point
+//! form `Nᵀ g` (the assembled `Nᵀ K N` plus `∂(Nᵀ g)/∂q`, as in Newmark and
+//! statics), not of `Ñᵀ g`: the two differ by `O(Δt)` (`Ñ` uses mid-step
+//! levers), so Newton converges linearly with a small rate instead of
+//! quadratically, and the converged step — which is all the conservation
+//! properties depend on — is that of `Ñᵀ g = 0`. Beams without joints have
+//! the exact tangent.
 
+use super::slave_velocities;
 use super::{DynamicSettings, Motion, StepControl};
 use crate::assembly::Assembler;
-use crate::dofs::DofMap;
+use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::SolveError;
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
@@ -18,7 +31,7 @@ use crate::newton::{self, NewtonReport, NewtonSystem};
 use crate::record::{Energies, StepRecord};
 use crate::statics::strain_energy;
 use flexmech_core::conserving::{MidRotation, Pose};
-use flexmech_core::rotation::{cayley_inverse, exp};
+use flexmech_core::rotation::{cayley_inverse, exp, log};
 use flexmech_core::{BeamElement, Configuration, Element, Inertia};
 use nalgebra::{Const, Matrix3, SVector, Vector3, U1};
 use num_dual::DualSVec64;
@@ -168,14 +181,16 @@ fn inertial_moment(
 /// One step of a midpoint scheme, as the [`NewtonSystem`] Newton solves.
 pub struct MidpointStep<'a> {
     pub mech: &'a Mechanism,
-    pub dofs: &'a DofMap,
+    /// Unknowns and node maps (refreshed at the iterate).
+    pub topo: &'a mut Topology,
     pub inertia: &'a Inertia,
     pub asm: &'a mut Assembler,
-    pub start: &'a Configuration,
+    /// The state at `tₙ`.
+    pub start: &'a MechanismState,
     pub v_n: &'a [Vector3<f64>],
     pub w_n: &'a [Vector3<f64>],
-    /// The current iterate of the end configuration.
-    pub end: Configuration,
+    /// The current iterate of the state at `tₙ₊₁` (slaves placed exactly).
+    pub end: MechanismState,
     pub dt: f64,
     pub mid: MidRotation,
     /// Energy–momentum β (0 for the momentum scheme).
@@ -189,11 +204,35 @@ pub struct MidpointStep<'a> {
     pub floor: f64,
 }
 
+impl MidpointStep<'_> {
+    /// The reduced residual `Ñᵀ g` of nodal residuals `g` (plain `Tᵀ g`
+    /// without joints).
+    pub fn reduce_residual(&self, g: &[f64], out: &mut [f64]) {
+        self.topo
+            .reduce_incremental(self.mech, self.start, &self.end, g, out);
+    }
+
+    /// Adds `k` between components `ri..ri+3` of node `i` and `cj..cj+3` of
+    /// node `j` to the tangent through the node maps.
+    fn add_block(&mut self, i: usize, ri: usize, j: usize, cj: usize, k: &Matrix3<f64>) {
+        let (mi, mj) = (&self.topo.dofs.nodes[i], &self.topo.dofs.nodes[j]);
+        for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
+            for (ej, cjv) in mj.eqs.iter().zip(&mj.cols) {
+                let v = ci.fixed_rows::<3>(ri).dot(&(k * cjv.fixed_rows::<3>(cj)));
+                if v != 0.0 {
+                    self.asm.add_entry(*ei, *ej, v);
+                }
+            }
+        }
+    }
+}
+
 impl NewtonSystem for MidpointStep<'_> {
     fn evaluate(&mut self, r: &mut [f64]) -> f64 {
-        let (start, end, mid, beta) = (self.start, &self.end, self.mid, self.beta);
+        self.topo.refresh(self.mech, &self.end);
+        let (start, end, mid, beta) = (&self.start.config, &self.end.config, self.mid, self.beta);
         self.asm
-            .assemble_with(&self.mech.mesh, self.dofs, |el, _, re, ke| {
+            .assemble_with(&self.mech.mesh, &self.topo.dofs, |el, _, re, ke| {
                 element_kernel(el, start, end, mid, beta, re, ke)
             });
         let dt = self.dt;
@@ -206,50 +245,52 @@ impl NewtonSystem for MidpointStep<'_> {
         }
         // Translational inertia: Σⱼ m_ij (vⱼ,ₙ₊₁ − vⱼ,ₙ)/Δt, vₙ₊₁ = 2(xₙ₊₁ − xₙ)/Δt − vₙ.
         self.inertia_abs.iter_mut().for_each(|v| *v = 0.0);
-        for &(i, j, m) in &self.inertia.mass {
-            let dv = (end.x[j] - start.x[j]) * (2.0 / dt) - self.v_n[j] * 2.0;
+        for k in 0..self.inertia.mass.len() {
+            let (i, j, m) = self.inertia.mass[k];
+            let dv =
+                (self.end.config.x[j] - self.start.config.x[j]) * (2.0 / dt) - self.v_n[j] * 2.0;
             for c in 0..3 {
                 self.nodal[6 * i + c] += m * dv[c] / dt;
                 self.inertia_abs[6 * i + c] += (m * dv[c] / dt).abs();
             }
-            let k = 2.0 * m / (dt * dt);
-            let (mi, mj) = (&self.dofs.nodes[i], &self.dofs.nodes[j]);
-            for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
-                for (ej, cj) in mj.eqs.iter().zip(&mj.cols) {
-                    let v = k * ci.fixed_rows::<3>(0).dot(&cj.fixed_rows::<3>(0));
-                    if v != 0.0 {
-                        self.asm.add_entry(*ei, *ej, v);
-                    }
-                }
-            }
+            self.add_block(i, 0, j, 0, &(Matrix3::identity() * (2.0 * m / (dt * dt))));
         }
         // Rotational inertia, node by node.
-        for (i, j0) in self.inertia.rotational.iter().enumerate() {
-            if *j0 == Matrix3::zeros() {
+        for i in 0..self.inertia.rotational.len() {
+            let j0 = self.inertia.rotational[i];
+            if j0 == Matrix3::zeros() {
                 continue;
             }
-            let (m, k) = inertial_moment(j0, &start.rot[i], &end.rot[i], &self.w_n[i], dt);
+            let (m, k) = inertial_moment(
+                &j0,
+                &self.start.config.rot[i],
+                &self.end.config.rot[i],
+                &self.w_n[i],
+                dt,
+            );
             for c in 0..3 {
                 self.nodal[6 * i + 3 + c] += m[c];
                 self.inertia_abs[6 * i + 3 + c] += m[c].abs();
             }
-            let map = &self.dofs.nodes[i];
-            for (ei, ci) in map.eqs.iter().zip(&map.cols) {
-                for (ej, cj) in map.eqs.iter().zip(&map.cols) {
-                    let v = ci.fixed_rows::<3>(3).dot(&(k * cj.fixed_rows::<3>(3)));
-                    if v != 0.0 {
-                        self.asm.add_entry(*ei, *ej, v);
-                    }
-                }
+            self.add_block(i, 3, i, 3, &k);
+        }
+        self.reduce_residual(&self.nodal, r);
+        if !self.mech.joints.is_empty() {
+            // The end-point part of the tangent: ∂(Nᵀg)/∂q with the slaves'
+            // full residuals (see the module docs).
+            let blocks = self
+                .topo
+                .geometric_blocks(self.mech, &self.end, &self.nodal);
+            for (b, block) in blocks.iter().enumerate() {
+                self.asm.add_block(b, block);
             }
         }
-        self.dofs.reduce(&self.nodal, r);
-        self.dofs.reduce(&self.fext, &mut self.scratch);
+        self.topo.dofs.reduce(&self.fext, &mut self.scratch);
         let f_ext = norm(&self.scratch);
         for (a, b) in self.inertia_abs.iter_mut().zip(&self.asm.nodal_abs) {
             *a += b;
         }
-        self.dofs.reduce(&self.inertia_abs, &mut self.scratch);
+        self.topo.dofs.reduce(&self.inertia_abs, &mut self.scratch);
         f_ext.max(norm(&self.scratch))
     }
 
@@ -258,16 +299,7 @@ impl NewtonSystem for MidpointStep<'_> {
     }
 
     fn apply(&mut self, dq: &[f64]) {
-        for n in 0..self.end.x.len() {
-            let p = self.dofs.node_increment(n, dq);
-            if p != nalgebra::Vector6::zeros() {
-                self.end.increment(
-                    n,
-                    &p.fixed_rows::<3>(0).into_owned(),
-                    &p.fixed_rows::<3>(3).into_owned(),
-                );
-            }
-        }
+        self.topo.apply(self.mech, &mut self.end, dq);
     }
 
     fn floor(&self) -> f64 {
@@ -280,9 +312,9 @@ fn norm(v: &[f64]) -> f64 {
 }
 
 /// Runs a midpoint scheme from `initial` over `[0, t_end]`, reporting a record
-/// at t = 0 and after every converged step. Beams of 2-node elements without
-/// joints or prescribed motion (joints in dynamics come with the exact
-/// incremental maps `Ñ`).
+/// at t = 0 and after every converged step. Beams of 2-node elements; joints
+/// through `Ñ`, driven joint coordinates and prescribed DOFs follow their
+/// schedules (their work enters the energy balance as external work).
 pub fn solve(
     mech: &Mechanism,
     settings: &DynamicSettings,
@@ -290,11 +322,6 @@ pub fn solve(
     mid: MidRotation,
     mut on_step: impl FnMut(&StepRecord),
 ) -> Result<Configuration, SolveError> {
-    if !mech.joints.is_empty() || !mech.prescribed.is_empty() {
-        return Err(SolveError::InvalidMechanism(
-            "joints and prescribed motion are not available in dynamic analyses yet".into(),
-        ));
-    }
     if mech
         .mesh
         .elements
@@ -311,41 +338,68 @@ pub fn solve(
         ));
     }
     let nodes = mech.mesh.node_count();
-    let dofs = DofMap::independent(&mech.fixed);
+    let mut state = initial_state(mech);
+    let mut topo = Topology::new(mech, &state)?;
+    topo.impose(mech, &mut state, 0.0);
+    let n_eq = topo.dofs.n_eq;
     let inertia = Inertia::new(&mech.mesh, settings.mass);
-    let mut asm = Assembler::new(&mech.mesh, &dofs, &[]);
+    let mut asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
     let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
-    let (mut r, mut dq) = (vec![0.0; dofs.n_eq], vec![0.0; dofs.n_eq]);
-    let mut config = Configuration::initial(&mech.mesh.positions);
-    let (mut v, mut w) = (initial.v.clone(), initial.w.clone());
+    let (mut r, mut dq) = (vec![0.0; n_eq], vec![0.0; n_eq]);
+    let (mut v, mut w) = slave_velocities(mech, &topo, &state, initial);
+    // Rates of the released coordinates, for the predictor.
+    let mut rates: Vec<Vec<f64>> = mech
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(j, joint)| {
+            let mut rate = vec![0.0; joint.map.released_count()];
+            if let Some(r0) = rate.first_mut() {
+                *r0 = initial.joint_rates.get(j).copied().unwrap_or(0.0);
+            }
+            rate
+        })
+        .collect();
     let mut fext = vec![0.0; 6 * nodes];
     mech.external_forces(0.0, &mut fext);
-    on_step(&dynamic_record(
-        mech, &inertia, &config, &v, &w, &fext, 0.0, 0.0, None,
-    ));
+    let record = |state: &MechanismState,
+                  v: &[Vector3<f64>],
+                  w: &[Vector3<f64>],
+                  fext: &[f64],
+                  t: f64,
+                  dt: f64,
+                  rep: Option<&NewtonReport>| {
+        let mut rec = dynamic_record(mech, &inertia, &state.config, v, w, fext, t, dt, rep);
+        rec.joints = joint_records(mech, state);
+        rec
+    };
+    on_step(&record(&state, &v, &w, &fext, 0.0, 0.0, None));
     let (mut t, mut control) = (0.0f64, StepControl::new(settings));
     while t < settings.t_end * (1.0 - 1e-12) {
         let dt = control.next(t, settings.t_end);
         // Predictor: constant velocities over the step.
-        let mut end = config.clone();
+        let mut end = state.clone();
         for i in 0..nodes {
-            let spin = config.rot[i] * w[i] * dt;
-            end.increment(i, &(v[i] * dt), &spin);
-        }
-        for (i, f) in mech.fixed.iter().enumerate() {
-            if f.iter().any(|&h| h) {
-                end.x[i] = config.x[i];
-                end.rot[i] = config.rot[i];
+            if !mech.fixed[i].iter().any(|&h| h) && topo.slave_of[i].is_none() {
+                let spin = state.config.rot[i] * w[i] * dt;
+                end.config.increment(i, &(v[i] * dt), &spin);
             }
         }
+        for (j, joint) in mech.joints.iter().enumerate() {
+            let delta: Vec<f64> = rates[j].iter().map(|r| r * dt).collect();
+            if delta.iter().any(|&d| d != 0.0) {
+                joint.map.advance(&mut end.released[j], &delta);
+            }
+        }
+        topo.impose(mech, &mut end, t + dt);
         let mut fmid = vec![0.0; 6 * nodes];
         mech.external_forces(t + 0.5 * dt, &mut fmid);
         let mut sys = MidpointStep {
             mech,
-            dofs: &dofs,
+            topo: &mut topo,
             inertia: &inertia,
             asm: &mut asm,
-            start: &config,
+            start: &state,
             v_n: &v,
             w_n: &w,
             end,
@@ -355,7 +409,7 @@ pub fn solve(
             fext: fmid,
             nodal: vec![0.0; 6 * nodes],
             inertia_abs: vec![0.0; 6 * nodes],
-            scratch: vec![0.0; dofs.n_eq],
+            scratch: vec![0.0; n_eq],
             floor: mech.round_off_floor(),
         };
         let outcome = match mid {
@@ -370,14 +424,16 @@ pub fn solve(
         match outcome {
             Ok((report, beta)) => {
                 let end = sys.end;
-                let (v1, w1) = end_motion(&config, &end, &v, &w, dt);
-                config = end;
+                let (v1, w1) = end_motion(&state.config, &end.config, &v, &w, dt);
+                for (j, rate) in rates.iter_mut().enumerate() {
+                    *rate = released_rate(&state.released[j], &end.released[j], rate.len(), dt);
+                }
+                state = end;
                 v = v1;
                 w = w1;
                 t += dt;
                 mech.external_forces(t, &mut fext);
-                let mut rec =
-                    dynamic_record(mech, &inertia, &config, &v, &w, &fext, t, dt, Some(&report));
+                let mut rec = record(&state, &v, &w, &fext, t, dt, Some(&report));
                 rec.beta = beta;
                 on_step(&rec);
                 control.succeeded();
@@ -385,7 +441,23 @@ pub fn solve(
             Err(reason) => control.failed(t + dt, reason)?,
         }
     }
-    Ok(config)
+    Ok(state.config)
+}
+
+/// The rate of a joint's released coordinates over a step: additive
+/// coordinates by their difference, a multiplicative released rotation by
+/// the spin between its two values.
+fn released_rate(
+    a: &flexmech_joints::ReleasedState,
+    b: &flexmech_joints::ReleasedState,
+    count: usize,
+    dt: f64,
+) -> Vec<f64> {
+    if a.rot != b.rot {
+        let spin = log(&(b.rot * a.rot.transpose())) / dt;
+        return vec![spin.x, spin.y, spin.z];
+    }
+    (0..count).map(|c| (b.q[c] - a.q[c]) / dt).collect()
 }
 
 /// A record with energies (kinetic, strain, potential of the external forces

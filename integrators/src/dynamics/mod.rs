@@ -14,10 +14,14 @@ pub mod midpoint;
 pub mod momentum;
 pub mod newmark;
 
+use crate::constraints::{MechanismState, Topology};
 use crate::error::{NewtonFailure, SolveError};
+use crate::mechanism::Mechanism;
 use crate::newton::NewtonSettings;
 use flexmech_core::MassKind;
+use flexmech_joints::LOCAL;
 use nalgebra::Vector3;
+use nalgebra::{SVector, Vector6};
 
 /// Settings of a dynamic analysis.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -109,4 +113,33 @@ impl StepControl {
         self.step *= 0.5;
         Ok(())
     }
+}
+
+/// Initial velocities, every slave's derived from its master's and the
+/// joint's released rate through `N` (spatial spin `w = R W`).
+pub(crate) fn slave_velocities(
+    mech: &Mechanism,
+    topo: &Topology,
+    state: &MechanismState,
+    initial: &Motion,
+) -> (Vec<Vector3<f64>>, Vec<Vector3<f64>>) {
+    let (mut v, mut w) = (initial.v.clone(), initial.w.clone());
+    for &j in &topo.order {
+        let joint = &mech.joints[j];
+        let (m, s) = (joint.master, joint.slave);
+        let n = joint
+            .map
+            .variation(&state.config.x[m], &state.config.rot[m], &state.released[j]);
+        let mut p = SVector::<f64, LOCAL>::zeros();
+        p.fixed_rows_mut::<3>(0).copy_from(&v[m]);
+        p.fixed_rows_mut::<3>(3)
+            .copy_from(&(state.config.rot[m] * w[m]));
+        if joint.map.released_count() > 0 {
+            p[6] = initial.joint_rates.get(j).copied().unwrap_or(0.0);
+        }
+        let ps: Vector6<f64> = n * p;
+        v[s] = ps.fixed_rows::<3>(0).into_owned();
+        w[s] = state.config.rot[s].transpose() * ps.fixed_rows::<3>(3);
+    }
+    (v, w)
 }

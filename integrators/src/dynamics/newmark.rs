@@ -13,7 +13,7 @@
 //! screw example shows its energy growing until it fails.
 
 use super::midpoint::dynamic_record;
-use super::{DynamicSettings, Motion, StepControl};
+use super::{slave_velocities, DynamicSettings, Motion, StepControl};
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::SolveError;
@@ -23,8 +23,7 @@ use crate::newton::{self, NewtonReport, NewtonSystem};
 use crate::record::StepRecord;
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::{Configuration, Inertia};
-use flexmech_joints::LOCAL;
-use nalgebra::{Const, Matrix3, SVector, Vector3, Vector6, U1};
+use nalgebra::{Const, Matrix3, Vector3, U1};
 use num_dual::DualSVec64;
 
 const BETA: f64 = 0.25;
@@ -166,35 +165,6 @@ impl NewtonSystem for NewmarkStep<'_> {
 
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
-}
-
-/// Initial velocities, every slave's derived from its master's and the
-/// joint's released rate through `N` (spatial spin `w = R W`).
-fn slave_velocities(
-    mech: &Mechanism,
-    topo: &Topology,
-    state: &MechanismState,
-    initial: &Motion,
-) -> (Vec<Vector3<f64>>, Vec<Vector3<f64>>) {
-    let (mut v, mut w) = (initial.v.clone(), initial.w.clone());
-    for &j in &topo.order {
-        let joint = &mech.joints[j];
-        let (m, s) = (joint.master, joint.slave);
-        let n = joint
-            .map
-            .variation(&state.config.x[m], &state.config.rot[m], &state.released[j]);
-        let mut p = SVector::<f64, LOCAL>::zeros();
-        p.fixed_rows_mut::<3>(0).copy_from(&v[m]);
-        p.fixed_rows_mut::<3>(3)
-            .copy_from(&(state.config.rot[m] * w[m]));
-        if joint.map.released_count() > 0 {
-            p[6] = initial.joint_rates.get(j).copied().unwrap_or(0.0);
-        }
-        let ps: Vector6<f64> = n * p;
-        v[s] = ps.fixed_rows::<3>(0).into_owned();
-        w[s] = state.config.rot[s].transpose() * ps.fixed_rows::<3>(3);
-    }
-    (v, w)
 }
 
 /// Initial accelerations from the reduced equations of motion at t = 0,
