@@ -12,6 +12,11 @@ pub struct Energies {
     pub potential: f64,
     /// `kinetic + strain + potential`.
     pub total: f64,
+    /// Work done on the mechanism since t = 0 by its drivers: driven joint
+    /// coordinates and prescribed nodal DOFs (`Σ pᵢ·gᵢ` of each step, the
+    /// reactions' work). With drivers `total − driver_work` is the conserved
+    /// quantity of a conservative system. Zero in statics.
+    pub driver_work: f64,
 }
 
 /// State of one joint at the end of a step.

@@ -136,6 +136,7 @@ fn record(
             strain,
             potential,
             total: strain + potential,
+            driver_work: 0.0,
         },
         momentum_linear: [0.0; 3],
         momentum_angular: [0.0; 3],

@@ -20,7 +20,7 @@
 //! properties depend on — is that of `Ñᵀ g = 0`. Beams without joints have
 //! the exact tangent.
 
-use super::slave_velocities;
+use super::{increment_work, slave_velocities};
 use super::{DynamicSettings, Motion, StepControl};
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
@@ -375,6 +375,7 @@ pub fn solve(
     };
     on_step(&record(&state, &v, &w, &fext, 0.0, 0.0, None));
     let (mut t, mut control) = (0.0f64, StepControl::new(settings));
+    let mut driver_work = 0.0;
     while t < settings.t_end * (1.0 - 1e-12) {
         let dt = control.next(t, settings.t_end);
         // Predictor: constant velocities over the step.
@@ -423,6 +424,8 @@ pub fn solve(
         };
         match outcome {
             Ok((report, beta)) => {
+                // The drivers' work: exact for these schemes (Σ pᵢ·gᵢ = ΔH − W_loads).
+                driver_work += increment_work(&state.config, &sys.end.config, &sys.nodal, true);
                 let end = sys.end;
                 let (v1, w1) = end_motion(&state.config, &end.config, &v, &w, dt);
                 for (j, rate) in rates.iter_mut().enumerate() {
@@ -435,6 +438,7 @@ pub fn solve(
                 mech.external_forces(t, &mut fext);
                 let mut rec = record(&state, &v, &w, &fext, t, dt, Some(&report));
                 rec.beta = beta;
+                rec.energy.driver_work = driver_work;
                 on_step(&rec);
                 control.succeeded();
             }
@@ -499,6 +503,7 @@ pub fn dynamic_record(
             strain,
             potential,
             total: kinetic + strain + potential,
+            driver_work: 0.0,
         },
         momentum_linear: [lin.x, lin.y, lin.z],
         momentum_angular: [ang.x, ang.y, ang.z],

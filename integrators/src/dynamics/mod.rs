@@ -143,3 +143,31 @@ pub(crate) fn slave_velocities(
     }
     (v, w)
 }
+
+/// `Σᵢ pᵢ·gᵢ` over all nodes for the step `start → end`: displacement
+/// increments and rotation increments (`cayley`: the tangent-scaled `θ` of
+/// `Rₙ₊₁ = cay(θ)Rₙ`, else the spatial rotation vector `log(Rₙ₊₁Rₙᵀ)`) against
+/// the nodal residuals `g`. At a converged step the free equations vanish, so
+/// this is the work of the drivers' reactions (driven joint coordinates,
+/// prescribed DOFs).
+pub(crate) fn increment_work(
+    start: &flexmech_core::Configuration,
+    end: &flexmech_core::Configuration,
+    g: &[f64],
+    cayley: bool,
+) -> f64 {
+    use flexmech_core::rotation::{cayley_inverse, log};
+    (0..start.x.len())
+        .map(|i| {
+            let u = end.x[i] - start.x[i];
+            let rel = end.rot[i] * start.rot[i].transpose();
+            let th = if cayley {
+                cayley_inverse(&rel)
+            } else {
+                log(&rel)
+            };
+            let gi = Vector6::from_column_slice(&g[6 * i..6 * i + 6]);
+            u.dot(&gi.fixed_rows::<3>(0)) + th.dot(&gi.fixed_rows::<3>(3))
+        })
+        .sum()
+}

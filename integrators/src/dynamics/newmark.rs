@@ -13,7 +13,7 @@
 //! screw example shows its energy growing until it fails.
 
 use super::midpoint::dynamic_record;
-use super::{slave_velocities, DynamicSettings, Motion, StepControl};
+use super::{increment_work, slave_velocities, DynamicSettings, Motion, StepControl};
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::SolveError;
@@ -279,6 +279,9 @@ pub fn solve(
     };
     on_step(&record(&state, &kin, &fext, 0.0, 0.0, None));
     let (mut t, mut control) = (0.0f64, StepControl::new(settings));
+    // The drivers' work, by the trapezoidal rule on the nodal residuals at
+    // both ends of each step (the first step uses its end value twice).
+    let (mut driver_work, mut g_prev): (f64, Option<Vec<f64>>) = (0.0, None);
     while t < settings.t_end * (1.0 - 1e-12) {
         let dt = control.next(t, settings.t_end);
         let start = state.config.clone();
@@ -309,6 +312,12 @@ pub fn solve(
         };
         match newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq) {
             Ok(report) => {
+                let g_end = sys.nodal.clone();
+                let g_start = g_prev.as_deref().unwrap_or(&g_end);
+                driver_work += 0.5
+                    * (increment_work(&start, &sys.end.config, g_start, false)
+                        + increment_work(&start, &sys.end.config, &g_end, false));
+                g_prev = Some(g_end);
                 let end = sys.end;
                 let mut next = Kinematics {
                     v: Vec::new(),
@@ -338,7 +347,9 @@ pub fn solve(
                 kin = next;
                 t += dt;
                 mech.external_forces(t, &mut fext);
-                on_step(&record(&state, &kin, &fext, t, dt, Some(&report)));
+                let mut rec = record(&state, &kin, &fext, t, dt, Some(&report));
+                rec.energy.driver_work = driver_work;
+                on_step(&rec);
                 control.succeeded();
             }
             Err(reason) => control.failed(t + dt, reason)?,

@@ -48,6 +48,8 @@ pub const ENERGY_STRAIN: &str = "/energy/strain";
 pub const ENERGY_POTENTIAL: &str = "/energy/potential";
 /// T: kinetic + strain + potential.
 pub const ENERGY_TOTAL: &str = "/energy/total";
+/// T: work done by driven joint coordinates and prescribed DOFs since t = 0.
+pub const ENERGY_DRIVER_WORK: &str = "/energy/driver_work";
 
 /// Group of the momentum datasets.
 pub const MOMENTUM: &str = "/momentum";

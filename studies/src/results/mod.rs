@@ -18,6 +18,7 @@
 //! |---|---|---|
 //! | `/time` | T | time of each step (statics: load factor) |
 //! | `/energy/kinetic`, `/energy/strain`, `/energy/potential`, `/energy/total` | T | energies |
+//! | `/energy/driver_work` | T | work done by driven joint coordinates and prescribed DOFs since t = 0 (extension) |
 //! | `/momentum/linear`, `/momentum/angular` | T×3 | total momenta (angular about the origin) |
 //! | `/solver/iterations` | T, `u64` | Newton iterations of the step |
 //! | `/solver/dt` | T | step size actually used (after halvings) |

@@ -312,6 +312,7 @@ struct Datasets {
     strain: Series,
     potential: Series,
     total: Series,
+    driver_work: Series,
     momentum_linear: Series,
     momentum_angular: Series,
     iterations: Series,
@@ -479,6 +480,11 @@ impl ResultWriter {
             "potential of gravity and dead external loads",
         )?;
         let total = f64s(names::ENERGY_TOTAL, &[], "kinetic + strain + potential")?;
+        let driver_work = f64s(
+            names::ENERGY_DRIVER_WORK,
+            &[],
+            "work done by driven joint coordinates and prescribed DOFs since t = 0",
+        )?;
         let momentum_linear = f64s(names::MOMENTUM_LINEAR, &[3], "total linear momentum")?;
         let momentum_angular = f64s(
             names::MOMENTUM_ANGULAR,
@@ -616,6 +622,7 @@ impl ResultWriter {
             strain,
             potential,
             total,
+            driver_work,
             momentum_linear,
             momentum_angular,
             iterations,
@@ -691,6 +698,8 @@ impl ResultWriter {
         s.strain.push_scalar(t, step.energy.strain, path)?;
         s.potential.push_scalar(t, step.energy.potential, path)?;
         s.total.push_scalar(t, step.energy.total, path)?;
+        s.driver_work
+            .push_scalar(t, step.energy.driver_work, path)?;
         s.momentum_linear.push_row(t, step.momentum_linear, path)?;
         s.momentum_angular
             .push_row(t, step.momentum_angular, path)?;
