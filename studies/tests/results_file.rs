@@ -123,6 +123,7 @@ fn record(step: usize) -> StepRecord {
             strain: 10.0 + k,
             potential: -k,
             total: 11.0 + k,
+            driver_work: 0.25 * k,
         },
         momentum_linear: [k, 2.0 * k, 3.0 * k],
         momentum_angular: [-k, 0.5, k * k],
@@ -213,12 +214,13 @@ type MetaEdit = fn(&mut RunMeta);
 /// Checks the series of a file holding steps `0..t` of [`record`].
 fn check_series(file: &hdf5::File, t: usize) {
     let steps: Vec<StepRecord> = (0..t).map(record).collect();
-    let scalars: [(&str, Getter<f64>); 8] = [
+    let scalars: [(&str, Getter<f64>); 9] = [
         (layout::TIME, |s| s.time),
         (layout::ENERGY_KINETIC, |s| s.energy.kinetic),
         (layout::ENERGY_STRAIN, |s| s.energy.strain),
         (layout::ENERGY_POTENTIAL, |s| s.energy.potential),
         (layout::ENERGY_TOTAL, |s| s.energy.total),
+        (layout::ENERGY_DRIVER_WORK, |s| s.energy.driver_work),
         (layout::SOLVER_DT, |s| s.dt),
         (layout::SOLVER_RESIDUAL, |s| s.residual),
         (layout::SOLVER_BETA, |s| s.beta),
