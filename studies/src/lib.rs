@@ -8,4 +8,4 @@ pub mod results;
 pub mod run;
 
 pub use build::{build, Built};
-pub use run::{run_model, RunError, RunSummary};
+pub use run::{run_model, run_model_to, RunError, RunSummary};

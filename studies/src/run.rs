@@ -88,12 +88,22 @@ impl Sink {
 
 /// Runs `model` and writes `out_dir/<name>.h5`.
 pub fn run_model(model: &Model, out_dir: &Path) -> Result<RunSummary, RunError> {
+    run_model_to(model, &out_dir.join(format!("{}.h5", model.name)))
+}
+
+/// Runs `model` and writes its results to `file` (parent directories are
+/// created).
+pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> {
     let built: Built = build(model)?;
+    let out_dir = file
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     std::fs::create_dir_all(out_dir).map_err(|source| RunError::OutputDir {
         dir: out_dir.to_path_buf(),
         source,
     })?;
-    let file = out_dir.join(format!("{}.h5", model.name));
+    let file = file.to_path_buf();
     let mech = &built.mechanism;
     let meta = RunMeta {
         model_text: model.source_text.clone(),
