@@ -61,14 +61,17 @@ impl Motion {
     }
 }
 
-/// Step-size control shared by the integrators: halve on failure (at most
-/// `max_halvings` times in a row, then a typed error), grow back towards the
-/// nominal step after four easy steps in a row.
+/// Step-size control shared by the integrators: halve on failure, grow back
+/// (doubling) towards the nominal step after four easy steps in a row. The
+/// step never goes below `nominal / 2^max_halvings`: a step that fails at
+/// that size ends the run with a typed error — so a run whose solution blows
+/// up stops instead of creeping on with ever smaller steps.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct StepControl {
     nominal: f64,
     step: f64,
-    halvings: usize,
+    /// Halvings below the nominal step now in force.
+    level: usize,
     easy: usize,
     max_halvings: usize,
 }
@@ -78,7 +81,7 @@ impl StepControl {
         Self {
             nominal: settings.dt,
             step: settings.dt,
-            halvings: 0,
+            level: 0,
             easy: 0,
             max_halvings: settings.max_halvings,
         }
@@ -91,26 +94,26 @@ impl StepControl {
 
     /// A step converged.
     pub(crate) fn succeeded(&mut self) {
-        self.halvings = 0;
         self.easy += 1;
-        if self.easy >= 4 && self.step < self.nominal {
-            self.step = (2.0 * self.step).min(self.nominal);
+        if self.easy >= 4 && self.level > 0 {
+            self.level -= 1;
+            self.step = self.nominal / f64::powi(2.0, self.level as i32);
             self.easy = 0;
         }
     }
 
     /// A step to `time` failed: halve, or give up with the reason.
     pub(crate) fn failed(&mut self, time: f64, reason: NewtonFailure) -> Result<(), SolveError> {
-        if self.halvings >= self.max_halvings {
+        if self.level >= self.max_halvings {
             return Err(SolveError::NoConvergence {
                 time,
-                halvings: self.halvings,
+                halvings: self.level,
                 reason,
             });
         }
-        self.halvings += 1;
+        self.level += 1;
         self.easy = 0;
-        self.step *= 0.5;
+        self.step = self.nominal / f64::powi(2.0, self.level as i32);
         Ok(())
     }
 }
