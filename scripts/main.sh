@@ -1,10 +1,16 @@
 #!/usr/bin/env bash
-# The main job: build flexmech (release) and solve every model in
-# data/benchmarks/, data/statics/ and data/dynamics/, writing one HDF5 result
-# file per model into results/
-# (or the directory given as the first argument).
+# The main job: build flexmech (release), reproduce the paper's examples
+# (data/paper, all three integrators) with their charts, and solve every other
+# model in data/benchmarks/, data/statics/ and data/dynamics/.
+#   results/<model>/<integrator>.h5   the paper's examples
+#   results/charts/*.png, *.svg       their figures
+#   results/summary.csv, summary.md   outcome, energy drift, step halvings
+#   results/models/<name>.h5          the other models
+# (or the directory given as the first argument instead of results/).
+set -e
 source "$(dirname "$0")/env.sh"
 OUT="${1:-results}"
 cargo build --release --bin flexmech
-./target/release/flexmech run data/benchmarks/*.toml data/statics/*.toml data/dynamics/*.toml --out "$OUT"
-echo "results written to $OUT/"
+./target/release/flexmech reproduce --out "$OUT"
+./target/release/flexmech run data/benchmarks/*.toml data/statics/*.toml data/dynamics/*.toml --out "$OUT/models"
+echo "results written to $OUT/ (figures in $OUT/charts/, summary in $OUT/summary.md)"

@@ -254,6 +254,40 @@ impl Topology {
         }
     }
 
+    /// The generalised reactions of the drivers for nodal residuals `g`
+    /// (through `Nᵀ`, deepest slaves first): for every joint, one value per
+    /// released coordinate (meaningful for the driven ones), and for every
+    /// prescribed nodal DOF the residual component it carries. Their products
+    /// with the drivers' increments are the drivers' work.
+    pub fn driver_reactions(
+        &self,
+        mech: &Mechanism,
+        state: &MechanismState,
+        g: &[f64],
+    ) -> (Vec<Vec<f64>>, Vec<f64>) {
+        let mut acc = g.to_vec();
+        let mut joints = vec![Vec::new(); mech.joints.len()];
+        for &j in self.order.iter().rev() {
+            let joint = &mech.joints[j];
+            let (m, s) = (joint.master, joint.slave);
+            let n =
+                joint
+                    .map
+                    .variation(&state.config.x[m], &state.config.rot[m], &state.released[j]);
+            let t = n.transpose() * Vector6::from_column_slice(&acc[6 * s..6 * s + 6]);
+            for d in 0..6 {
+                acc[6 * m + d] += t[d];
+            }
+            joints[j] = (0..joint.map.released_count()).map(|c| t[6 + c]).collect();
+        }
+        let prescribed = mech
+            .prescribed
+            .iter()
+            .map(|p| acc[6 * p.node + p.dof])
+            .collect();
+        (joints, prescribed)
+    }
+
     /// Applies a Newton increment: independent nodes, then released
     /// coordinates and the exact placement of every slave.
     pub fn apply(&self, mech: &Mechanism, state: &mut MechanismState, dq: &[f64]) {

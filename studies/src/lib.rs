@@ -4,8 +4,10 @@
 pub mod build;
 pub mod charts;
 pub mod model;
+pub mod reproduce;
 pub mod results;
 pub mod run;
+pub mod study;
 
 pub use build::{build, Built};
 pub use run::{run_model, run_model_to, RunError, RunSummary};

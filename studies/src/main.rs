@@ -4,6 +4,7 @@
 use clap::{Parser, Subcommand};
 use flexmech_studies::charts::plot_datasets;
 use flexmech_studies::model::load_model;
+use flexmech_studies::reproduce::{reproduce, ReproduceOptions};
 use flexmech_studies::run_model;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -30,6 +31,24 @@ enum Command {
         #[arg(long, short, default_value = "results")]
         out: PathBuf,
     },
+    /// Reproduce the paper's examples (data/paper) with all three integrators.
+    ///
+    /// Writes `<out>/<model>/<integrator>.h5` for every run, the charts
+    /// (PNG and SVG) into `<out>/charts/`, and `<out>/summary.csv` and
+    /// `<out>/summary.md` with each run's outcome, energy drift and step
+    /// halvings. A run that fails (Newmark in `screw_free`) is a result, not
+    /// an error.
+    Reproduce {
+        /// Output directory.
+        #[arg(long, short, default_value = "results")]
+        out: PathBuf,
+        /// Only these models (screw_free, screw_driven, rack_pinion, cam, lobe).
+        #[arg(long = "model")]
+        models: Vec<String>,
+        /// Factor on every model's end time (e.g. 0.2 for a quick look).
+        #[arg(long, default_value_t = 1.0)]
+        time_scale: f64,
+    },
     /// Draw line charts (PNG and SVG) of result datasets over /time.
     ///
     /// Writes `<out>/<dataset path with / as _>.png` (1600x1000 px) and `.svg`
@@ -47,6 +66,26 @@ enum Command {
         /// Logarithmic y axis (non-positive values are left out).
         #[arg(long)]
         log: bool,
+    },
+    /// Run a parameter study: a base model over a grid of key values.
+    ///
+    /// Writes `<out>/<name>/runs/<run id>.h5` per run, `summary.csv`,
+    /// `summary.h5` and `charts/<figure>.png/.svg` (see "Study files" in
+    /// MODEL_FORMAT.md). Without --shard, a Slurm array task runs the shard
+    /// SLURM_ARRAY_TASK_ID/_MIN/_COUNT select.
+    Study {
+        /// Study file (TOML).
+        study: PathBuf,
+        /// Output directory; the study writes to `<out>/<name>/`.
+        #[arg(long, short, default_value = "studies")]
+        out: PathBuf,
+        /// Run only shard K of N (runs with index % N == K-1) and write
+        /// summary-shard-K-of-N.csv/.h5.
+        #[arg(long, value_name = "K/N", conflicts_with = "merge")]
+        shard: Option<String>,
+        /// Merge the shard summaries into summary.csv/.h5 and the charts.
+        #[arg(long)]
+        merge: bool,
     },
 }
 
@@ -82,6 +121,48 @@ fn main() -> ExitCode {
                 ExitCode::SUCCESS
             }
         }
+        Command::Reproduce {
+            out,
+            models,
+            time_scale,
+        } => {
+            let options = ReproduceOptions {
+                out,
+                models,
+                time_scale,
+            };
+            match reproduce(&options) {
+                Ok(rep) => {
+                    for r in &rep.runs {
+                        let outcome = match r.failure_time {
+                            Some(t) => format!("failed at t = {t:.4} s"),
+                            None => "completed".to_string(),
+                        };
+                        println!(
+                            "{:13} {:16} {:28} energy drift {:.2e}, {} reduced steps -> {}",
+                            r.model,
+                            r.integrator,
+                            outcome,
+                            r.energy_drift(),
+                            r.reduced_steps(),
+                            r.file.display()
+                        );
+                    }
+                    println!(
+                        "{} charts in {}; summary in {} and {}",
+                        rep.charts.len(),
+                        options.out.join("charts").display(),
+                        rep.summary.0.display(),
+                        rep.summary.1.display()
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
         Command::Plot {
             result,
             datasets,
@@ -99,5 +180,46 @@ fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
+        Command::Study {
+            study,
+            out,
+            shard,
+            merge,
+        } => {
+            let slurm = flexmech_studies::study::SlurmArray::from_env();
+            let outcome = flexmech_studies::study::study_command(
+                &study,
+                &out,
+                shard.as_deref(),
+                merge,
+                &slurm,
+                true,
+            );
+            match outcome {
+                Ok(r) => {
+                    let what = match r.shard {
+                        Some(s) => format!("shard {s}"),
+                        None if merge => "merged".to_owned(),
+                        None => "all runs".to_owned(),
+                    };
+                    println!(
+                        "{}: {what}: {} run(s), {} failed -> {} and {}",
+                        study.display(),
+                        r.runs,
+                        r.failed,
+                        r.csv.display(),
+                        r.h5.display()
+                    );
+                    if !r.charts.is_empty() {
+                        println!("charts: {}", r.dir.join("charts").display());
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
     }
 }

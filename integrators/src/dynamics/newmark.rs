@@ -13,7 +13,7 @@
 //! screw example shows its energy growing until it fails.
 
 use super::midpoint::dynamic_record;
-use super::{increment_work, slave_velocities, DynamicSettings, Motion, StepControl};
+use super::{slave_velocities, DynamicSettings, Motion, StepControl};
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::SolveError;
@@ -279,9 +279,10 @@ pub fn solve(
     };
     on_step(&record(&state, &kin, &fext, 0.0, 0.0, None));
     let (mut t, mut control) = (0.0f64, StepControl::new(settings));
-    // The drivers' work, by the trapezoidal rule on the nodal residuals at
-    // both ends of each step (the first step uses its end value twice).
-    let (mut driver_work, mut g_prev): (f64, Option<Vec<f64>>) = (0.0, None);
+    // The drivers' work, by the trapezoidal rule on their reactions at both
+    // ends of each step (the first step uses its end value twice).
+    let mut driver_work = 0.0;
+    let mut r_prev: Option<(Vec<Vec<f64>>, Vec<f64>)> = None;
     while t < settings.t_end * (1.0 - 1e-12) {
         let dt = control.next(t, settings.t_end);
         let start = state.config.clone();
@@ -312,12 +313,10 @@ pub fn solve(
         };
         match newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq) {
             Ok(report) => {
-                let g_end = sys.nodal.clone();
-                let g_start = g_prev.as_deref().unwrap_or(&g_end);
-                driver_work += 0.5
-                    * (increment_work(&start, &sys.end.config, g_start, false)
-                        + increment_work(&start, &sys.end.config, &g_end, false));
-                g_prev = Some(g_end);
+                let r_end = sys.topo.driver_reactions(mech, &sys.end, &sys.nodal);
+                let r_start = r_prev.take().unwrap_or_else(|| r_end.clone());
+                driver_work += driver_increment_work(mech, &state, &sys.end, &r_start, &r_end);
+                r_prev = Some(r_end);
                 let end = sys.end;
                 let mut next = Kinematics {
                     v: Vec::new(),
@@ -356,4 +355,30 @@ pub fn solve(
         }
     }
     Ok(state.config)
+}
+
+/// The drivers' work over a step by the trapezoidal rule: the mean of the
+/// reactions at both ends ([`Topology::driver_reactions`]) times the driven
+/// coordinates' and prescribed DOFs' increments.
+fn driver_increment_work(
+    mech: &Mechanism,
+    start: &MechanismState,
+    end: &MechanismState,
+    r0: &(Vec<Vec<f64>>, Vec<f64>),
+    r1: &(Vec<Vec<f64>>, Vec<f64>),
+) -> f64 {
+    let mut w = 0.0;
+    for (j, joint) in mech.joints.iter().enumerate() {
+        for (c, d) in joint.driven.iter().enumerate() {
+            if d.is_some() {
+                let dq = end.released[j].q[c] - start.released[j].q[c];
+                w += 0.5 * (r0.0[j][c] + r1.0[j][c]) * dq;
+            }
+        }
+    }
+    for k in 0..mech.prescribed.len() {
+        let dv = end.prescribed[k] - start.prescribed[k];
+        w += 0.5 * (r0.1[k] + r1.1[k]) * dv;
+    }
+    w
 }

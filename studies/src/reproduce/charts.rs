@@ -1,0 +1,232 @@
+//! The reproduction's figures, drawn from the result files into `DIR/charts/`:
+//!
+//! * `fig6_screw_free_post_top_y` — paper Figure 6: Y displacement of the top
+//!   of the vertical beam, the three schemes, Newmark's failure time marked;
+//! * `fig8_screw_driven_tip_uz`, `fig9_screw_driven_tip_rotation_x` — paper
+//!   Figures 8–9: the driven screw's tip displacement `u_z` and rotation
+//!   about X;
+//! * per model: `<model>_energy` (total energy minus the drivers' work),
+//!   `<model>_energy_error` (its relative change, logarithmic),
+//!   `<model>_beta` (energy–momentum β), `<model>_dt` (step sizes) and
+//!   `<model>_joint` (released translation against the joint angle).
+
+use super::{ReproduceError, RunRecord, INTEGRATORS};
+use crate::charts::{LineChart, Series};
+use std::path::{Path, PathBuf};
+
+/// Legend names of the integrators.
+fn legend(integrator: &str) -> &'static str {
+    match integrator {
+        "newmark" => "Newmark (trapezoidal)",
+        "momentum" => "momentum conserving",
+        _ => "energy–momentum",
+    }
+}
+
+/// Reads a dataset (flattened) from a result file.
+fn read(file: &Path, name: &str) -> Result<Vec<f64>, ReproduceError> {
+    hdf5::File::open(file)
+        .and_then(|h| h.dataset(name)?.read_raw::<f64>())
+        .map_err(|e| ReproduceError::Read {
+            file: file.to_path_buf(),
+            message: format!("{name}: {e}"),
+        })
+}
+
+/// Component `c` of a T×3 dataset.
+fn column(file: &Path, name: &str, c: usize) -> Result<Vec<f64>, ReproduceError> {
+    Ok(read(file, name)?.chunks(3).map(|r| r[c]).collect())
+}
+
+/// The first joint's name in a result file.
+fn first_joint(file: &Path) -> Result<String, ReproduceError> {
+    let names = hdf5::File::open(file)
+        .and_then(|h| h.group("/joints")?.member_names())
+        .map_err(|e| ReproduceError::Read {
+            file: file.to_path_buf(),
+            message: format!("/joints: {e}"),
+        })?;
+    names.into_iter().next().ok_or(ReproduceError::Read {
+        file: file.to_path_buf(),
+        message: "no joint in /joints".into(),
+    })
+}
+
+/// Markers for the runs that failed: "<scheme> fails (t = …)".
+fn failure_markers(runs: &[&RunRecord]) -> Vec<(f64, String)> {
+    runs.iter()
+        .filter_map(|r| {
+            r.failure_time
+                .map(|t| (t, format!("{} fails (t = {t:.3} s)", legend(&r.integrator))))
+        })
+        .collect()
+}
+
+/// A time-series chart of one quantity for the three schemes of a model.
+fn scheme_chart(
+    runs: &[&RunRecord],
+    title: &str,
+    y_label: &str,
+    values: impl Fn(&RunRecord) -> Result<Vec<f64>, ReproduceError>,
+) -> Result<LineChart, ReproduceError> {
+    let mut chart = LineChart::new(title, "time (s)", y_label);
+    for r in runs {
+        chart.series.push(Series::new(
+            legend(&r.integrator),
+            r.time.clone(),
+            values(r)?,
+        ));
+    }
+    chart.markers = failure_markers(runs);
+    Ok(chart)
+}
+
+/// Draws every chart of the reproduction; returns the PNG paths.
+pub fn draw_all(records: &[RunRecord], out: &Path) -> Result<Vec<PathBuf>, ReproduceError> {
+    let dir = out.join("charts");
+    let mut written = Vec::new();
+    let mut models: Vec<&str> = records.iter().map(|r| r.model.as_str()).collect();
+    models.dedup();
+    for model in models {
+        let runs: Vec<&RunRecord> = INTEGRATORS
+            .iter()
+            .filter_map(|i| {
+                records
+                    .iter()
+                    .find(|r| r.model == model && r.integrator == *i)
+            })
+            .collect();
+        let mut draw = |name: String, chart: LineChart| -> Result<(), ReproduceError> {
+            let (png, _) = chart.render(&dir.join(name))?;
+            written.push(png);
+            Ok(())
+        };
+        if model == "screw_free" {
+            // A run that blew up is drawn until its energy error passes
+            // 1000 % (its last steps would set the scale); the marker shows
+            // where it failed.
+            let chart = scheme_chart(
+                &runs,
+                "Freely rotating screw joint: top of the vertical beam (paper Fig. 6)",
+                "Y displacement (m)",
+                |r| {
+                    let y = column(&r.file, "/nodes/post.end/displacement", 1)?;
+                    let b0 = r.balance.first().copied().unwrap_or(0.0);
+                    let mut blown = false;
+                    Ok(y.iter()
+                        .zip(&r.balance)
+                        .map(|(&y, b)| {
+                            blown |= (b - b0).abs() > 10.0 * r.energy_scale;
+                            if blown {
+                                f64::NAN
+                            } else {
+                                y
+                            }
+                        })
+                        .collect())
+                },
+            )?;
+            draw("fig6_screw_free_post_top_y".into(), chart)?;
+        }
+        if model == "screw_driven" {
+            let chart = scheme_chart(
+                &runs,
+                "Driven screw joint: tip displacement (paper Fig. 8)",
+                "out-of-plane displacement u_z (m)",
+                |r| column(&r.file, "/nodes/arm.end/displacement", 2),
+            )?;
+            draw("fig8_screw_driven_tip_uz".into(), chart)?;
+            let chart = scheme_chart(
+                &runs,
+                "Driven screw joint: tip rotation (paper Fig. 9)",
+                "rotation about X (rad)",
+                |r| column(&r.file, "/nodes/arm.end/rotation", 0),
+            )?;
+            draw("fig9_screw_driven_tip_rotation_x".into(), chart)?;
+        }
+        let energy_label = if model == "screw_free" {
+            "total energy (J)"
+        } else {
+            "total energy − work of the drive (J)"
+        };
+        let chart = scheme_chart(
+            &runs,
+            &format!("{model}: energy balance"),
+            energy_label,
+            |r| Ok(r.balance.clone()),
+        )?;
+        draw(format!("{model}_energy"), chart)?;
+        let mut chart = scheme_chart(
+            &runs,
+            &format!("{model}: relative energy error"),
+            "|E − E₀| / E_ref  (E_ref = E₀, or the drive's largest work)",
+            |r| {
+                let b0 = r.balance.first().copied().unwrap_or(0.0);
+                Ok(r.balance
+                    .iter()
+                    .map(|b| (b - b0).abs() / r.energy_scale)
+                    .collect())
+            },
+        )?;
+        chart.log_y = true;
+        draw(format!("{model}_energy_error"), chart)?;
+        let chart = scheme_chart(
+            &runs,
+            &format!("{model}: step size actually used"),
+            "Δt (s)",
+            |r| {
+                Ok(r.dt
+                    .iter()
+                    .map(|&d| if d > 0.0 { d } else { f64::NAN })
+                    .collect())
+            },
+        )?;
+        draw(format!("{model}_dt"), chart)?;
+        if let Some(em) = runs.iter().find(|r| r.integrator == "energy-momentum") {
+            if em.beta.iter().any(|b| b.is_finite()) {
+                let mut chart = LineChart::new(
+                    format!("{model}: energy–momentum correction"),
+                    "time (s)",
+                    "β",
+                );
+                chart.series.push(Series::new(
+                    "energy–momentum",
+                    em.time.clone(),
+                    em.beta.clone(),
+                ));
+                draw(format!("{model}_beta"), chart)?;
+            }
+        }
+        if let Some(first) = runs.first() {
+            let joint = first_joint(&first.file)?;
+            let mut chart = LineChart::new(
+                format!("{model}: joint `{joint}`"),
+                "joint angle ψ (rad)",
+                "released translation (m)",
+            );
+            for r in &runs {
+                let angle = read(&r.file, &format!("/joints/{joint}/angle"))?;
+                let rr = read(&r.file, &format!("/joints/{joint}/released_translation"))?;
+                // The component that moves most.
+                let c = (0..3)
+                    .max_by(|&a, &b| {
+                        let range = |c: usize| {
+                            let v = rr.chunks(3).map(|x| x[c]);
+                            v.clone().fold(f64::MIN, f64::max) - v.fold(f64::MAX, f64::min)
+                        };
+                        range(a).total_cmp(&range(b))
+                    })
+                    .unwrap_or(0);
+                let axis = ["x", "y", "z"][c];
+                chart.y_label = format!("released translation r_R,{axis} (m)");
+                chart.series.push(Series::new(
+                    legend(&r.integrator),
+                    angle,
+                    rr.chunks(3).map(|x| x[c]).collect(),
+                ));
+            }
+            draw(format!("{model}_joint"), chart)?;
+        }
+    }
+    Ok(written)
+}

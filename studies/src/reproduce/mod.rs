@@ -1,0 +1,153 @@
+//! `flexmech reproduce`: the paper's numerical examples (data/paper) with all
+//! three integrators, their result files and the paper's figures.
+//!
+//! Every model of [`PAPER_MODELS`] runs with `newmark`, `momentum` and
+//! `energy-momentum`, all runs in parallel (rayon), each writing
+//! `DIR/<model>/<integrator>.h5`. A run that fails (Newmark's energy blow-up
+//! in `screw_free`, paper §5.1) keeps its steps and is part of the result.
+//! Then [`charts`] draws the figures into `DIR/charts/` and [`summary`]
+//! writes the figures of merit (failure time, energy drift, step halvings)
+//! to `DIR/summary.csv` and `DIR/summary.md`.
+//!
+//! The model files are compiled into the program, so the command works from
+//! any directory; they are the files of `data/paper/`, byte for byte.
+
+pub mod charts;
+pub mod runs;
+pub mod summary;
+
+use std::path::{Path, PathBuf};
+
+pub use runs::{run_all, RunRecord};
+
+/// The paper's examples: `(name, path in the repository, model text)`.
+pub const PAPER_MODELS: [(&str, &str, &str); 5] = [
+    (
+        "screw_free",
+        "data/paper/screw_free.toml",
+        include_str!("../../../data/paper/screw_free.toml"),
+    ),
+    (
+        "screw_driven",
+        "data/paper/screw_driven.toml",
+        include_str!("../../../data/paper/screw_driven.toml"),
+    ),
+    (
+        "rack_pinion",
+        "data/paper/rack_pinion.toml",
+        include_str!("../../../data/paper/rack_pinion.toml"),
+    ),
+    (
+        "cam",
+        "data/paper/cam.toml",
+        include_str!("../../../data/paper/cam.toml"),
+    ),
+    (
+        "lobe",
+        "data/paper/lobe.toml",
+        include_str!("../../../data/paper/lobe.toml"),
+    ),
+];
+
+/// The integrators compared, in the order of the charts' legends.
+pub const INTEGRATORS: [&str; 3] = ["newmark", "momentum", "energy-momentum"];
+
+/// What to reproduce.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReproduceOptions {
+    /// Output directory.
+    pub out: PathBuf,
+    /// Models to run (names of [`PAPER_MODELS`]); empty: all.
+    pub models: Vec<String>,
+    /// Factor on every model's `t_end` (1: the full examples; smaller for a
+    /// quick look).
+    pub time_scale: f64,
+}
+
+impl ReproduceOptions {
+    /// All models, full length, into `out`.
+    pub fn full(out: impl Into<PathBuf>) -> Self {
+        Self {
+            out: out.into(),
+            models: Vec::new(),
+            time_scale: 1.0,
+        }
+    }
+}
+
+/// Why a reproduction could not be carried out (a run that fails is not an
+/// error: it is a result).
+#[derive(Debug, thiserror::Error)]
+pub enum ReproduceError {
+    /// A model name that is not one of the paper's examples.
+    #[error("unknown model `{name}`; the paper's examples are {known}")]
+    UnknownModel { name: String, known: String },
+    /// `time_scale` must be positive and finite.
+    #[error("the time scale must be positive and finite, found {0}")]
+    TimeScale(f64),
+    /// A run could not start (bad model, unwritable directory, HDF5 error).
+    #[error("{model} with {integrator}: {message}")]
+    Run {
+        model: String,
+        integrator: String,
+        message: String,
+    },
+    /// Reading a result file back failed.
+    #[error("reading {}: {message}", file.display())]
+    Read { file: PathBuf, message: String },
+    /// Drawing a chart failed.
+    #[error(transparent)]
+    Chart(#[from] crate::charts::ChartError),
+    /// Writing the summary failed.
+    #[error("writing {}: {source}", file.display())]
+    Write {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// Everything a reproduction produced.
+#[derive(Debug, Clone)]
+pub struct Reproduction {
+    /// One record per run, in model then integrator order.
+    pub runs: Vec<RunRecord>,
+    /// The charts written (PNG paths; an SVG sits next to each).
+    pub charts: Vec<PathBuf>,
+    /// `DIR/summary.csv` and `DIR/summary.md`.
+    pub summary: (PathBuf, PathBuf),
+}
+
+/// Runs the selected examples with every integrator, draws the charts and
+/// writes the summary.
+pub fn reproduce(options: &ReproduceOptions) -> Result<Reproduction, ReproduceError> {
+    if !(options.time_scale > 0.0 && options.time_scale.is_finite()) {
+        return Err(ReproduceError::TimeScale(options.time_scale));
+    }
+    let known: Vec<&str> = PAPER_MODELS.iter().map(|m| m.0).collect();
+    for name in &options.models {
+        if !known.contains(&name.as_str()) {
+            return Err(ReproduceError::UnknownModel {
+                name: name.clone(),
+                known: known.join(", "),
+            });
+        }
+    }
+    let selected: Vec<(&str, &str, &str)> = PAPER_MODELS
+        .iter()
+        .copied()
+        .filter(|m| options.models.is_empty() || options.models.iter().any(|n| n == m.0))
+        .collect();
+    let runs = run_all(&selected, &options.out, options.time_scale)?;
+    let charts = charts::draw_all(&runs, &options.out)?;
+    let summary = summary::write(&runs, &options.out)?;
+    Ok(Reproduction {
+        runs,
+        charts,
+        summary,
+    })
+}
+
+/// `DIR/<model>/<integrator>.h5`.
+pub fn result_path(out: &Path, model: &str, integrator: &str) -> PathBuf {
+    out.join(model).join(format!("{integrator}.h5"))
+}

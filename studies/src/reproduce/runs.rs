@@ -1,0 +1,205 @@
+//! The runs of a reproduction: every (model, integrator) pair in parallel,
+//! and what each left in its result file.
+
+use super::{result_path, ReproduceError, INTEGRATORS};
+use crate::model::parse_model;
+use crate::run::{run_model_to, RunError};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// One run of a reproduction, with the series the charts and the summary use.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunRecord {
+    /// Model name (`screw_free`, …).
+    pub model: String,
+    /// Integrator name (`newmark`, `momentum`, `energy-momentum`).
+    pub integrator: String,
+    /// The result file.
+    pub file: PathBuf,
+    /// `completed` or `failed: …`.
+    pub status: String,
+    /// Time of the last converged step when the run failed.
+    pub failure_time: Option<f64>,
+    /// Nominal step of the model.
+    pub nominal_dt: f64,
+    /// Stored times (the first row is t = 0).
+    pub time: Vec<f64>,
+    /// Total energy minus the drivers' work (the conserved quantity).
+    pub balance: Vec<f64>,
+    /// Step size actually used.
+    pub dt: Vec<f64>,
+    /// Newton iterations per step.
+    pub iterations: Vec<f64>,
+    /// Energy–momentum β (NaN for the other schemes).
+    pub beta: Vec<f64>,
+    /// Wall time of the solve, seconds.
+    pub wall_time_s: f64,
+    /// The scale energy errors are measured against: the larger of the
+    /// initial energy |E₀| and the largest |driver work| of the run.
+    pub energy_scale: f64,
+}
+
+impl RunRecord {
+    /// Largest `|B(t) − B(0)| / scale` of the balance `B = E − W_drivers`.
+    pub fn energy_drift(&self) -> f64 {
+        let b0 = self.balance.first().copied().unwrap_or(0.0);
+        let scale = self.energy_scale;
+        self.balance
+            .iter()
+            .map(|b| (b - b0).abs())
+            .fold(0.0, f64::max)
+            / scale
+    }
+
+    /// Steps taken with less than the nominal step (halvings in force); the
+    /// last step, which may be shortened to end at `t_end`, is not counted.
+    pub fn reduced_steps(&self) -> usize {
+        let n = self.dt.len();
+        self.dt
+            .iter()
+            .take(n.saturating_sub(1))
+            .skip(1)
+            .filter(|&&d| d < self.nominal_dt * (1.0 - 1e-9))
+            .count()
+    }
+
+    /// The smallest step used (the last, possibly shortened, step aside).
+    pub fn min_dt(&self) -> f64 {
+        let n = self.dt.len();
+        self.dt
+            .iter()
+            .take(n.saturating_sub(1))
+            .skip(1)
+            .fold(self.nominal_dt, |m, &d| m.min(d))
+    }
+}
+
+/// Runs every model of `models` with every integrator, in parallel.
+pub fn run_all(
+    models: &[(&str, &str, &str)],
+    out: &Path,
+    time_scale: f64,
+) -> Result<Vec<RunRecord>, ReproduceError> {
+    let jobs: Vec<(&str, &str, &str, &str)> = models
+        .iter()
+        .flat_map(|&(name, path, text)| INTEGRATORS.iter().map(move |&i| (name, path, text, i)))
+        .collect();
+    jobs.par_iter()
+        .map(|&(name, path, text, integrator)| {
+            run_one(name, path, text, integrator, out, time_scale)
+        })
+        .collect()
+}
+
+/// The model text with the integrator (and `t_end`, scaled) replaced, so the
+/// result file's stored model reproduces exactly this run.
+fn adapted_text(text: &str, integrator: &str, time_scale: f64) -> String {
+    text.lines()
+        .map(|line| {
+            let key = line.split('=').next().unwrap_or("").trim();
+            if key == "integrator" {
+                format!("integrator = \"{integrator}\"")
+            } else if key == "t_end" && time_scale != 1.0 {
+                let value: f64 = line
+                    .split('=')
+                    .nth(1)
+                    .and_then(|v| v.split('#').next())
+                    .and_then(|v| v.trim().parse().ok())
+                    .unwrap_or(0.0);
+                format!("t_end = {}", value * time_scale)
+            } else {
+                line.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+fn run_one(
+    name: &str,
+    path: &str,
+    text: &str,
+    integrator: &str,
+    out: &Path,
+    time_scale: f64,
+) -> Result<RunRecord, ReproduceError> {
+    let fail = |message: String| ReproduceError::Run {
+        model: name.to_string(),
+        integrator: integrator.to_string(),
+        message,
+    };
+    let model = parse_model(&adapted_text(text, integrator, time_scale), Path::new(path))
+        .map_err(|e| fail(e.to_string()))?;
+    let nominal_dt = match model.solver.analysis {
+        crate::model::Analysis::Dynamic { dt, .. } => dt,
+        crate::model::Analysis::Static { .. } => {
+            return Err(fail("the paper's examples are dynamic analyses".into()))
+        }
+    };
+    let file = result_path(out, name, integrator);
+    match run_model_to(&model, &file) {
+        Ok(_) | Err(RunError::Solve { .. }) => {}
+        Err(e) => return Err(fail(e.to_string())),
+    }
+    read_back(name, integrator, &file, nominal_dt)
+}
+
+/// Reads a run's series back from its result file.
+fn read_back(
+    model: &str,
+    integrator: &str,
+    file: &Path,
+    nominal_dt: f64,
+) -> Result<RunRecord, ReproduceError> {
+    let err = |message: String| ReproduceError::Read {
+        file: file.to_path_buf(),
+        message,
+    };
+    let h5 = hdf5::File::open(file).map_err(|e| err(e.to_string()))?;
+    let read = |name: &str| -> Result<Vec<f64>, ReproduceError> {
+        h5.dataset(name)
+            .and_then(|d| d.read_raw::<f64>())
+            .map_err(|e| err(format!("{name}: {e}")))
+    };
+    let time = read("/time")?;
+    let total = read("/energy/total")?;
+    let work = read("/energy/driver_work")?;
+    let status: String = h5
+        .attr("status")
+        .and_then(|a| a.read_scalar::<hdf5::types::VarLenUnicode>())
+        .map(|s| s.as_str().to_string())
+        .map_err(|e| err(format!("status: {e}")))?;
+    let wall_time_s: f64 = h5
+        .attr("wall_time_s")
+        .and_then(|a| a.read_scalar::<f64>())
+        .unwrap_or(f64::NAN);
+    let failure_time = status
+        .starts_with("failed")
+        .then(|| time.last().copied().unwrap_or(0.0));
+    let balance: Vec<f64> = total.iter().zip(&work).map(|(e, w)| e - w).collect();
+    let record = RunRecord {
+        model: model.to_string(),
+        integrator: integrator.to_string(),
+        file: file.to_path_buf(),
+        status,
+        failure_time,
+        nominal_dt,
+        dt: read("/solver/dt")?,
+        iterations: h5
+            .dataset("/solver/iterations")
+            .and_then(|d| d.read_raw::<u64>())
+            .map(|v| v.into_iter().map(|i| i as f64).collect())
+            .map_err(|e| err(format!("/solver/iterations: {e}")))?,
+        beta: read("/solver/beta")?,
+        time,
+        balance,
+        wall_time_s,
+        energy_scale: work
+            .iter()
+            .fold(total.first().map_or(0.0, |e| e.abs()), |m, v| {
+                m.max(v.abs())
+            })
+            .max(f64::MIN_POSITIVE),
+    };
+    Ok(record)
+}

@@ -1,0 +1,187 @@
+//! `flexmech reproduce`: the paper's qualitative claims, with numbers.
+//!
+//! * §5.1 (screw_free, full length): Newmark's energy grows until it fails
+//!   after successive step halvings; the momentum-conserving scheme runs
+//!   without a single step reduction; the energy–momentum scheme conserves
+//!   the energy to the solver tolerance.
+//! * The other examples (shortened to a fifth of their time): every run
+//!   completes, the energy–momentum scheme balances energy and the drive's
+//!   work to the solver tolerance, and every chart and the summary are there.
+
+use flexmech_studies::reproduce::{reproduce, ReproduceError, ReproduceOptions, INTEGRATORS};
+use std::path::Path;
+
+fn exists_with_svg(png: &Path) -> bool {
+    png.exists() && png.with_extension("svg").exists()
+}
+
+#[test]
+fn screw_free_shows_the_papers_claims() {
+    let dir = tempfile::tempdir().unwrap();
+    let options = ReproduceOptions {
+        out: dir.path().to_path_buf(),
+        models: vec!["screw_free".into()],
+        time_scale: 1.0,
+    };
+    let rep = reproduce(&options).unwrap();
+    assert_eq!(rep.runs.len(), 3);
+    let run = |i: &str| rep.runs.iter().find(|r| r.integrator == i).unwrap();
+    let (nm, mc, em) = (run("newmark"), run("momentum"), run("energy-momentum"));
+    for r in &rep.runs {
+        assert!(dir
+            .path()
+            .join("screw_free")
+            .join(format!("{}.h5", r.integrator))
+            .exists());
+        eprintln!(
+            "{}: {} t = {:.4}, energy drift {:.2e}, {} reduced steps, min dt {}",
+            r.integrator,
+            r.status,
+            r.time.last().unwrap(),
+            r.energy_drift(),
+            r.reduced_steps(),
+            r.min_dt()
+        );
+    }
+    // Newmark: energy blow-up, then failure after the step was halved down
+    // to nominal/2^8 (max_halvings = 8 in the model file).
+    let t_fail = nm.failure_time.expect("Newmark must fail");
+    assert!(t_fail > 1.0 && t_fail < 6.0, "failure at {t_fail}");
+    assert!(nm.status.contains("8 step halvings"), "{}", nm.status);
+    assert!(
+        nm.energy_drift() > 1.0,
+        "Newmark energy drift {}",
+        nm.energy_drift()
+    );
+    assert!((nm.min_dt() - 0.02 / 256.0).abs() < 1e-12);
+    // Before the blow-up Newmark's energy error is small: it *grows*.
+    let early = nm
+        .time
+        .iter()
+        .zip(&nm.balance)
+        .filter(|(t, _)| **t <= 2.0)
+        .map(|(_, b)| (b - nm.balance[0]).abs() / nm.energy_scale)
+        .fold(0.0, f64::max);
+    assert!(early < 1e-2, "Newmark's early energy error {early}");
+    // Momentum-conserving: to the end, never reducing the step.
+    assert!(mc.failure_time.is_none() && (mc.time.last().unwrap() - 6.0).abs() < 1e-9);
+    assert_eq!(mc.reduced_steps(), 0);
+    // Energy–momentum: to the end, energy to the solver tolerance (1e-10
+    // per step in the model file, 300 steps).
+    assert!(em.failure_time.is_none() && (em.time.last().unwrap() - 6.0).abs() < 1e-9);
+    assert!(em.energy_drift() <= 1e-9, "EM drift {}", em.energy_drift());
+    // The two conserving schemes agree (paper Figure 6): the post top's Y
+    // displacement at the end differs by less than 5 % of its range.
+    let y = |file: &Path| -> Vec<f64> {
+        let d: Vec<f64> = hdf5::File::open(file)
+            .unwrap()
+            .dataset("/nodes/post.end/displacement")
+            .unwrap()
+            .read_raw()
+            .unwrap();
+        d.chunks(3).map(|r| r[1]).collect()
+    };
+    let (ym, ye) = (y(&mc.file), y(&em.file));
+    let range = ym.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!((ym.last().unwrap() - ye.last().unwrap()).abs() <= 0.05 * range);
+    let charts = dir.path().join("charts");
+    for name in [
+        "fig6_screw_free_post_top_y",
+        "screw_free_energy",
+        "screw_free_energy_error",
+        "screw_free_dt",
+        "screw_free_beta",
+        "screw_free_joint",
+    ] {
+        assert!(
+            exists_with_svg(&charts.join(format!("{name}.png"))),
+            "{name}"
+        );
+    }
+    let summary = std::fs::read_to_string(&rep.summary.0).unwrap();
+    assert_eq!(summary.lines().count(), 4);
+    assert!(summary
+        .lines()
+        .any(|l| l.starts_with("screw_free,newmark,failed")));
+}
+
+#[test]
+fn driven_examples_run_and_balance_their_energy() {
+    let dir = tempfile::tempdir().unwrap();
+    let options = ReproduceOptions {
+        out: dir.path().to_path_buf(),
+        models: vec![
+            "screw_driven".into(),
+            "rack_pinion".into(),
+            "cam".into(),
+            "lobe".into(),
+        ],
+        time_scale: 0.2,
+    };
+    let rep = reproduce(&options).unwrap();
+    assert_eq!(rep.runs.len(), 12);
+    for r in &rep.runs {
+        assert!(
+            r.failure_time.is_none(),
+            "{} {}: {}",
+            r.model,
+            r.integrator,
+            r.status
+        );
+        assert!(r.file.ends_with(format!("{}/{}.h5", r.model, r.integrator)));
+        if r.integrator == "energy-momentum" {
+            assert!(
+                r.energy_drift() <= 1e-9,
+                "{}: {}",
+                r.model,
+                r.energy_drift()
+            );
+        }
+        // Every run has its contract datasets.
+        let h = hdf5::File::open(&r.file).unwrap();
+        for d in [
+            "/time",
+            "/energy/total",
+            "/energy/driver_work",
+            "/solver/beta",
+            "/solver/dt",
+        ] {
+            assert!(h.dataset(d).is_ok(), "{d}");
+        }
+    }
+    let charts = dir.path().join("charts");
+    assert!(exists_with_svg(
+        &charts.join("fig8_screw_driven_tip_uz.png")
+    ));
+    assert!(exists_with_svg(
+        &charts.join("fig9_screw_driven_tip_rotation_x.png")
+    ));
+    for model in ["screw_driven", "rack_pinion", "cam", "lobe"] {
+        for kind in ["energy", "energy_error", "dt", "joint"] {
+            let png = charts.join(format!("{model}_{kind}.png"));
+            assert!(exists_with_svg(&png), "{}", png.display());
+        }
+    }
+    let summary = std::fs::read_to_string(&rep.summary.0).unwrap();
+    assert_eq!(summary.lines().count(), 1 + 4 * INTEGRATORS.len());
+}
+
+#[test]
+fn unknown_models_and_bad_scales_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut options = ReproduceOptions::full(dir.path());
+    options.models = vec!["screw_fre".into()];
+    match reproduce(&options) {
+        Err(ReproduceError::UnknownModel { name, known }) => {
+            assert_eq!(name, "screw_fre");
+            assert!(known.contains("screw_free"));
+        }
+        other => panic!("{other:?}"),
+    }
+    options.models.clear();
+    options.time_scale = 0.0;
+    assert!(matches!(
+        reproduce(&options),
+        Err(ReproduceError::TimeScale(_))
+    ));
+}
