@@ -37,7 +37,7 @@ pub fn write(runs: &[RunRecord], out: &Path) -> Result<(PathBuf, PathBuf), Repro
         );
         let outcome = match r.failure_time {
             Some(t) => format!("fails at t = {t:.4} s"),
-            None => format!("completed (t = {t_reached} s)"),
+            None => format!("completed (t = {t_reached:.3} s)"),
         };
         let _ = writeln!(
             md,
