@@ -10,7 +10,7 @@
 use crate::dofs::DofMap;
 use faer::sparse::SymbolicSparseColMat;
 use flexmech_core::{Configuration, Element, Mesh};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Matrix3};
 use rayon::prelude::*;
 
 struct Slots {
@@ -189,6 +189,27 @@ impl Assembler {
     pub fn add_block(&mut self, b: usize, m: &DMatrix<f64>) {
         for (&p, &v) in self.blocks[b].pos.iter().zip(m.as_slice()) {
             self.values[p] += v;
+        }
+    }
+
+    /// Adds the 3×3 block `k` — rows: components `ri..ri+3` of node `i`'s
+    /// increment, columns: `cj..cj+3` of node `j`'s — to the tangent through
+    /// the node maps (`T_iᵀ k T_j`, e.g. a mass or inertia block).
+    pub fn add_node_block(
+        &mut self,
+        dofs: &DofMap,
+        (i, ri): (usize, usize),
+        (j, cj): (usize, usize),
+        k: &Matrix3<f64>,
+    ) {
+        let (mi, mj) = (&dofs.nodes[i], &dofs.nodes[j]);
+        for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
+            for (ej, cjv) in mj.eqs.iter().zip(&mj.cols) {
+                let v = ci.fixed_rows::<3>(ri).dot(&(k * cjv.fixed_rows::<3>(cj)));
+                if v != 0.0 {
+                    self.add_entry(*ei, *ej, v);
+                }
+            }
         }
     }
 

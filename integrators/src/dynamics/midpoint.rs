@@ -211,20 +211,6 @@ impl MidpointStep<'_> {
         self.topo
             .reduce_incremental(self.mech, self.start, &self.end, g, out);
     }
-
-    /// Adds `k` between components `ri..ri+3` of node `i` and `cj..cj+3` of
-    /// node `j` to the tangent through the node maps.
-    fn add_block(&mut self, i: usize, ri: usize, j: usize, cj: usize, k: &Matrix3<f64>) {
-        let (mi, mj) = (&self.topo.dofs.nodes[i], &self.topo.dofs.nodes[j]);
-        for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
-            for (ej, cjv) in mj.eqs.iter().zip(&mj.cols) {
-                let v = ci.fixed_rows::<3>(ri).dot(&(k * cjv.fixed_rows::<3>(cj)));
-                if v != 0.0 {
-                    self.asm.add_entry(*ei, *ej, v);
-                }
-            }
-        }
-    }
 }
 
 impl NewtonSystem for MidpointStep<'_> {
@@ -253,7 +239,12 @@ impl NewtonSystem for MidpointStep<'_> {
                 self.nodal[6 * i + c] += m * dv[c] / dt;
                 self.inertia_abs[6 * i + c] += (m * dv[c] / dt).abs();
             }
-            self.add_block(i, 0, j, 0, &(Matrix3::identity() * (2.0 * m / (dt * dt))));
+            self.asm.add_node_block(
+                &self.topo.dofs,
+                (i, 0),
+                (j, 0),
+                &(Matrix3::identity() * (2.0 * m / (dt * dt))),
+            );
         }
         // Rotational inertia, node by node.
         for i in 0..self.inertia.rotational.len() {
@@ -272,7 +263,7 @@ impl NewtonSystem for MidpointStep<'_> {
                 self.nodal[6 * i + 3 + c] += m[c];
                 self.inertia_abs[6 * i + 3 + c] += m[c].abs();
             }
-            self.add_block(i, 3, i, 3, &k);
+            self.asm.add_node_block(&self.topo.dofs, (i, 3), (i, 3), &k);
         }
         self.reduce_residual(&self.nodal, r);
         if !self.mech.joints.is_empty() {

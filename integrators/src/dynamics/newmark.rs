@@ -68,22 +68,6 @@ struct NewmarkStep<'a> {
     floor: f64,
 }
 
-impl NewmarkStep<'_> {
-    /// Adds the 3×3 block `k` (rows: component `ri..ri+3` of node `i`; columns:
-    /// `cj..cj+3` of node `j`) to the tangent through the node maps.
-    fn add_block(&mut self, i: usize, ri: usize, j: usize, cj: usize, k: &Matrix3<f64>) {
-        let (mi, mj) = (&self.topo.dofs.nodes[i], &self.topo.dofs.nodes[j]);
-        for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
-            for (ej, cjv) in mj.eqs.iter().zip(&mj.cols) {
-                let v = ci.fixed_rows::<3>(ri).dot(&(k * cjv.fixed_rows::<3>(cj)));
-                if v != 0.0 {
-                    self.asm.add_entry(*ei, *ej, v);
-                }
-            }
-        }
-    }
-}
-
 impl NewtonSystem for NewmarkStep<'_> {
     fn evaluate(&mut self, r: &mut [f64]) -> f64 {
         self.topo.refresh(self.mech, &self.end);
@@ -107,7 +91,12 @@ impl NewtonSystem for NewmarkStep<'_> {
                 self.nodal[6 * i + c] += m * a1[c];
                 self.abs[6 * i + c] += (m * a1[c]).abs();
             }
-            self.add_block(i, 0, j, 0, &(Matrix3::identity() * (m / (BETA * dt * dt))));
+            self.asm.add_node_block(
+                &self.topo.dofs,
+                (i, 0),
+                (j, 0),
+                &(Matrix3::identity() * (m / (BETA * dt * dt))),
+            );
         }
         // Rotational inertia Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), by AD in a spin of Rₙ₊₁.
         type D = DualSVec64<3>;
@@ -133,7 +122,7 @@ impl NewtonSystem for NewmarkStep<'_> {
                 self.abs[6 * i + 3 + c] += m[c].re.abs();
                 k.set_row(c, &m[c].eps.unwrap_generic(Const::<3>, U1).transpose());
             }
-            self.add_block(i, 3, i, 3, &k);
+            self.asm.add_node_block(&self.topo.dofs, (i, 3), (i, 3), &k);
         }
         self.topo.dofs.reduce(&self.nodal, r);
         // Joints: the derivative of Nᵀg with the slave's full residual
@@ -187,23 +176,12 @@ fn initial_accelerations(
     let nodes = mech.mesh.node_count();
     let zero = (vec![Vector3::zeros(); nodes], vec![Vector3::zeros(); nodes]);
     asm.values.iter_mut().for_each(|v| *v = 0.0);
-    let mut add = |i: usize, ri: usize, j: usize, cj: usize, k: &Matrix3<f64>| {
-        let (mi, mj) = (&topo.dofs.nodes[i], &topo.dofs.nodes[j]);
-        for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
-            for (ej, cjv) in mj.eqs.iter().zip(&mj.cols) {
-                let v = ci.fixed_rows::<3>(ri).dot(&(k * cjv.fixed_rows::<3>(cj)));
-                if v != 0.0 {
-                    asm.add_entry(*ei, *ej, v);
-                }
-            }
-        }
-    };
     for &(i, j, m) in &inertia.mass {
-        add(i, 0, j, 0, &(Matrix3::identity() * m));
+        asm.add_node_block(&topo.dofs, (i, 0), (j, 0), &(Matrix3::identity() * m));
     }
     for (i, j0) in inertia.rotational.iter().enumerate() {
         let r = state.config.rot[i];
-        add(i, 3, i, 3, &(r * j0 * r.transpose()));
+        asm.add_node_block(&topo.dofs, (i, 3), (i, 3), &(r * j0 * r.transpose()));
     }
     let mut q = vec![0.0; topo.dofs.n_eq];
     topo.dofs.reduce(residual, &mut q);
