@@ -53,6 +53,13 @@ impl DofMap {
         m.eqs.iter().zip(&m.cols).map(|(&e, c)| c * dq[e]).sum()
     }
 
+    /// `‖Σₙ Tₙᵀ gₙ‖`, reduced into `scratch` (length `n_eq`): the size of
+    /// nodal forces `g` as the unknowns see them (residual scales).
+    pub fn reduced_norm(&self, g: &[f64], scratch: &mut [f64]) -> f64 {
+        self.reduce(g, scratch);
+        scratch.iter().map(|x| x * x).sum::<f64>().sqrt()
+    }
+
     /// Reduced residual `Σₙ Tₙᵀ gₙ` from nodal residuals `g` (6 per node).
     pub fn reduce(&self, g: &[f64], out: &mut [f64]) {
         out.iter_mut().for_each(|v| *v = 0.0);

@@ -69,12 +69,9 @@ impl NewtonSystem for StaticProblem<'_> {
         {
             self.asm.add_block(b, block);
         }
-        self.topo.dofs.reduce(&self.fext, &mut self.scratch);
-        let f_ext = norm(&self.scratch);
-        self.topo
-            .dofs
-            .reduce(&self.asm.nodal_abs, &mut self.scratch);
-        f_ext.max(norm(&self.scratch))
+        let dofs = &self.topo.dofs;
+        let f_ext = dofs.reduced_norm(&self.fext, &mut self.scratch);
+        f_ext.max(dofs.reduced_norm(&self.asm.nodal_abs, &mut self.scratch))
     }
 
     fn tangent_values(&self) -> &[f64] {
@@ -88,10 +85,6 @@ impl NewtonSystem for StaticProblem<'_> {
     fn floor(&self) -> f64 {
         self.floor
     }
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// Strain energy of the whole mesh (element energies summed in element order).

@@ -276,13 +276,12 @@ impl NewtonSystem for MidpointStep<'_> {
                 self.asm.add_block(b, block);
             }
         }
-        self.topo.dofs.reduce(&self.fext, &mut self.scratch);
-        let f_ext = norm(&self.scratch);
         for (a, b) in self.inertia_abs.iter_mut().zip(&self.asm.nodal_abs) {
             *a += b;
         }
-        self.topo.dofs.reduce(&self.inertia_abs, &mut self.scratch);
-        f_ext.max(norm(&self.scratch))
+        let dofs = &self.topo.dofs;
+        let f_ext = dofs.reduced_norm(&self.fext, &mut self.scratch);
+        f_ext.max(dofs.reduced_norm(&self.inertia_abs, &mut self.scratch))
     }
 
     fn tangent_values(&self) -> &[f64] {
@@ -296,10 +295,6 @@ impl NewtonSystem for MidpointStep<'_> {
     fn floor(&self) -> f64 {
         self.floor
     }
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// Runs a midpoint scheme from `initial` over `[0, t_end]`, reporting a record

@@ -133,10 +133,9 @@ impl NewtonSystem for NewmarkStep<'_> {
         for (b, block) in blocks.iter().enumerate() {
             self.asm.add_block(b, block);
         }
-        self.topo.dofs.reduce(&self.fext, &mut self.scratch);
-        let f_ext = norm(&self.scratch);
-        self.topo.dofs.reduce(&self.abs, &mut self.scratch);
-        f_ext.max(norm(&self.scratch))
+        let dofs = &self.topo.dofs;
+        let f_ext = dofs.reduced_norm(&self.fext, &mut self.scratch);
+        f_ext.max(dofs.reduced_norm(&self.abs, &mut self.scratch))
     }
 
     fn tangent_values(&self) -> &[f64] {
@@ -150,10 +149,6 @@ impl NewtonSystem for NewmarkStep<'_> {
     fn floor(&self) -> f64 {
         self.floor
     }
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// Initial accelerations from the reduced equations of motion at t = 0,
