@@ -78,7 +78,7 @@ impl<const N: usize> BeamElement<N> {
     }
 
     /// Nodal triads `Λᵢ = Rᵢ Λ₀ᵢ`.
-    fn triads<T: Scalar>(&self, rot: &[Matrix3<T>; N]) -> [Matrix3<T>; N] {
+    pub(crate) fn triads<T: Scalar>(&self, rot: &[Matrix3<T>; N]) -> [Matrix3<T>; N] {
         std::array::from_fn(|i| rot[i] * self.lambda0[i].map(cst::<T>))
     }
 

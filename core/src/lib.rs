@@ -7,6 +7,7 @@ pub mod scalar;
 
 pub use scalar::{cst, Scalar};
 pub mod conserving;
+pub mod discrete_gradient;
 pub mod element;
 pub mod inertia;
 pub mod section;

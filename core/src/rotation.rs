@@ -15,7 +15,7 @@ use crate::scalar::{cst, Scalar};
 use nalgebra::{Matrix3, Vector3, Vector4};
 
 /// Below this `|ψ|²` the series branches are used.
-const SERIES_LIMIT: f64 = 1e-2;
+pub(crate) const SERIES_LIMIT: f64 = 1e-2;
 
 /// `â`: the skew-symmetric matrix with `â w = a × w`.
 #[inline]
@@ -37,7 +37,7 @@ pub fn vee<T: Scalar>(m: &Matrix3<T>) -> Vector3<T> {
 
 /// Evaluates `Σ_k c_k x^k` (Horner) for a short series in `x = |ψ|²`.
 #[inline]
-fn series<T: Scalar>(x: T, c: &[f64]) -> T {
+pub(crate) fn series<T: Scalar>(x: T, c: &[f64]) -> T {
     let mut acc = cst::<T>(c[c.len() - 1]);
     for &ck in c.iter().rev().skip(1) {
         acc = acc * x + cst::<T>(ck);

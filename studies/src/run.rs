@@ -5,7 +5,9 @@
 use crate::build::{build, Built};
 use crate::model::{Analysis, IntegratorKind, MassKind, Model, ModelError};
 use crate::results::{layout, ResultError, ResultWriter, RunMeta};
-use flexmech_integrators::dynamics::{energy_momentum, momentum, newmark, DynamicSettings};
+use flexmech_integrators::dynamics::{
+    energy_momentum, energy_momentum_paper, momentum, newmark, DynamicSettings,
+};
 use flexmech_integrators::{solve_static, NewtonSettings, SolveError, StaticSettings, StepRecord};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -171,6 +173,9 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
                 IntegratorKind::Momentum => momentum::solve(mech, &settings, &built.motion, push),
                 IntegratorKind::EnergyMomentum => {
                     energy_momentum::solve(mech, &settings, &built.motion, push)
+                }
+                IntegratorKind::EnergyMomentumPaper => {
+                    energy_momentum_paper::solve(mech, &settings, &built.motion, push)
                 }
             }
             .map(|_| ())

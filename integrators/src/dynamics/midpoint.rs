@@ -20,6 +20,7 @@
 //! properties depend on — is that of `Ñᵀ g = 0`. Beams without joints have
 //! the exact tangent.
 
+pub use super::Scheme;
 use super::{increment_work, slave_velocities};
 use super::{DynamicSettings, Motion, StepControl};
 use crate::assembly::Assembler;
@@ -106,26 +107,34 @@ pub(super) fn midpoint_forces(
     correction: bool,
 ) -> (SVector<Dual12, 12>, Option<SVector<Dual12, 12>>) {
     type D = Dual12;
-    let (n0, m0) = e.resultants(&s.0, &s.1);
-    let (n1, m1) = e.resultants(&ed.0, &ed.1);
-    let half = D::from_re(0.5);
-    let nbar = (n0.map(D::from_re) + n1) * half;
-    let mbar = (m0.map(D::from_re) + m1) * half;
+    let (nbar, mbar) = averaged_resultants(e, s, ed);
     let qk = e.midpoint_force(sd, ed, &nbar, &mbar, mid);
-    let qd = correction
-        .then(|| e.midpoint_force(sd, ed, &(n1 - n0.map(D::from_re)), &Vector3::zeros(), mid));
+    // N_d = Nₙ₊₁ − Nₙ = 2(Nₙ₊½ − Nₙ).
+    let n0 = e.resultants(&s.0, &s.1).0.map(D::from_re);
+    let qd = correction.then(|| {
+        e.midpoint_force(
+            sd,
+            ed,
+            &((nbar - n0) * D::from_re(2.0)),
+            &Vector3::zeros(),
+            mid,
+        )
+    });
     (qk, qd)
 }
 
-/// Element kernel of the midpoint schemes: `q_k(Nₙ₊½, Mₙ₊½)` (plus
-/// `β q_k(N_d, 0)` for the energy–momentum scheme) and its
-/// derivative with respect to spatial increments of the end pose
-/// (`x ← x + η`, `R ← exp(η̂)R`), by forward-mode AD.
+/// Element kernel of the midpoint schemes: the scheme's internal force
+/// (`q_k(Nₙ₊½, Mₙ₊½)` with the geodesic mid rotation for the momentum
+/// scheme; the energy-consistent discrete gradient for the energy–momentum
+/// scheme; `q_k(Nₙ₊½, Mₙ₊½) + β q_k(N_d, 0)` with the algebraic mid rotation
+/// for the paper's energy–momentum scheme) and its derivative with respect
+/// to spatial increments of the end pose (`x ← x + η`, `R ← exp(η̂)R`), by
+/// forward-mode AD.
 fn element_kernel(
     el: &Element,
     start: &Configuration,
     end: &Configuration,
-    mid: MidRotation,
+    scheme: Scheme,
     beta: f64,
     r: &mut [f64],
     k: &mut [f64],
@@ -135,16 +144,68 @@ fn element_kernel(
     };
     type D = Dual12;
     let (s, sd, ed) = seeded_poses(e, start, end);
-    let (mut q, qd) = midpoint_forces(e, &s, &sd, &ed, mid, beta != 0.0);
-    if let Some(qd) = qd {
-        q += qd * D::from_re(beta);
-    }
+    let q = match scheme {
+        Scheme::EnergyMomentum => {
+            let (nbar, mbar) = averaged_resultants(e, &s, &ed);
+            e.discrete_gradient_force(&sd, &ed, &nbar, &mbar)
+        }
+        Scheme::Momentum | Scheme::EnergyMomentumPaper => {
+            let (mut q, qd) = midpoint_forces(e, &s, &sd, &ed, scheme.mid_rotation(), beta != 0.0);
+            if let Some(qd) = qd {
+                q += qd * D::from_re(beta);
+            }
+            q
+        }
+    };
     for i in 0..12 {
         r[i] = q[i].re;
         let row = q[i].eps.unwrap_generic(Const::<12>, U1);
         for j in 0..12 {
             k[j * 12 + i] = row[j];
         }
+    }
+}
+
+/// The step averages `(Nₙ₊½, Mₙ₊½)` of an element's material resultants,
+/// the end seeded (see [`seeded_poses`]).
+fn averaged_resultants(
+    e: &BeamElement<2>,
+    s: &Pose<f64>,
+    ed: &Pose<Dual12>,
+) -> (Vector3<Dual12>, Vector3<Dual12>) {
+    type D = Dual12;
+    let (n0, m0) = e.resultants(&s.0, &s.1);
+    let (n1, m1) = e.resultants(&ed.0, &ed.1);
+    let half = D::from_re(0.5);
+    (
+        (n0.map(D::from_re) + n1) * half,
+        (m0.map(D::from_re) + m1) * half,
+    )
+}
+
+/// The energy–momentum scheme's consistency measure of a converged step:
+/// the largest size, over the elements, of the rank-one corrections of the
+/// discrete gradient relative to the largest element force. `O(Δt²)`.
+pub fn correction_size(mech: &Mechanism, start: &Configuration, end: &Configuration) -> f64 {
+    let (mut corr, mut size) = (0.0f64, 0.0f64);
+    for el in &mech.mesh.elements {
+        let Element::Linear(e) = el else { continue };
+        let n = e.nodes;
+        let s: Pose<f64> = (
+            [start.x[n[0]], start.x[n[1]]],
+            [start.rot[n[0]], start.rot[n[1]]],
+        );
+        let t: Pose<f64> = ([end.x[n[0]], end.x[n[1]]], [end.rot[n[0]], end.rot[n[1]]]);
+        let (n0, m0) = e.resultants(&s.0, &s.1);
+        let (n1, m1) = e.resultants(&t.0, &t.1);
+        let (q, c) = e.discrete_gradient_parts(&s, &t, &((n0 + n1) * 0.5), &((m0 + m1) * 0.5));
+        corr = corr.max(c.norm());
+        size = size.max(q.norm());
+    }
+    if size > 0.0 {
+        corr / size
+    } else {
+        0.0
     }
 }
 
@@ -192,8 +253,8 @@ pub struct MidpointStep<'a> {
     /// The current iterate of the state at `tₙ₊₁` (slaves placed exactly).
     pub end: MechanismState,
     pub dt: f64,
-    pub mid: MidRotation,
-    /// Energy–momentum β (0 for the momentum scheme).
+    pub scheme: Scheme,
+    /// The paper's energy–momentum β (0 for the other schemes).
     pub beta: f64,
     /// External nodal forces at `tₙ₊½`.
     pub fext: Vec<f64>,
@@ -216,10 +277,11 @@ impl MidpointStep<'_> {
 impl NewtonSystem for MidpointStep<'_> {
     fn evaluate(&mut self, r: &mut [f64]) -> f64 {
         self.topo.refresh(self.mech, &self.end);
-        let (start, end, mid, beta) = (&self.start.config, &self.end.config, self.mid, self.beta);
+        let (start, end) = (&self.start.config, &self.end.config);
+        let (scheme, beta) = (self.scheme, self.beta);
         self.asm
             .assemble_with(&self.mech.mesh, &self.topo.dofs, |el, _, re, ke| {
-                element_kernel(el, start, end, mid, beta, re, ke)
+                element_kernel(el, start, end, scheme, beta, re, ke)
             });
         let dt = self.dt;
         for (g, (fi, fe)) in self
@@ -305,7 +367,7 @@ pub fn solve(
     mech: &Mechanism,
     settings: &DynamicSettings,
     initial: &Motion,
-    mid: MidRotation,
+    scheme: Scheme,
     mut on_step: impl FnMut(&StepRecord),
 ) -> Result<Configuration, SolveError> {
     if mech
@@ -391,7 +453,7 @@ pub fn solve(
             w_n: &w,
             end,
             dt,
-            mid,
+            scheme,
             beta: 0.0,
             fext: fmid,
             nodal: vec![0.0; 6 * nodes],
@@ -399,13 +461,17 @@ pub fn solve(
             scratch: vec![0.0; n_eq],
             floor: mech.round_off_floor(),
         };
-        let outcome = match mid {
-            MidRotation::Geodesic => {
-                newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq)
-                    .map(|rep| (rep, f64::NAN))
+        let outcome = match scheme {
+            Scheme::Momentum => newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq)
+                .map(|rep| (rep, f64::NAN)),
+            Scheme::EnergyMomentum => {
+                newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq).map(|rep| {
+                    let size = correction_size(mech, &sys.start.config, &sys.end.config);
+                    (rep, size)
+                })
             }
-            MidRotation::Algebraic => {
-                super::energy_momentum::solve_step(&mut sys, &mut lu, &settings.newton)
+            Scheme::EnergyMomentumPaper => {
+                super::energy_momentum_paper::solve_step(&mut sys, &mut lu, &settings.newton)
             }
         };
         match outcome {

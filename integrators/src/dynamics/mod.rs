@@ -6,10 +6,16 @@
 //! * [`newmark`]: the trapezoidal rule on SO(3) (Simo & Vu-Quoc).
 //! * [`momentum`]: the midpoint scheme with the geodesic mid rotation —
 //!   conserves linear and angular momentum exactly.
-//! * [`energy_momentum`]: the algebraic mid rotation and the β correction —
-//!   conserves momenta and the total energy of conservative systems.
+//! * [`energy_momentum`]: the energy-consistent discrete gradient of the
+//!   element energy — conserves momenta and the total energy of
+//!   conservative systems, and is consistent (no correction that grows as
+//!   the step shrinks).
+//! * [`energy_momentum_paper`]: the paper's energy–momentum scheme, the
+//!   algebraic mid rotation and the scalar correction `β q_k(N_d, 0)`, kept
+//!   to reproduce the paper.
 
 pub mod energy_momentum;
+pub mod energy_momentum_paper;
 pub mod midpoint;
 pub mod momentum;
 pub mod newmark;
@@ -22,6 +28,29 @@ use flexmech_core::MassKind;
 use flexmech_joints::LOCAL;
 use nalgebra::Vector3;
 use nalgebra::{SVector, Vector6};
+
+/// The midpoint (conserving) schemes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scheme {
+    /// Geodesic mid rotation, paper eq. 17: momenta conserved.
+    Momentum,
+    /// Discrete gradient of the element energy: momenta and energy conserved.
+    EnergyMomentum,
+    /// The paper's eqs 17–20 (algebraic mid rotation and β): momenta and
+    /// energy conserved, β growing as `Δt → 0`.
+    EnergyMomentumPaper,
+}
+
+impl Scheme {
+    /// The mid rotation of the paper's force `q_k` in this scheme.
+    pub fn mid_rotation(self) -> flexmech_core::conserving::MidRotation {
+        use flexmech_core::conserving::MidRotation;
+        match self {
+            Scheme::Momentum => MidRotation::Geodesic,
+            Scheme::EnergyMomentum | Scheme::EnergyMomentumPaper => MidRotation::Algebraic,
+        }
+    }
+}
 
 /// Settings of a dynamic analysis.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -6,11 +6,10 @@
 //! Newton tolerance; energy is not conserved exactly (it is in the
 //! energy–momentum scheme).
 
-use super::{midpoint, DynamicSettings, Motion};
+use super::{midpoint, DynamicSettings, Motion, Scheme};
 use crate::error::SolveError;
 use crate::mechanism::Mechanism;
 use crate::record::StepRecord;
-use flexmech_core::conserving::MidRotation;
 use flexmech_core::Configuration;
 
 /// Integrates `mech` from `initial` with the momentum-conserving scheme.
@@ -20,5 +19,5 @@ pub fn solve(
     initial: &Motion,
     on_step: impl FnMut(&StepRecord),
 ) -> Result<Configuration, SolveError> {
-    midpoint::solve(mech, settings, initial, MidRotation::Geodesic, on_step)
+    midpoint::solve(mech, settings, initial, Scheme::Momentum, on_step)
 }

@@ -187,6 +187,8 @@ pub enum IntegratorKind {
     Newmark,
     Momentum,
     EnergyMomentum,
+    /// The paper's energy–momentum scheme (eqs 17–20, scalar β).
+    EnergyMomentumPaper,
 }
 
 impl IntegratorKind {
@@ -196,6 +198,7 @@ impl IntegratorKind {
             IntegratorKind::Newmark => "newmark",
             IntegratorKind::Momentum => "momentum",
             IntegratorKind::EnergyMomentum => "energy-momentum",
+            IntegratorKind::EnergyMomentumPaper => "energy-momentum-paper",
         }
     }
 }

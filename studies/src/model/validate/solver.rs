@@ -44,6 +44,7 @@ impl Ctx<'_> {
                 IntegratorKind::Newmark,
                 IntegratorKind::Momentum,
                 IntegratorKind::EnergyMomentum,
+                IntegratorKind::EnergyMomentumPaper,
             ];
             let names = quoted_list(integrators.iter().map(|i| i.name()));
             let int_s = self.need(
