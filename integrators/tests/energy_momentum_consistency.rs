@@ -149,4 +149,3 @@ fn the_papers_beta_does_not_vanish_as_the_step_is_refined() {
     // (measured 0.37, 0.64, 0.30).
     assert!(betas[2] >= 0.25 * betas[0] && betas[2] > 0.1, "β {betas:?}");
 }
-

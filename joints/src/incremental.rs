@@ -1,6 +1,6 @@
 //! Exact incremental relations of a joint over a time step, for the
 //! momentum- and energy–momentum-conserving schemes (paper eqs 21–23,
-//! FORMULATION §4 "Joints in the conserving schemes").
+//! FORMULATION §4.4 "Joints in the conserving schemes").
 //!
 //! Over a step `n → n+1` the slave's increments `p_s = (u_s, θ_s)` — the
 //! displacement and the tangent-scaled rotation increment

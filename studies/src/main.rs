@@ -139,7 +139,7 @@ fn main() -> ExitCode {
                             None => "completed".to_string(),
                         };
                         println!(
-                            "{:13} {:16} {:28} energy drift {:.2e}, {} reduced steps -> {}",
+                            "{:13} {:21} {:28} energy drift {:.2e}, {} reduced steps -> {}",
                             r.model,
                             r.integrator,
                             outcome,

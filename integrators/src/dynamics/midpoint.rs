@@ -5,7 +5,10 @@
 //! * rotations `Rₙ₊₁ = cay(θ)Rₙ`, `θ = (Δt/2) Rₙ(Wₙ + Wₙ₊₁)`, inertial moment
 //!   `(πₙ₊₁ − πₙ)/Δt` with `π = R J₀ W` — so that `θ·(πₙ₊₁ − πₙ)/Δt` and
 //!   `u·M(vₙ₊₁ − vₙ)/Δt` are exactly the kinetic energy changes;
-//! * internal force `q_k(Nₙ₊½, Mₙ₊½)` with the mid rotation of the scheme;
+//! * internal force of the scheme ([`Scheme`]): `q_k(Nₙ₊½, Mₙ₊½)` with the
+//!   geodesic mid rotation (momentum), the energy-consistent discrete
+//!   gradient (energy–momentum, FORMULATION §4.3), or `q_k` with the
+//!   algebraic mid rotation plus `β q_k(N_d, 0)` (the paper's energy–momentum);
 //! * external loads at `tₙ₊½`;
 //! * joints through the exact incremental map `Ñ` (paper eqs 21–23,
 //!   [`flexmech_joints::incremental`]): slaves are placed exactly by relation

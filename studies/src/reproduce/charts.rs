@@ -7,10 +7,14 @@
 //!   about X;
 //! * per model: `<model>_energy` (total energy minus the drivers' work),
 //!   `<model>_energy_error` (its relative change, logarithmic),
-//!   `<model>_beta` (energy–momentum β), `<model>_dt` (step sizes) and
-//!   `<model>_joint` (released translation against the joint angle).
+//!   `<model>_beta` (the energy–momentum corrections: the discrete
+//!   gradient's and the paper's β, logarithmic), `<model>_dt` (step sizes)
+//!   and `<model>_joint` (released translation against the joint angle);
+//! * `<model>_consistency` for the consistency study's model: both
+//!   energy–momentum corrections at the model's step and at half of it — the
+//!   discrete gradient's falls by 4, the paper's β does not fall.
 
-use super::{ReproduceError, RunRecord, INTEGRATORS};
+use super::{ReproduceError, RunRecord, CONSISTENCY_INTEGRATORS, CONSISTENCY_MODEL, INTEGRATORS};
 use crate::charts::{LineChart, Series};
 use std::path::{Path, PathBuf};
 
@@ -19,6 +23,7 @@ fn legend(integrator: &str) -> &'static str {
     match integrator {
         "newmark" => "Newmark (trapezoidal)",
         "momentum" => "momentum conserving",
+        "energy-momentum-paper" => "energy–momentum (paper, β)",
         _ => "energy–momentum",
     }
 }
@@ -182,20 +187,26 @@ pub fn draw_all(records: &[RunRecord], out: &Path) -> Result<Vec<PathBuf>, Repro
             },
         )?;
         draw(format!("{model}_dt"), chart)?;
-        if let Some(em) = runs.iter().find(|r| r.integrator == "energy-momentum") {
-            if em.beta.iter().any(|b| b.is_finite()) {
-                let mut chart = LineChart::new(
-                    format!("{model}: energy–momentum correction"),
-                    "time (s)",
-                    "β",
-                );
+        let em: Vec<&RunRecord> = runs
+            .iter()
+            .copied()
+            .filter(|r| CONSISTENCY_INTEGRATORS.contains(&r.integrator.as_str()))
+            .collect();
+        if em.iter().any(|r| r.beta.iter().any(|b| b.is_finite())) {
+            let mut chart = LineChart::new(
+                format!("{model}: energy–momentum corrections"),
+                "time (s)",
+                "|β|",
+            );
+            for r in em {
                 chart.series.push(Series::new(
-                    "energy–momentum",
-                    em.time.clone(),
-                    em.beta.clone(),
+                    legend(&r.integrator),
+                    r.time.clone(),
+                    abs_beta(r),
                 ));
-                draw(format!("{model}_beta"), chart)?;
             }
+            chart.log_y = true;
+            draw(format!("{model}_beta"), chart)?;
         }
         if let Some(first) = runs.first() {
             let joint = first_joint(&first.file)?;
@@ -229,4 +240,50 @@ pub fn draw_all(records: &[RunRecord], out: &Path) -> Result<Vec<PathBuf>, Repro
         }
     }
     Ok(written)
+}
+
+/// `|β|` of a run, with zeros (nothing to correct) left out of a log axis.
+fn abs_beta(r: &RunRecord) -> Vec<f64> {
+    r.beta
+        .iter()
+        .map(|b| if *b != 0.0 { b.abs() } else { f64::NAN })
+        .collect()
+}
+
+/// The consistency chart: the energy–momentum corrections of
+/// [`CONSISTENCY_MODEL`] at its step and at half of it. Returns the PNG
+/// written (none when the half-step runs are absent).
+pub fn draw_consistency(
+    runs: &[RunRecord],
+    half_step: &[RunRecord],
+    out: &Path,
+) -> Result<Vec<PathBuf>, ReproduceError> {
+    if half_step.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut chart = LineChart::new(
+        format!("{CONSISTENCY_MODEL}: energy–momentum corrections at Δt and Δt/2"),
+        "time (s)",
+        "|β|",
+    );
+    for integrator in CONSISTENCY_INTEGRATORS {
+        for (set, step) in [(runs, "Δt"), (half_step, "Δt/2")] {
+            if let Some(r) = set
+                .iter()
+                .find(|r| r.model == CONSISTENCY_MODEL && r.integrator == integrator)
+            {
+                chart.series.push(Series::new(
+                    format!("{}, {step}", legend(integrator)),
+                    r.time.clone(),
+                    abs_beta(r),
+                ));
+            }
+        }
+    }
+    chart.log_y = true;
+    let (png, _) = chart.render(
+        &out.join("charts")
+            .join(format!("{CONSISTENCY_MODEL}_consistency")),
+    )?;
+    Ok(vec![png])
 }

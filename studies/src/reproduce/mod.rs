@@ -1,9 +1,11 @@
 //! `flexmech reproduce`: the paper's numerical examples (data/paper) with all
 //! three integrators, their result files and the paper's figures.
 //!
-//! Every model of [`PAPER_MODELS`] runs with `newmark`, `momentum` and
-//! `energy-momentum`, all runs in parallel (rayon), each writing
-//! `DIR/<model>/<integrator>.h5`. A run that fails (Newmark's energy blow-up
+//! Every model of [`PAPER_MODELS`] runs with `newmark`, `momentum`,
+//! `energy-momentum` and `energy-momentum-paper` ([`INTEGRATORS`]), all runs
+//! in parallel (rayon), each writing `DIR/<model>/<integrator>.h5`; the two
+//! energy–momentum schemes also run [`CONSISTENCY_MODEL`] at half the step
+//! (`DIR/<model>/<integrator>-half-dt.h5`) for the consistency chart. A run that fails (Newmark's energy blow-up
 //! in `screw_free`, paper §5.1) keeps its steps and is part of the result.
 //! Then [`charts`] draws the figures into `DIR/charts/` and [`summary`]
 //! writes the figures of merit (failure time, energy drift, step halvings)
@@ -49,8 +51,23 @@ pub const PAPER_MODELS: [(&str, &str, &str); 5] = [
     ),
 ];
 
-/// The integrators compared, in the order of the charts' legends.
-pub const INTEGRATORS: [&str; 3] = ["newmark", "momentum", "energy-momentum"];
+/// The integrators compared, in the order of the charts' legends: the
+/// paper's three, with the toolkit's consistent `energy-momentum` in place of
+/// the paper's, and the paper's own energy–momentum scheme beside them.
+pub const INTEGRATORS: [&str; 4] = [
+    "newmark",
+    "momentum",
+    "energy-momentum",
+    "energy-momentum-paper",
+];
+
+/// The energy–momentum schemes rerun at half the step in the consistency
+/// study (`<model>_consistency` chart), on [`CONSISTENCY_MODEL`].
+pub const CONSISTENCY_INTEGRATORS: [&str; 2] = ["energy-momentum", "energy-momentum-paper"];
+
+/// The example of the consistency study: the free screw (no drive, so the
+/// energy is conserved and β is the whole correction).
+pub const CONSISTENCY_MODEL: &str = "screw_free";
 
 /// What to reproduce.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,8 +126,11 @@ pub enum ReproduceError {
 /// Everything a reproduction produced.
 #[derive(Debug, Clone)]
 pub struct Reproduction {
-    /// One record per run, in model then integrator order.
+    /// One record per run at the models' step, in model then integrator order.
     pub runs: Vec<RunRecord>,
+    /// The half-step runs of the consistency study (empty when
+    /// [`CONSISTENCY_MODEL`] is not selected).
+    pub half_step: Vec<RunRecord>,
     /// The charts written (PNG paths; an SVG sits next to each).
     pub charts: Vec<PathBuf>,
     /// `DIR/summary.csv` and `DIR/summary.md`.
@@ -137,17 +157,21 @@ pub fn reproduce(options: &ReproduceOptions) -> Result<Reproduction, ReproduceEr
         .copied()
         .filter(|m| options.models.is_empty() || options.models.iter().any(|n| n == m.0))
         .collect();
-    let runs = run_all(&selected, &options.out, options.time_scale)?;
-    let charts = charts::draw_all(&runs, &options.out)?;
+    let (runs, half_step) = run_all(&selected, &options.out, options.time_scale)?;
+    let mut charts = charts::draw_all(&runs, &options.out)?;
+    charts.extend(charts::draw_consistency(&runs, &half_step, &options.out)?);
     let summary = summary::write(&runs, &options.out)?;
     Ok(Reproduction {
         runs,
+        half_step,
         charts,
         summary,
     })
 }
 
-/// `DIR/<model>/<integrator>.h5`.
-pub fn result_path(out: &Path, model: &str, integrator: &str) -> PathBuf {
-    out.join(model).join(format!("{integrator}.h5"))
+/// `DIR/<model>/<integrator>.h5`, or `<integrator>-half-dt.h5` for a
+/// half-step run.
+pub fn result_path(out: &Path, model: &str, integrator: &str, half_step: bool) -> PathBuf {
+    let suffix = if half_step { "-half-dt" } else { "" };
+    out.join(model).join(format!("{integrator}{suffix}.h5"))
 }

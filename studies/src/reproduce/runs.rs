@@ -1,7 +1,7 @@
 //! The runs of a reproduction: every (model, integrator) pair in parallel,
 //! and what each left in its result file.
 
-use super::{result_path, ReproduceError, INTEGRATORS};
+use super::{result_path, ReproduceError, CONSISTENCY_INTEGRATORS, CONSISTENCY_MODEL, INTEGRATORS};
 use crate::model::parse_model;
 use crate::run::{run_model_to, RunError};
 use rayon::prelude::*;
@@ -20,7 +20,8 @@ pub struct RunRecord {
     pub status: String,
     /// Time of the last converged step when the run failed.
     pub failure_time: Option<f64>,
-    /// Nominal step of the model.
+    /// Nominal step of the run (the model's, or half of it in the
+    /// consistency study).
     pub nominal_dt: f64,
     /// Stored times (the first row is t = 0).
     pub time: Vec<f64>,
@@ -74,39 +75,60 @@ impl RunRecord {
     }
 }
 
-/// Runs every model of `models` with every integrator, in parallel.
+/// Runs every model of `models` with every integrator, and the consistency
+/// study's half-step runs, in parallel. Returns `(runs, half_step)`.
 pub fn run_all(
     models: &[(&str, &str, &str)],
     out: &Path,
     time_scale: f64,
-) -> Result<Vec<RunRecord>, ReproduceError> {
-    let jobs: Vec<(&str, &str, &str, &str)> = models
+) -> Result<(Vec<RunRecord>, Vec<RunRecord>), ReproduceError> {
+    let mut jobs: Vec<(&str, &str, &str, &str, bool)> = models
         .iter()
-        .flat_map(|&(name, path, text)| INTEGRATORS.iter().map(move |&i| (name, path, text, i)))
-        .collect();
-    jobs.par_iter()
-        .map(|&(name, path, text, integrator)| {
-            run_one(name, path, text, integrator, out, time_scale)
+        .flat_map(|&(name, path, text)| {
+            INTEGRATORS
+                .iter()
+                .map(move |&i| (name, path, text, i, false))
         })
-        .collect()
+        .collect();
+    for &(name, path, text) in models.iter().filter(|m| m.0 == CONSISTENCY_MODEL) {
+        jobs.extend(
+            CONSISTENCY_INTEGRATORS
+                .iter()
+                .map(|&i| (name, path, text, i, true)),
+        );
+    }
+    let mut all: Vec<RunRecord> = jobs
+        .par_iter()
+        .map(|&(name, path, text, integrator, half)| {
+            run_one(name, path, text, integrator, half, out, time_scale)
+        })
+        .collect::<Result<_, _>>()?;
+    let half = all.split_off(all.len() - (jobs.iter().filter(|j| j.4).count()));
+    Ok((all, half))
 }
 
-/// The model text with the integrator (and `t_end`, scaled) replaced, so the
-/// result file's stored model reproduces exactly this run.
-fn adapted_text(text: &str, integrator: &str, time_scale: f64) -> String {
+/// The number on a `key = value  # comment` line.
+fn value_of(line: &str) -> f64 {
+    line.split('=')
+        .nth(1)
+        .and_then(|v| v.split('#').next())
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(0.0)
+}
+
+/// The model text with the integrator (and `t_end`, scaled, and `dt`,
+/// halved for a half-step run) replaced, so the result file's stored model
+/// reproduces exactly this run.
+fn adapted_text(text: &str, integrator: &str, half_step: bool, time_scale: f64) -> String {
     text.lines()
         .map(|line| {
             let key = line.split('=').next().unwrap_or("").trim();
             if key == "integrator" {
                 format!("integrator = \"{integrator}\"")
             } else if key == "t_end" && time_scale != 1.0 {
-                let value: f64 = line
-                    .split('=')
-                    .nth(1)
-                    .and_then(|v| v.split('#').next())
-                    .and_then(|v| v.trim().parse().ok())
-                    .unwrap_or(0.0);
-                format!("t_end = {}", value * time_scale)
+                format!("t_end = {}", value_of(line) * time_scale)
+            } else if key == "dt" && half_step {
+                format!("dt = {}", value_of(line) * 0.5)
             } else {
                 line.to_string()
             }
@@ -120,6 +142,7 @@ fn run_one(
     path: &str,
     text: &str,
     integrator: &str,
+    half_step: bool,
     out: &Path,
     time_scale: f64,
 ) -> Result<RunRecord, ReproduceError> {
@@ -128,15 +151,18 @@ fn run_one(
         integrator: integrator.to_string(),
         message,
     };
-    let model = parse_model(&adapted_text(text, integrator, time_scale), Path::new(path))
-        .map_err(|e| fail(e.to_string()))?;
+    let model = parse_model(
+        &adapted_text(text, integrator, half_step, time_scale),
+        Path::new(path),
+    )
+    .map_err(|e| fail(e.to_string()))?;
     let nominal_dt = match model.solver.analysis {
         crate::model::Analysis::Dynamic { dt, .. } => dt,
         crate::model::Analysis::Static { .. } => {
             return Err(fail("the paper's examples are dynamic analyses".into()))
         }
     };
-    let file = result_path(out, name, integrator);
+    let file = result_path(out, name, integrator, half_step);
     match run_model_to(&model, &file) {
         Ok(_) | Err(RunError::Solve { .. }) => {}
         Err(e) => return Err(fail(e.to_string())),
