@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The main job: build flexmech (release), reproduce the paper's examples
-# (data/paper, all three integrators) with their charts, and solve every other
-# model in data/benchmarks/, data/statics/ and data/dynamics/.
+# (data/paper, every integrator) with their charts, solve every other model in
+# data/benchmarks/, data/statics/ and data/dynamics/, and check the published
+# dynamic benchmarks in full with every integrator (the long, #[ignore]d runs
+# of studies/tests/published_dynamics.rs).
 #   results/<model>/<integrator>.h5   the paper's examples
 #   results/charts/*.png, *.svg       their figures
 #   results/summary.csv, summary.md   outcome, energy drift, step halvings
@@ -13,4 +15,5 @@ OUT="${1:-results}"
 cargo build --release --bin flexmech
 ./target/release/flexmech reproduce --out "$OUT"
 ./target/release/flexmech run data/benchmarks/*.toml data/statics/*.toml data/dynamics/*.toml --out "$OUT/models"
+cargo test --release -p flexmech-studies --test published_dynamics -- --ignored
 echo "results written to $OUT/ (figures in $OUT/charts/, summary in $OUT/summary.md)"
