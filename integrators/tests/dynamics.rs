@@ -278,3 +278,31 @@ fn energy_momentum_is_bitwise_deterministic_across_thread_counts() {
         }
     }
 }
+
+#[test]
+fn stored_times_are_multiples_of_the_step() {
+    // Summing 0.1 ten times gives 0.9999999999999999; the stored times are
+    // n·Δt exactly, in every integrator.
+    let (mech, motion, mut settings) = spinning_beam(MassKind::Lumped);
+    settings.dt = 0.1;
+    settings.t_end = 1.0;
+    let mut times: Vec<Vec<f64>> = Vec::new();
+    let mut run = |f: &dyn Fn(&mut dyn FnMut(&StepRecord))| {
+        let mut t = Vec::new();
+        f(&mut |s: &StepRecord| t.push(s.time));
+        times.push(t);
+    };
+    run(&|push| {
+        flexmech_integrators::dynamics::newmark::solve(&mech, &settings, &motion, |s| push(s))
+            .unwrap();
+    });
+    run(&|push| {
+        momentum::solve(&mech, &settings, &motion, |s| push(s)).unwrap();
+    });
+    for t in &times {
+        assert_eq!(t.len(), 11);
+        for (k, &tk) in t.iter().enumerate() {
+            assert_eq!(tk, k as f64 * 0.1, "{t:?}");
+        }
+    }
+}

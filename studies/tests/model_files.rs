@@ -25,6 +25,7 @@ EA = 1000
 GA = [500, 500]
 GJ = 10
 EI = [20, 30]
+rhoA = 0.5
 
 [[beam]]
 name = "post"
@@ -239,7 +240,7 @@ fn full_file_parses_with_the_right_values() {
     );
     assert_eq!((s.rho_a, s.rho_j), (1.0, [0.02, 0.01, 0.01]));
     assert_eq!(m.sections[1].ea, 1000.0);
-    assert_eq!(m.sections[1].rho_a, 0.0);
+    assert_eq!(m.sections[1].rho_a, 0.5);
 
     // Beams.
     let post = &m.beams[0];
@@ -1220,4 +1221,42 @@ fn unknown_key_in_solver() {
         &["unknown key `steps`", "`load_steps`"],
     );
     assert_eq!(e.line(), Some(line_of(&text, "steps = 3")));
+}
+
+#[test]
+fn dynamics_without_mass_is_refused() {
+    // Omitted rhoA (the default, 0) and an explicit 0: both named by key.
+    let dynamic =
+        "[solver]\nanalysis = \"dynamic\"\nintegrator = \"newmark\"\ndt = 0.1\nt_end = 1.0\n";
+    let text = with(dynamic);
+    let e = expect_err(
+        &text,
+        "section[0].rhoA",
+        &["needs mass", "section \"s\"", "no rhoA", "rhoA = 7.85"],
+    );
+    assert_eq!(e.line(), Some(line_of(&text, "[[section]]")));
+    let text = with(dynamic).replace("EI = [1.0, 1.0]\n", "EI = [1.0, 1.0]\nrhoA = 0.0\n");
+    let e = expect_err(&text, "section[0].rhoA", &["needs mass", "rhoA = 0;"]);
+    assert_eq!(e.line(), Some(line_of(&text, "rhoA = 0.0")));
+    // Statics needs no mass.
+    assert!(parse(BASE).is_ok());
+}
+
+#[test]
+fn a_prescribed_dof_that_is_also_supported_is_refused() {
+    let text = format!(
+        "{BASE}\n[[support]]\nnode = \"a.start\"\nfixed = [\"ux\", \"rz\"]\n\n[[prescribed]]\nnode = \"a.start\"\ndof = \"rz\"\nvalue = 0.5\n"
+    );
+    let e = expect_err(
+        &text,
+        "prescribed[0].dof",
+        &[
+            "also held by support[0].fixed",
+            "remove \"rz\" from support[0].fixed",
+        ],
+    );
+    assert_eq!(e.line(), Some(line_of(&text, "dof = \"rz\"")));
+    // Another DOF of the same node may be prescribed.
+    let ok = text.replace("dof = \"rz\"", "dof = \"ry\"");
+    assert!(parse(&ok).is_ok(), "{:?}", parse(&ok).err());
 }

@@ -489,7 +489,7 @@ pub fn solve(
                 state = end;
                 v = v1;
                 w = w1;
-                t += dt;
+                t = control.advance(t, dt);
                 mech.external_forces(t, &mut fext);
                 let mut rec = record(&state, &v, &w, &fext, t, dt, Some(&report));
                 rec.beta = beta;

@@ -90,6 +90,10 @@ impl Motion {
     }
 }
 
+/// Relative distance to a multiple of the nominal step below which a time is
+/// that multiple (round-off of summed steps: far below any halved step).
+const TIME_SNAP: f64 = 1e-9;
+
 /// Step-size control shared by the integrators: halve on failure, grow back
 /// (doubling) towards the nominal step after four easy steps in a row. The
 /// step never goes below `nominal / 2^max_halvings`: a step that fails at
@@ -119,6 +123,20 @@ impl StepControl {
     /// The step to try from time `t` (never past `t_end`).
     pub(crate) fn next(&self, t: f64, t_end: f64) -> f64 {
         self.step.min(t_end - t)
+    }
+
+    /// The time after a converged step of `dt` from `t`: snapped to the
+    /// nearest multiple of the nominal step when it is one up to round-off,
+    /// so that stored times are `n·Δt` (not `0.9999999999999999`) however
+    /// many steps were summed.
+    pub(crate) fn advance(&self, t: f64, dt: f64) -> f64 {
+        let next = t + dt;
+        let n = (next / self.nominal).round();
+        if (next - n * self.nominal).abs() <= TIME_SNAP * self.nominal {
+            n * self.nominal
+        } else {
+            next
+        }
     }
 
     /// A step converged.

@@ -317,7 +317,7 @@ pub fn solve(
                 }
                 state = end;
                 kin = next;
-                t += dt;
+                t = control.advance(t, dt);
                 mech.external_forces(t, &mut fext);
                 let mut rec = record(&state, &kin, &fext, t, dt, Some(&report));
                 rec.energy.driver_work = driver_work;

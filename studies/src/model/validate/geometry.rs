@@ -66,6 +66,42 @@ impl Ctx<'_> {
         Ok(out)
     }
 
+    /// A dynamic analysis needs mass: every section a beam uses must have
+    /// `rhoA > 0` (without it the mass matrix is singular and no integrator
+    /// can give a meaningful answer).
+    pub(super) fn massive(
+        &self,
+        raw: &[S<RawSection>],
+        sections: &[SectionSpec],
+        beams: &[BeamSpec],
+        solver: &SolverSpec,
+    ) -> Res<()> {
+        if !matches!(solver.analysis, Analysis::Dynamic { .. }) {
+            return Ok(());
+        }
+        for beam in beams {
+            let (i, sec) = (beam.section, &sections[beam.section]);
+            if sec.rho_a > 0.0 {
+                continue;
+            }
+            let key = format!("section[{i}].rhoA");
+            let given = raw[i].get_ref().rho_a.as_ref();
+            let what =
+                format!(
+                "a dynamic analysis needs mass, but section \"{}\" (used by beam \"{}\") has {}; \
+                 give its mass per unit length, e.g. rhoA = 7.85, or make the analysis static",
+                sec.name,
+                beam.name,
+                if given.is_some() { "rhoA = 0" } else { "no rhoA" }
+            );
+            return Err(match given {
+                Some(v) => self.at(key, v, what),
+                None => self.err(key, Some(raw[i].span()), what),
+            });
+        }
+        Ok(())
+    }
+
     pub(super) fn beams(&self, raw: &[S<RawBeam>], sections: &[SectionSpec]) -> Res<Vec<BeamSpec>> {
         let mut out: Vec<BeamSpec> = Vec::new();
         for (i, entry) in raw.iter().enumerate() {

@@ -121,6 +121,7 @@ impl Ctx<'_> {
         raw: &[S<RawPrescribed>],
         beams: &[BeamSpec],
         joints: &[JointSpec],
+        supports: &[SupportSpec],
     ) -> Res<Vec<PrescribedSpec>> {
         let mut out: Vec<PrescribedSpec> = Vec::new();
         for (i, entry) in raw.iter().enumerate() {
@@ -256,6 +257,20 @@ impl Ctx<'_> {
                              the master; prescribe the master node or the joint angle instead",
                             node_s.get_ref(),
                             joints[j].name
+                        ),
+                    ));
+                }
+                // A support holds the DOF at zero; prescribing it too would
+                // silently override one of the two.
+                if let Some(s) = supports.iter().position(|s| s.node == node && s.fixed[dof]) {
+                    return Err(self.at(
+                        k("dof"),
+                        dof_s,
+                        format!(
+                            "DOF \"{dof_name}\" of node \"{}\" is also held by support[{s}].fixed; a DOF is \
+                             either supported or prescribed: remove \"{dof_name}\" from support[{s}].fixed, \
+                             or remove this prescribed entry",
+                            node_s.get_ref()
                         ),
                     ));
                 }

@@ -292,9 +292,10 @@ pub(crate) fn validate(raw: RawModel, text: &str, file: &Path) -> Result<Model, 
     let joints = cx.joints(&raw.joint, &beams)?;
     cx.topology(&raw.support, &supports, &raw.joint, &joints)?;
     let loads = cx.loads(&raw.load, &beams)?;
-    let prescribed = cx.prescribed(&raw.prescribed, &beams, &joints)?;
+    let prescribed = cx.prescribed(&raw.prescribed, &beams, &joints, &supports)?;
     let initial_velocities = cx.initial_velocities(&raw.initial_velocity, &beams)?;
     let solver = cx.solver(raw.solver.as_ref())?;
+    cx.massive(&raw.section, &sections, &beams, &solver)?;
     let output = cx.output(raw.output.as_ref(), &beams)?;
     Ok(Model {
         name,
