@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 use flexmech_studies::charts::plot_datasets;
 use flexmech_studies::model::load_model;
 use flexmech_studies::reproduce::{reproduce, ReproduceOptions};
-use flexmech_studies::run_model;
+use flexmech_studies::{run_model, RunError};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -94,10 +94,19 @@ fn main() -> ExitCode {
     match cli.command {
         Command::Run { models, out } => {
             let mut failed = 0;
+            let mut names: Vec<(String, PathBuf)> = Vec::new();
             for path in &models {
-                let outcome = load_model(path)
-                    .map_err(Into::into)
-                    .and_then(|m| run_model(&m, &out));
+                let outcome = load_model(path).map_err(Into::into).and_then(|m| {
+                    if let Some((_, first)) = names.iter().find(|(n, _)| *n == m.name) {
+                        return Err(RunError::DuplicateName {
+                            name: m.name.clone(),
+                            file: path.clone(),
+                            first: first.clone(),
+                        });
+                    }
+                    names.push((m.name.clone(), path.clone()));
+                    run_model(&m, &out)
+                });
                 match outcome {
                     Ok(s) => println!(
                         "{}: completed, {} steps ({} written, {} Newton iterations) in {:.2} s -> {}",

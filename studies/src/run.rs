@@ -28,6 +28,19 @@ pub enum RunError {
     /// Writing the result file failed.
     #[error(transparent)]
     Result(#[from] ResultError),
+    /// Two models of one `flexmech run` have the same `name`: the second
+    /// would overwrite the first's result file, so it is refused.
+    #[error(
+        "{}: key `name`: \"{name}\" is also the name of {} in this run; their results would \
+         overwrite each other ({name}.h5): give one of them another name",
+        file.display(),
+        first.display()
+    )]
+    DuplicateName {
+        name: String,
+        file: PathBuf,
+        first: PathBuf,
+    },
     /// The solver stopped; `file` holds the steps computed before.
     #[error("{model}: {error} (steps computed so far are in {})", file.display())]
     Solve {

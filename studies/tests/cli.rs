@@ -142,3 +142,30 @@ fn failed_solve_keeps_a_valid_file_with_the_steps_so_far() {
     let pos = f.dataset("/configuration/position").unwrap();
     assert_eq!(pos.shape()[0], t.len());
 }
+
+#[test]
+fn two_models_with_the_same_name_in_one_run_are_refused() {
+    // The second would overwrite the first's result file: it is refused,
+    // naming both files and the key, and the first's result is kept.
+    let dir = tempfile::tempdir().unwrap();
+    let copy = dir.path().join("copy.toml");
+    std::fs::copy(bench("rollup_linear.toml"), &copy).unwrap();
+    let out = flexmech()
+        .args(["run", &bench("rollup_linear.toml")])
+        .arg(&copy)
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("copy.toml: key `name`")
+            && stderr.contains("rollup_linear.toml in this run")
+            && stderr.contains("give one of them another name"),
+        "{stderr}"
+    );
+    assert!(dir.path().join("rollup-linear.h5").is_file());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(stdout.matches("completed").count(), 1, "{stdout}");
+}
