@@ -81,12 +81,14 @@ impl BeamElement<2> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::rotation::{cayley, tan_scaled};
     use crate::section::Section;
 
-    fn element() -> (BeamElement<2>, [Vector3<f64>; 2]) {
+    /// A tilted 2-node element with an anisotropic section, shared with the
+    /// discrete-gradient tests.
+    pub(crate) fn element() -> (BeamElement<2>, [Vector3<f64>; 2]) {
         let sec = Section::new(
             [2.0e4, 8.0e3, 9.0e3],
             [30.0, 45.0, 60.0],

@@ -5,8 +5,8 @@
 //! central differences.
 
 use super::*;
+use crate::conserving::tests::element;
 use crate::rotation::{cayley, exp};
-use crate::section::Section;
 use num_dual::DualSVec64;
 use proptest::prelude::*;
 
@@ -14,23 +14,6 @@ use proptest::prelude::*;
 const ENERGY_TOL: f64 = 1e-11;
 /// Self-equilibrium to within round-off of the force's size.
 const EQUILIBRIUM_TOL: f64 = 1e-13;
-
-fn element() -> (BeamElement<2>, [Vector3<f64>; 2]) {
-    let sec = Section::new(
-        [2.0e4, 8.0e3, 9.0e3],
-        [30.0, 45.0, 60.0],
-        1.0,
-        [0.2, 0.1, 0.1],
-    );
-    let x0 = [Vector3::new(0.1, 0.2, -0.3), Vector3::new(1.2, 0.6, -0.1)];
-    let t1 = (x0[1] - x0[0]).normalize();
-    let t2 = (Vector3::z() - t1 * t1.z).normalize();
-    let l0 = Matrix3::from_columns(&[t1, t2, t1.cross(&t2)]);
-    (
-        BeamElement::new([0, 1], sec, (x0[1] - x0[0]).norm(), &x0, [l0, l0]),
-        x0,
-    )
-}
 
 /// A strongly deformed start pose (relative rotation ≈ 0.6 rad) and an end pose
 /// `h` times a large step away; also the step's Cayley increments.

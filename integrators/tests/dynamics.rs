@@ -286,19 +286,11 @@ fn stored_times_are_multiples_of_the_step() {
     let (mech, motion, mut settings) = spinning_beam(MassKind::Lumped);
     settings.dt = 0.1;
     settings.t_end = 1.0;
-    let mut times: Vec<Vec<f64>> = Vec::new();
-    let mut run = |f: &dyn Fn(&mut dyn FnMut(&StepRecord))| {
-        let mut t = Vec::new();
-        f(&mut |s: &StepRecord| t.push(s.time));
-        times.push(t);
-    };
-    run(&|push| {
-        flexmech_integrators::dynamics::newmark::solve(&mech, &settings, &motion, |s| push(s))
-            .unwrap();
-    });
-    run(&|push| {
-        momentum::solve(&mech, &settings, &motion, |s| push(s)).unwrap();
-    });
+    let (mut nm, mut mc) = (Vec::new(), Vec::new());
+    flexmech_integrators::dynamics::newmark::solve(&mech, &settings, &motion, |s| nm.push(s.time))
+        .unwrap();
+    momentum::solve(&mech, &settings, &motion, |s| mc.push(s.time)).unwrap();
+    let times = [nm, mc];
     for t in &times {
         assert_eq!(t.len(), 11);
         for (k, &tk) in t.iter().enumerate() {
