@@ -31,6 +31,9 @@ pub enum MidRotation {
 /// A configuration of one 2-node element: nodal positions and rotations.
 pub type Pose<T> = ([Vector3<T>; 2], [Matrix3<T>; 2]);
 
+/// A configuration of one 3-node element: nodal positions and rotations.
+pub type Pose3<T> = ([Vector3<T>; 3], [Matrix3<T>; 3]);
+
 impl BeamElement<2> {
     /// Reference rotation `Λ_r = Λ₁ exp(½ log(Λ₁ᵀΛ₂))` of the element's triads
     /// `Λᵢ = Rᵢ Λ₀ᵢ`.

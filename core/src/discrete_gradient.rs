@@ -107,7 +107,7 @@ fn cayley_tangent_inverse<T: Scalar>(c: &Vector3<T>) -> Matrix3<T> {
 /// The smooth secant operators `(B, T)` of a step seen from one end: node 1's
 /// triad `lam1` and the relative rotation vector `phi0` at that end, `phi1` at
 /// the other, and the Cayley increments `th` of the nodes towards the other end.
-fn secant_operators<T: Scalar>(
+pub(crate) fn secant_operators<T: Scalar>(
     lam1: &Matrix3<T>,
     phi0: &Vector3<T>,
     phi1: &Vector3<T>,

@@ -8,6 +8,7 @@ pub mod scalar;
 pub use scalar::{cst, Scalar};
 pub mod conserving;
 pub mod discrete_gradient;
+pub mod discrete_gradient_quadratic;
 pub mod element;
 pub mod inertia;
 pub mod section;

@@ -12,6 +12,7 @@ pub mod mechanism;
 pub mod newton;
 pub mod record;
 pub mod statics;
+pub mod step_control;
 
 pub use constraints::{MechanismState, Topology};
 pub use error::{NewtonFailure, SolveError};

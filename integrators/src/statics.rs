@@ -1,9 +1,10 @@
 //! Static equilibrium under proportional (or scheduled) loading: the load
 //! factor λ runs from 0 to 1; each step (for driven mechanisms: from the
 //! secant prediction of the previous one) is solved by Newton with the exact
-//! tangent; a step that fails is retried with half the increment (up to
-//! `max_halvings` times in a row) and the increment grows back to nominal
-//! after three easy steps. Every planned level `k/load_steps` is reached
+//! tangent; a step that fails is retried with half the increment, never
+//! below `nominal/2^max_halvings` ([`StepControl`]: the halving level is kept
+//! across successes), and the increment grows back to nominal after three
+//! easy steps. Every planned level `k/load_steps` is reached
 //! exactly; halvings only insert levels between them.
 
 use crate::assembly::Assembler;
@@ -13,6 +14,7 @@ use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonSettings, NewtonSystem};
 use crate::record::{Energies, StepRecord};
+use crate::step_control::StepControl;
 use flexmech_core::Configuration;
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -144,6 +146,9 @@ fn record(
     }
 }
 
+/// Easy load steps in a row before a halved step doubles again.
+const GROW_AFTER: usize = 3;
+
 /// Solves the static problem, calling `on_step` after every converged step.
 /// On failure the steps already reported stay valid; the error says where.
 pub fn solve_static(
@@ -175,8 +180,8 @@ pub fn solve_static(
     };
     let (mut r, mut dq) = (vec![0.0; n], vec![0.0; n]);
     let nominal = 1.0 / settings.load_steps as f64;
-    let (mut lambda, mut step, mut halvings, mut easy, mut steps) =
-        (0.0f64, nominal, 0usize, 0usize, 0usize);
+    let mut control = StepControl::with(nominal, settings.max_halvings, GROW_AFTER);
+    let (mut lambda, mut steps) = (0.0f64, 0usize);
     // Kinematically driven mechanisms start each step from the secant
     // prediction, which carries the rigid motion downstream of a driven joint;
     // under load control the last equilibrium is the better start (Newton's
@@ -193,7 +198,7 @@ pub fn solve_static(
         // Never step over a planned level k/load_steps: results are reported
         // at the load factors the user asked for; halvings only add levels.
         let next_planned = ((lambda / nominal + 1e-9).floor() + 1.0) * nominal;
-        let target = (lambda + step).min(next_planned);
+        let target = (lambda + control.step()).min(next_planned);
         let target = if target > 1.0 - 1e-12 { 1.0 } else { target };
         let saved = prob.state.clone();
         if let (true, Some((before, before_step))) = (driven, &previous) {
@@ -212,33 +217,22 @@ pub fn solve_static(
                 previous = Some((saved, dt));
                 lambda = target;
                 steps += 1;
-                halvings = 0;
-                easy += 1;
                 on_step(&record(mech, &prob.state, &prob.fext, lambda, dt, &report));
-                if easy >= 3 && step < nominal {
-                    step = (2.0 * step).min(nominal);
-                    easy = 0;
-                }
+                control.succeeded();
             }
             Err(reason) => {
                 prob.state = saved;
                 if let NewtonFailure::LinearSolve(msg) = &reason {
-                    if lambda == 0.0 && halvings == 0 {
+                    if lambda == 0.0 && control.level() == 0 {
                         // A singular tangent at the undeformed state will not be
                         // cured by a smaller load: the mechanism is under-supported.
                         return Err(SolveError::Singular(msg.clone()));
                     }
                 }
-                if halvings >= settings.max_halvings {
-                    return Err(SolveError::NoConvergence {
-                        time: target,
-                        halvings,
-                        reason,
-                    });
-                }
-                halvings += 1;
-                easy = 0;
-                step *= 0.5;
+                // Halve, never below nominal/2^max_halvings (the level is
+                // kept across successes, so the load path cannot creep on
+                // with ever smaller steps).
+                control.failed(target, reason)?;
             }
         }
     }

@@ -11,6 +11,15 @@ use nalgebra::Vector3;
 /// `v = v₀ + ω × x`, `W = ω` (spin about an axis oblique to the beam, so it
 /// wobbles, stretches and bends).
 fn spinning_beam(mass: MassKind) -> (Mechanism, Motion, DynamicSettings) {
+    spinning_beam_of(mass, 10, 2)
+}
+
+/// [`spinning_beam`] meshed with `elements` elements of `nodes` nodes.
+fn spinning_beam_of(
+    mass: MassKind,
+    elements: usize,
+    nodes: usize,
+) -> (Mechanism, Motion, DynamicSettings) {
     let sec = Section::new(
         [1.0e4, 4.0e3, 4.0e3],
         [50.0, 80.0, 80.0],
@@ -22,8 +31,8 @@ fn spinning_beam(mass: MassKind) -> (Mechanism, Motion, DynamicSettings) {
         Vector3::zeros(),
         Vector3::new(10.0, 0.0, 0.0),
         Vector3::y(),
-        10,
-        2,
+        elements,
+        nodes,
         sec,
     )
     .unwrap();
@@ -296,5 +305,44 @@ fn stored_times_are_multiples_of_the_step() {
         for (k, &tk) in t.iter().enumerate() {
             assert_eq!(tk, k as f64 * 0.1, "{t:?}");
         }
+    }
+}
+
+#[test]
+fn three_node_elements_conserve_energy_and_momenta_in_both_conserving_schemes() {
+    // 5 quadratic elements, a fifth of a turn per step, 60 steps: the
+    // discrete gradient of the 3-node element (used by both conserving
+    // schemes) conserves energy and both momenta to the Newton tolerance.
+    use flexmech_integrators::dynamics::energy_momentum;
+    let (mech, motion, mut settings) = spinning_beam_of(MassKind::Consistent, 5, 3);
+    settings.dt = 0.2;
+    settings.t_end = 12.0;
+    for scheme in ["momentum", "energy-momentum"] {
+        let mut steps: Vec<StepRecord> = Vec::new();
+        let push = |s: &StepRecord| steps.push(s.clone());
+        if scheme == "momentum" {
+            momentum::solve(&mech, &settings, &motion, push).unwrap();
+        } else {
+            energy_momentum::solve(&mech, &settings, &motion, push).unwrap();
+        }
+        assert_eq!(steps.len(), 61, "{scheme}: a step was halved");
+        let e0 = steps[0].energy.total;
+        let de = steps
+            .iter()
+            .map(|s| (s.energy.total - e0).abs() / e0)
+            .fold(0.0, f64::max);
+        let lin: Vec<_> = steps.iter().map(|s| s.momentum_linear).collect();
+        let ang: Vec<_> = steps.iter().map(|s| s.momentum_angular).collect();
+        let (dl, dh) = (rel_drift(&lin), rel_drift(&ang));
+        let strain = steps.iter().map(|s| s.energy.strain).fold(0.0, f64::max);
+        eprintln!(
+            "3-node, {scheme}: energy {de:.2e}, momenta {dl:.2e} / {dh:.2e}, strain {strain:.2e}"
+        );
+        assert!(de <= 1e-9, "{scheme}: energy drift {de:e}");
+        assert!(
+            dl <= 1e-9 && dh <= 1e-9,
+            "{scheme}: momentum drift {dl:e} / {dh:e}"
+        );
+        assert!(strain > 1e-6);
     }
 }

@@ -64,8 +64,13 @@ fn kinds() -> Vec<(&'static str, Arc<dyn JointMap>)> {
 }
 
 /// Beam A along x from the origin, beam B from A's tip + r_R(ψ₀) along y;
-/// 3 flexible elements each, no supports, no loads.
+/// 3 flexible 2-node elements each, no supports, no loads.
 fn free_pair(map: Arc<dyn JointMap>) -> (Mechanism, Motion) {
+    free_pair_of(map, 3, 2)
+}
+
+/// [`free_pair`] with `elements` elements of `nodes` nodes per beam.
+fn free_pair_of(map: Arc<dyn JointMap>, elements: usize, nodes: usize) -> (Mechanism, Motion) {
     let section = Section::new(
         [2.0e4, 1.0e4, 1.0e4],
         [60.0, 40.0, 40.0],
@@ -76,7 +81,14 @@ fn free_pair(map: Arc<dyn JointMap>) -> (Mechanism, Motion) {
     let (offset, _) = map.released_placement(&initial);
     let mut mesh = Mesh::default();
     let a = mesh
-        .add_straight_beam(Vector3::zeros(), Vector3::x(), Vector3::z(), 3, 2, section)
+        .add_straight_beam(
+            Vector3::zeros(),
+            Vector3::x(),
+            Vector3::z(),
+            elements,
+            nodes,
+            section,
+        )
         .unwrap();
     let start_b = Vector3::x() + offset;
     let b = mesh
@@ -84,8 +96,8 @@ fn free_pair(map: Arc<dyn JointMap>) -> (Mechanism, Motion) {
             start_b,
             start_b + Vector3::y() * 0.8,
             Vector3::z(),
-            3,
-            2,
+            elements,
+            nodes,
             section,
         )
         .unwrap();
@@ -185,5 +197,40 @@ fn conserving_schemes_carry_momentum_and_energy_through_every_joint_kind() {
             .map(|r| r.joints[0].constraint_error)
             .fold(0.0, f64::max);
         assert!(worst_c <= 1e-12, "{name} Newmark: constraint {worst_c:e}");
+    }
+}
+
+#[test]
+fn three_node_elements_carry_momentum_and_energy_through_every_joint_kind() {
+    // The same free pair meshed with two 3-node elements per beam, in the
+    // energy–momentum scheme: energy and momenta to the Newton tolerance,
+    // constraints at round-off, for every joint kind.
+    for (name, map) in kinds() {
+        let (mech, motion) = free_pair_of(map, 2, 3);
+        let mut em: Vec<StepRecord> = Vec::new();
+        energy_momentum::solve(&mech, &settings(0.02, 0.3), &motion, |r| em.push(r.clone()))
+            .unwrap_or_else(|e| panic!("{name}: energy–momentum scheme failed: {e}"));
+        assert_eq!(em.len(), 16, "{name}: a step was halved");
+        let l0 = Vector3::from(em[0].momentum_linear).norm();
+        let h0 = Vector3::from(em[0].momentum_angular).norm();
+        let dl = drift(em.iter().map(|r| r.momentum_linear), l0);
+        let dh = drift(em.iter().map(|r| r.momentum_angular), h0);
+        let e0 = em[0].energy.total;
+        let de = em
+            .iter()
+            .map(|r| (r.energy.total - e0).abs())
+            .fold(0.0, f64::max)
+            / e0;
+        let worst_c = em
+            .iter()
+            .map(|r| r.joints[0].constraint_error)
+            .fold(0.0, f64::max);
+        eprintln!("{name:12} 3-node EM: momentum {dl:.1e} / {dh:.1e}, energy {de:.1e}, constraint {worst_c:.1e}");
+        assert!(
+            dl <= 1e-9 && dh <= 1e-9,
+            "{name}: momentum drift {dl:e} / {dh:e}"
+        );
+        assert!(de <= 1e-9, "{name}: energy drift {de:e}");
+        assert!(worst_c <= 1e-12, "{name}: constraint {worst_c:e}");
     }
 }

@@ -139,13 +139,13 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
     let mut beam_nodes = Vec::with_capacity(model.beams.len());
     for (b, beam) in model.beams.iter().enumerate() {
         if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
-            if integrator != IntegratorKind::Newmark && beam.nodes_per_element != 2 {
+            if integrator == IntegratorKind::EnergyMomentumPaper && beam.nodes_per_element != 2 {
                 return Err(ModelError::new(
                     &model.path,
                     format!("beam[{b}].nodes_per_element"),
                     None,
                     format!(
-                        "integrator = \"{}\" runs on 2-node elements (its internal force is the midpoint form of the linear element); use nodes_per_element = 2 with more elements, or integrator = \"newmark\"",
+                        "integrator = \"{}\" runs on 2-node elements (the paper's internal force is the midpoint form of the linear element); use nodes_per_element = 2 with more elements, or integrator = \"energy-momentum\"",
                         integrator.name()
                     ),
                 ));

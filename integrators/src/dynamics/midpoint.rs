@@ -25,7 +25,7 @@
 
 pub use super::Scheme;
 use super::{increment_work, slave_velocities};
-use super::{DynamicSettings, Motion, StepControl};
+use super::{DynamicSettings, Motion, StepControl, GROW_AFTER};
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::SolveError;
@@ -34,7 +34,7 @@ use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSystem};
 use crate::record::{Energies, StepRecord};
 use crate::statics::strain_energy;
-use flexmech_core::conserving::{MidRotation, Pose};
+use flexmech_core::conserving::{MidRotation, Pose, Pose3};
 use flexmech_core::rotation::{cayley_inverse, exp, log};
 use flexmech_core::{BeamElement, Configuration, Element, Inertia};
 use nalgebra::{Const, Matrix3, SVector, Vector3, U1};
@@ -142,8 +142,9 @@ fn element_kernel(
     r: &mut [f64],
     k: &mut [f64],
 ) {
-    let Element::Linear(e) = el else {
-        unreachable!("the midpoint schemes are checked to run on 2-node elements")
+    let e = match el {
+        Element::Linear(e) => e,
+        Element::Quadratic(e) => return quadratic_kernel(e, start, end, r, k),
     };
     type D = Dual12;
     let (s, sd, ed) = seeded_poses(e, start, end);
@@ -165,6 +166,40 @@ fn element_kernel(
         let row = q[i].eps.unwrap_generic(Const::<12>, U1);
         for j in 0..12 {
             k[j * 12 + i] = row[j];
+        }
+    }
+}
+
+/// Element kernel for 3-node elements, in both conserving schemes: the
+/// energy-consistent discrete gradient (FORMULATION §4.3; there is no
+/// paper form for them, so the momentum scheme uses it too and conserves
+/// energy as well) and its AD derivative under spatial increments of the
+/// end pose.
+fn quadratic_kernel(
+    e: &BeamElement<3>,
+    start: &Configuration,
+    end: &Configuration,
+    r: &mut [f64],
+    k: &mut [f64],
+) {
+    type D = DualSVec64<18>;
+    let n = e.nodes;
+    let seed = |j: usize| D::from_re(0.0).derivative(j);
+    let v = |j: usize| Vector3::new(seed(j), seed(j + 1), seed(j + 2));
+    let sd: Pose3<D> = (
+        std::array::from_fn(|i| start.x[n[i]].map(D::from_re)),
+        std::array::from_fn(|i| start.rot[n[i]].map(D::from_re)),
+    );
+    let ed: Pose3<D> = (
+        std::array::from_fn(|i| end.x[n[i]].map(D::from_re) + v(6 * i)),
+        std::array::from_fn(|i| exp(&v(6 * i + 3)) * end.rot[n[i]].map(D::from_re)),
+    );
+    let q = e.discrete_gradient_force(&sd, &ed);
+    for i in 0..18 {
+        r[i] = q[i].re;
+        let row = q[i].eps.unwrap_generic(Const::<18>, U1);
+        for j in 0..18 {
+            k[j * 18 + i] = row[j];
         }
     }
 }
@@ -373,14 +408,15 @@ pub fn solve(
     scheme: Scheme,
     mut on_step: impl FnMut(&StepRecord),
 ) -> Result<Configuration, SolveError> {
-    if mech
-        .mesh
-        .elements
-        .iter()
-        .any(|e| !matches!(e, Element::Linear(_)))
+    if scheme == Scheme::EnergyMomentumPaper
+        && mech
+            .mesh
+            .elements
+            .iter()
+            .any(|e| !matches!(e, Element::Linear(_)))
     {
         return Err(SolveError::InvalidMechanism(
-            "the conserving schemes need 2-node elements".into(),
+            "the paper's energy-momentum scheme needs 2-node elements".into(),
         ));
     }
     if !(settings.dt > 0.0 && settings.t_end > 0.0) {
@@ -425,7 +461,10 @@ pub fn solve(
         rec
     };
     on_step(&record(&state, &v, &w, &fext, 0.0, 0.0, None));
-    let (mut t, mut control) = (0.0f64, StepControl::new(settings));
+    let (mut t, mut control) = (
+        0.0f64,
+        StepControl::with(settings.dt, settings.max_halvings, GROW_AFTER),
+    );
     let mut driver_work = 0.0;
     while t < settings.t_end * (1.0 - 1e-12) {
         let dt = control.next(t, settings.t_end);

@@ -21,7 +21,10 @@ pub mod momentum;
 pub mod newmark;
 
 use crate::constraints::{MechanismState, Topology};
-use crate::error::{NewtonFailure, SolveError};
+pub(crate) use crate::step_control::StepControl;
+
+/// Easy time steps in a row before a halved step doubles again.
+pub(crate) const GROW_AFTER: usize = 4;
 use crate::mechanism::Mechanism;
 use crate::newton::NewtonSettings;
 use flexmech_core::MassKind;
@@ -87,81 +90,6 @@ impl Motion {
             w: vec![Vector3::zeros(); nodes],
             joint_rates: Vec::new(),
         }
-    }
-}
-
-/// Relative distance to a multiple of the nominal step below which a time is
-/// that multiple (round-off of summed steps: far below any halved step).
-const TIME_SNAP: f64 = 1e-9;
-
-/// Step-size control shared by the integrators: halve on failure, grow back
-/// (doubling) towards the nominal step after four easy steps in a row. The
-/// step never goes below `nominal / 2^max_halvings`: a step that fails at
-/// that size ends the run with a typed error — so a run whose solution blows
-/// up stops instead of creeping on with ever smaller steps.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct StepControl {
-    nominal: f64,
-    step: f64,
-    /// Halvings below the nominal step now in force.
-    level: usize,
-    easy: usize,
-    max_halvings: usize,
-}
-
-impl StepControl {
-    pub(crate) fn new(settings: &DynamicSettings) -> Self {
-        Self {
-            nominal: settings.dt,
-            step: settings.dt,
-            level: 0,
-            easy: 0,
-            max_halvings: settings.max_halvings,
-        }
-    }
-
-    /// The step to try from time `t` (never past `t_end`).
-    pub(crate) fn next(&self, t: f64, t_end: f64) -> f64 {
-        self.step.min(t_end - t)
-    }
-
-    /// The time after a converged step of `dt` from `t`: snapped to the
-    /// nearest multiple of the nominal step when it is one up to round-off,
-    /// so that stored times are `n·Δt` (not `0.9999999999999999`) however
-    /// many steps were summed.
-    pub(crate) fn advance(&self, t: f64, dt: f64) -> f64 {
-        let next = t + dt;
-        let n = (next / self.nominal).round();
-        if (next - n * self.nominal).abs() <= TIME_SNAP * self.nominal {
-            n * self.nominal
-        } else {
-            next
-        }
-    }
-
-    /// A step converged.
-    pub(crate) fn succeeded(&mut self) {
-        self.easy += 1;
-        if self.easy >= 4 && self.level > 0 {
-            self.level -= 1;
-            self.step = self.nominal / f64::powi(2.0, self.level as i32);
-            self.easy = 0;
-        }
-    }
-
-    /// A step to `time` failed: halve, or give up with the reason.
-    pub(crate) fn failed(&mut self, time: f64, reason: NewtonFailure) -> Result<(), SolveError> {
-        if self.level >= self.max_halvings {
-            return Err(SolveError::NoConvergence {
-                time,
-                halvings: self.level,
-                reason,
-            });
-        }
-        self.level += 1;
-        self.easy = 0;
-        self.step = self.nominal / f64::powi(2.0, self.level as i32);
-        Ok(())
     }
 }
 

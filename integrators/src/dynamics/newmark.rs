@@ -13,7 +13,7 @@
 //! screw example shows its energy growing until it fails.
 
 use super::midpoint::dynamic_record;
-use super::{slave_velocities, DynamicSettings, Motion, StepControl};
+use super::{slave_velocities, DynamicSettings, Motion, StepControl, GROW_AFTER};
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::SolveError;
@@ -251,7 +251,10 @@ pub fn solve(
         rec
     };
     on_step(&record(&state, &kin, &fext, 0.0, 0.0, None));
-    let (mut t, mut control) = (0.0f64, StepControl::new(settings));
+    let (mut t, mut control) = (
+        0.0f64,
+        StepControl::with(settings.dt, settings.max_halvings, GROW_AFTER),
+    );
     // The drivers' work, by the trapezoidal rule on their reactions at both
     // ends of each step (the first step uses its end value twice).
     let mut driver_work = 0.0;
