@@ -24,6 +24,8 @@ struct Work {
     r: DVector<f64>,
     k: DMatrix<f64>,
     g: DMatrix<f64>,
+    /// The rows' map, where some node's rows differ from its columns.
+    g_row: DMatrix<f64>,
     tmp: DMatrix<f64>,
     k_red: DMatrix<f64>,
 }
@@ -72,6 +74,7 @@ impl Assembler {
                 r: DVector::zeros(d),
                 k: DMatrix::zeros(d, d),
                 g: DMatrix::zeros(d, m),
+                g_row: DMatrix::zeros(d, m),
                 tmp: DMatrix::zeros(d, m),
                 k_red: DMatrix::zeros(m, m),
             });
@@ -152,20 +155,29 @@ impl Assembler {
             .for_each(|((w, (index, el)), s)| {
                 kernel(el, index, w.r.as_mut_slice(), w.k.as_mut_slice());
                 w.g.fill(0.0);
+                let split = el.nodes().iter().any(|&nd| dofs.nodes[nd].rows.is_some());
+                if split {
+                    w.g_row.fill(0.0);
+                }
                 for (a, &nd) in el.nodes().iter().enumerate() {
                     let map = &dofs.nodes[nd];
-                    for (eq, col) in map.eqs.iter().zip(&map.cols) {
+                    for (k, (eq, col)) in map.eqs.iter().zip(&map.cols).enumerate() {
                         let j = s
                             .eqs
                             .binary_search(eq)
                             .expect("element equation list is complete");
+                        let row = &map.rows()[k];
                         for d in 0..6 {
                             w.g[(6 * a + d, j)] += col[d];
+                            if split {
+                                w.g_row[(6 * a + d, j)] += row[d];
+                            }
                         }
                     }
                 }
                 w.tmp.gemm(1.0, &w.k, &w.g, 0.0);
-                w.k_red.gemm_tr(1.0, &w.g, &w.tmp, 0.0);
+                let rows = if split { &w.g_row } else { &w.g };
+                w.k_red.gemm_tr(1.0, rows, &w.tmp, 0.0);
             });
         self.values.iter_mut().for_each(|v| *v = 0.0);
         self.nodal.iter_mut().for_each(|v| *v = 0.0);
@@ -203,7 +215,7 @@ impl Assembler {
         k: &Matrix3<f64>,
     ) {
         let (mi, mj) = (&dofs.nodes[i], &dofs.nodes[j]);
-        for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
+        for (ei, ci) in mi.eqs.iter().zip(mi.rows()) {
             for (ej, cjv) in mj.eqs.iter().zip(&mj.cols) {
                 let v = ci.fixed_rows::<3>(ri).dot(&(k * cjv.fixed_rows::<3>(cj)));
                 if v != 0.0 {

@@ -152,14 +152,49 @@ impl Topology {
         }
     }
 
-    /// The local-to-global map of joint `j`: rows 0..6 the master's node map,
-    /// rows 6.. the released coordinates; columns follow `local_eqs[j]`.
-    fn local_map(&self, mech: &Mechanism, j: usize) -> DMatrix<f64> {
+    /// Sets every slave's rows to those of the incremental map `Ñ` of the
+    /// step `start → end` (`R_s = Ñ [R_m; E]`, masters first), so that the
+    /// assembled tangent's rows are those of the conserving schemes'
+    /// reduced residual `Ñᵀ g` ([`Topology::reduce_incremental`]).
+    pub fn refresh_rows(&mut self, mech: &Mechanism, start: &MechanismState, end: &MechanismState) {
+        for &j in &self.order {
+            let joint = &mech.joints[j];
+            let m = joint.master;
+            let n = JointStep::new(
+                joint.map.as_ref(),
+                [
+                    (&start.config.x[m], &start.config.rot[m]),
+                    (&end.config.x[m], &end.config.rot[m]),
+                ],
+                [&start.released[j], &end.released[j]],
+            )
+            .matrix();
+            let nm = n.fixed_columns::<6>(0).into_owned();
+            let mut rows: Vec<Vector6<f64>> =
+                self.dofs.nodes[m].rows().iter().map(|r| nm * r).collect();
+            for (c, eq) in self.released_eqs[j].iter().enumerate() {
+                if eq.is_some() {
+                    rows.push(n.column(6 + c).into_owned());
+                }
+            }
+            self.dofs.nodes[joint.slave].rows = Some(rows);
+        }
+    }
+
+    /// The local-to-global map of joint `j`: rows 0..6 the master's node map
+    /// (its rows when `rows`, else its columns), rows 6.. the released
+    /// coordinates; columns follow `local_eqs[j]`.
+    fn local_map(&self, mech: &Mechanism, j: usize, rows: bool) -> DMatrix<f64> {
         let joint = &mech.joints[j];
         let eqs = &self.local_eqs[j];
         let mut l = DMatrix::zeros(LOCAL, eqs.len());
         let master = &self.dofs.nodes[joint.master];
-        for (k, col) in master.cols.iter().enumerate() {
+        let map = if rows {
+            master.rows()
+        } else {
+            &master.cols[..]
+        };
+        for (k, col) in map.iter().enumerate() {
             l.fixed_view_mut::<6, 1>(0, k).copy_from(col);
         }
         let mut k = master.eqs.len();
@@ -198,9 +233,49 @@ impl Topology {
             for d in 0..6 {
                 acc[6 * m + d] += ntg[d];
             }
-            let l = self.local_map(mech, j);
+            let l = self.local_map(mech, j, false);
             let hd = DMatrix::from_column_slice(LOCAL, LOCAL, h.as_slice());
             blocks[j] = l.transpose() * hd * &l;
+        }
+        blocks
+    }
+
+    /// The joints' contribution to the conserving schemes' exact tangent,
+    /// `Σ_j L_j,rowᵀ ∂(Ñ_jᵀ g_s)/∂q L_j,col` with the slaves' residuals held
+    /// (deepest slaves first, each handing `Ñᵀ g_s` to its master, as
+    /// [`Topology::reduce_incremental`] does): `Ñ` follows the step's end
+    /// state (AD through `Ñ`, [`flexmech_joints::JointMap::incremental_transfer`]);
+    /// rows through the masters' rows, columns through their columns.
+    pub fn incremental_blocks(
+        &self,
+        mech: &Mechanism,
+        start: &MechanismState,
+        end: &MechanismState,
+        g: &[f64],
+    ) -> Vec<DMatrix<f64>> {
+        let mut acc = g.to_vec();
+        let mut blocks = vec![DMatrix::zeros(0, 0); mech.joints.len()];
+        for &j in self.order.iter().rev() {
+            let joint = &mech.joints[j];
+            let (m, s) = (joint.master, joint.slave);
+            let gs = Vector6::from_column_slice(&acc[6 * s..6 * s + 6]);
+            let (t, h) = joint.map.incremental_transfer(
+                [
+                    (&start.config.x[m], &start.config.rot[m]),
+                    (&end.config.x[m], &end.config.rot[m]),
+                ],
+                [&start.released[j], &end.released[j]],
+                &gs,
+            );
+            for d in 0..6 {
+                acc[6 * m + d] += t[d];
+            }
+            let (lr, lc) = (
+                self.local_map(mech, j, true),
+                self.local_map(mech, j, false),
+            );
+            let hd = DMatrix::from_column_slice(LOCAL, LOCAL, h.as_slice());
+            blocks[j] = lr.transpose() * hd * &lc;
         }
         blocks
     }

@@ -15,6 +15,18 @@ pub struct NodeMap {
     pub eqs: Vec<usize>,
     /// The column of each equation: `pₙ = Σₖ cols[k]·q[eqs[k]]`.
     pub cols: Vec<Vector6<f64>>,
+    /// The row of each equation through which the node's residual reaches
+    /// the reduced equations, when it differs from the column: a slave in
+    /// the conserving schemes (rows of the incremental map `Ñ`, columns of
+    /// the variational map `N`). `None`: the columns.
+    pub rows: Option<Vec<Vector6<f64>>>,
+}
+
+impl NodeMap {
+    /// The rows of the node's equations (the columns unless set apart).
+    pub fn rows(&self) -> &[Vector6<f64>] {
+        self.rows.as_deref().unwrap_or(&self.cols)
+    }
 }
 
 /// The unknowns of a mechanism and every node's map.

@@ -234,3 +234,47 @@ fn three_node_elements_carry_momentum_and_energy_through_every_joint_kind() {
         assert!(worst_c <= 1e-12, "{name}: constraint {worst_c:e}");
     }
 }
+
+/// Residuals above this are far from round-off (scaled residual).
+const ABOVE_ROUND_OFF: f64 = 1e-11;
+/// Quadratic convergence: `rₖ₊₁ ≤ C rₖ²` over the iterations above round-off.
+const QUADRATIC: f64 = 50.0;
+
+#[test]
+fn newton_converges_quadratically_with_joints_in_the_conserving_schemes() {
+    // Newton's tangent is the exact derivative of Ñᵀg: every pair of
+    // successive residuals above round-off satisfies rₖ₊₁ ≤ 50 rₖ². (With the
+    // end-point tangent of Nᵀg the convergence is linear, rₖ₊₁ ≈ 0.01–0.1 rₖ,
+    // and this fails.)
+    for (name, map) in kinds() {
+        let (mech, motion) = free_pair(map);
+        let mut s = settings(0.05, 0.5);
+        s.newton.tolerance = 1e-13;
+        for scheme in ["MC", "EM"] {
+            let mut steps: Vec<StepRecord> = Vec::new();
+            let push = |r: &StepRecord| steps.push(r.clone());
+            if scheme == "MC" {
+                momentum::solve(&mech, &s, &motion, push)
+            } else {
+                energy_momentum::solve(&mech, &s, &motion, push)
+            }
+            .unwrap_or_else(|e| panic!("{name} {scheme}: {e}"));
+            let mut worst = 0.0f64;
+            for r in &steps[1..] {
+                for w in r.residual_history.windows(2) {
+                    if w[1] > ABOVE_ROUND_OFF {
+                        worst = worst.max(w[1] / (w[0] * w[0]));
+                    }
+                }
+            }
+            eprintln!(
+                "{name:12} {scheme}: max r(k+1)/r(k)² = {worst:.2e}; history of step 5: {:?}",
+                steps[5].residual_history
+            );
+            assert!(
+                worst <= QUADRATIC,
+                "{name} {scheme}: r(k+1)/r(k)² up to {worst:e}"
+            );
+        }
+    }
+}

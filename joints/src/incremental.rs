@@ -30,28 +30,30 @@
 use crate::kinematics::{
     Increments, JointKinematics, JointMap, ReleasedState, LOCAL, MAX_RELEASED,
 };
-use flexmech_core::rotation::{cayley_inverse, skew};
-use flexmech_core::Scalar;
+use flexmech_core::rotation::{cayley_inverse, exp, skew};
+use flexmech_core::{cst, Scalar};
 use nalgebra::{Const, Matrix3, SMatrix, SVector, Vector3, Vector6, U1};
 use num_dual::HyperDualSVec64;
 
 /// A node's pose: position and rotation.
 pub type NodePose<'a> = (&'a Vector3<f64>, &'a Matrix3<f64>);
 
-/// The incremental map `Ñ` of one joint over one step (see the module docs).
+/// The incremental map `Ñ` of one joint over one step (see the module docs),
+/// generic over the scalar so that its derivative with respect to the end
+/// state comes by automatic differentiation.
 #[derive(Debug, Clone, PartialEq)]
-pub struct JointStep {
+pub struct JointStep<T: Scalar = f64> {
     /// Mid-step slave offset `d = x̄_s − x̄_m`.
-    pub offset: Vector3<f64>,
+    pub offset: Vector3<T>,
     /// `(I − ¼θ̂_m²) Λ̄_m`: released translation increment → slave displacement.
-    pub lever: Matrix3<f64>,
+    pub lever: Matrix3<T>,
     /// `A`: released rotation increment → slave rotation increment.
-    pub a: Matrix3<f64>,
+    pub a: Matrix3<T>,
     /// `B`: released increments `τ` → `(u_R, θ_R)`.
-    pub b: SMatrix<f64, 6, MAX_RELEASED>,
+    pub b: SMatrix<T, 6, MAX_RELEASED>,
 }
 
-impl JointStep {
+impl JointStep<f64> {
     /// `Ñ` of joint `map` for the master's poses at both ends of the step and
     /// the released states at both ends.
     pub fn new(
@@ -59,30 +61,51 @@ impl JointStep {
         master: [NodePose<'_>; 2],
         released: [&ReleasedState; 2],
     ) -> Self {
+        map.incremental_step(master, released)
+    }
+}
+
+impl<T: Scalar> JointStep<T> {
+    /// `Ñ` of `joint` over a step whose end is seeded: the master's end pose
+    /// `(x₁ + δx, exp(δφ̂) R₁)` and the released end state `end ⊕ inc`, with
+    /// `δ = (δx, δφ)` given as `seed`.
+    pub fn of<J: JointKinematics + ?Sized>(
+        joint: &J,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+        seed: &[T; 6],
+        inc: &[T; MAX_RELEASED],
+    ) -> Self {
         let [(x0, r0), (x1, r1)] = master;
+        let zero = [T::zero(); MAX_RELEASED];
+        let x0 = x0.map(cst::<T>);
+        let r0 = r0.map(cst::<T>);
+        let x1 = x1.map(cst::<T>) + Vector3::new(seed[0], seed[1], seed[2]);
+        let r1 = exp(&Vector3::new(seed[3], seed[4], seed[5])) * r1.map(cst::<T>);
         let theta_m = cayley_inverse(&(r1 * r0.transpose()));
-        let (xs0, _) = map.slave(x0, r0, released[0]);
-        let (xs1, _) = map.slave(x1, r1, released[1]);
-        let offset = (xs0 + xs1 - x0 - x1) * 0.5;
+        let (rr0, l0) = released_at(joint, released[0], &zero);
+        let (rr1, l1) = released_at(joint, released[1], inc);
+        let (xs0, xs1) = (x0 + r0 * rr0, x1 + r1 * rr1);
+        let half = cst::<T>(0.5);
+        let quarter = cst::<T>(0.25);
+        let offset = (xs0 + xs1 - x0 - x1) * half;
         let tm = skew(&theta_m);
-        let lever = (Matrix3::identity() - tm * tm * 0.25) * ((r0 + r1) * 0.5);
-        let (_, l0) = map.released_placement(released[0]);
-        let (_, l1) = map.released_placement(released[1]);
+        let lever = (Matrix3::identity() - tm * tm * quarter) * ((r0 + r1) * half);
         let theta_r = r0 * cayley_inverse(&(l1 * l0.transpose()));
-        let a = (Matrix3::identity() + tm * 0.5 + theta_m * theta_m.transpose() * 0.25) * r0
-            / (1.0 - 0.25 * theta_m.dot(&theta_r));
+        let a = (Matrix3::identity() + tm * half + theta_m * theta_m.transpose() * quarter) * r0
+            / (T::one() - theta_m.dot(&theta_r) * quarter);
         Self {
             offset,
             lever,
             a,
-            b: map.step_map(released[0], released[1]),
+            b: joint.step_map(released[0], released[1], inc),
         }
     }
 
     /// `Ñ` as a matrix over the local increments `(u_m, θ_m, τ)` (the column
     /// layout of [`crate::JointMap::variation`]).
-    pub fn matrix(&self) -> SMatrix<f64, 6, LOCAL> {
-        let mut n = SMatrix::<f64, 6, LOCAL>::zeros();
+    pub fn matrix(&self) -> SMatrix<T, 6, LOCAL> {
+        let mut n = SMatrix::<T, 6, LOCAL>::zeros();
         n.fixed_view_mut::<3, 3>(0, 0)
             .copy_from(&Matrix3::identity());
         n.fixed_view_mut::<3, 3>(0, 3)
@@ -101,10 +124,10 @@ impl JointStep {
     /// `Ñᵀ g` for the slave's nodal residual `g = (force, moment)`: the
     /// master receives the force and the moment `d × force + moment`; the
     /// released equations `Bᵀ (leverᵀ force, Aᵀ moment)`.
-    pub fn transfer(&self, g: &Vector6<f64>) -> SVector<f64, LOCAL> {
+    pub fn transfer(&self, g: &Vector6<T>) -> SVector<T, LOCAL> {
         let f = g.fixed_rows::<3>(0).into_owned();
         let m = g.fixed_rows::<3>(3).into_owned();
-        let mut out = SVector::<f64, LOCAL>::zeros();
+        let mut out = SVector::<T, LOCAL>::zeros();
         out.fixed_rows_mut::<3>(0).copy_from(&f);
         out.fixed_rows_mut::<3>(3)
             .copy_from(&(self.offset.cross(&f) + m));
@@ -129,41 +152,50 @@ const TAYLOR_BELOW: f64 = 1e-6;
 /// [`JointKinematics::step_map`]): along the path that changes one coordinate
 /// after the other, `F(q) = (r_R(q) − r_R(qₙ), cay⁻¹(Λ_R(q) Λ_R(qₙ)ᵀ))`,
 /// column `k` is the divided difference `(F(Pₖ) − F(Pₖ₋₁))/τₖ` with
-/// `τₖ = qₖ,ₙ₊₁ − qₖ,ₙ`. The columns telescope, so `B τ = F(qₙ₊₁)` exactly;
-/// increments below `1e-6` use `F′ + ½F″τₖ` (hyper-dual numbers) so the
-/// column stays accurate as `τₖ → 0` and tends to `N`'s column.
-pub fn additive_step_map<J: JointKinematics + ?Sized>(
+/// `τₖ = qₖ,ₙ₊₁ − qₖ,ₙ` (the end state is `end ⊕ inc`). The columns
+/// telescope, so `B τ = F(qₙ₊₁)` exactly; increments below `1e-6` use
+/// `F′(Pₖ₋₁) + ½F″(Pₖ₋₁)τₖ` (hyper-dual numbers) so the column stays accurate
+/// as `τₖ → 0` and tends to `N`'s column. The Taylor column follows `τₖ`
+/// exactly under automatic differentiation; for `k ≥ 1` its dependence on the
+/// earlier coordinates' end values (through `Pₖ₋₁`) is not followed.
+pub fn additive_step_map<J: JointKinematics + ?Sized, T: Scalar>(
     joint: &J,
     start: &ReleasedState,
     end: &ReleasedState,
-) -> SMatrix<f64, 6, MAX_RELEASED> {
+    inc: &[T; MAX_RELEASED],
+) -> SMatrix<T, 6, MAX_RELEASED> {
     type H = HyperDualSVec64<1, 1>;
     let (r_n, l_n) = released_at(joint, start, &[0.0; MAX_RELEASED]);
-    let mut b = SMatrix::<f64, 6, MAX_RELEASED>::zeros();
-    let mut point = *start;
+    let tau: [T; MAX_RELEASED] = std::array::from_fn(|k| cst::<T>(end.q[k] - start.q[k]) + inc[k]);
+    // F at the path point with the first `upto` coordinates at their end values.
+    let f = |upto: usize| -> Vector6<T> {
+        let d: [T; MAX_RELEASED] =
+            std::array::from_fn(|i| if i < upto { tau[i] } else { T::zero() });
+        let (r, l) = released_at(joint, start, &d);
+        stack(
+            &(r - r_n.map(cst::<T>)),
+            &cayley_inverse(&(l * l_n.map(cst::<T>).transpose())),
+        )
+    };
+    let mut b = SMatrix::<T, 6, MAX_RELEASED>::zeros();
     for k in 0..J::RELEASED {
-        let tau = end.q[k] - start.q[k];
-        let column: Vector6<f64> = if tau.abs() >= TAYLOR_BELOW {
-            let f = |p: &ReleasedState| {
-                let (r, l) = released_at(joint, p, &[0.0; MAX_RELEASED]);
-                stack(&(r - r_n), &cayley_inverse(&(l * l_n.transpose())))
-            };
-            let mut next = point;
-            next.q[k] = end.q[k];
-            (f(&next) - f(&point)) / tau
+        let column: Vector6<T> = if tau[k].value().abs() >= TAYLOR_BELOW {
+            (f(k + 1) - f(k)) / tau[k]
         } else {
-            let mut inc = [H::from_re(0.0); MAX_RELEASED];
-            inc[k] = H::from_re(0.0).derivative1(0).derivative2(0);
-            let (r, l) = released_at(joint, &point, &inc);
+            let mut d = [H::from_re(0.0); MAX_RELEASED];
+            for (i, di) in d.iter_mut().enumerate().take(k) {
+                *di = H::from_re(tau[i].value());
+            }
+            d[k] = H::from_re(0.0).derivative1(0).derivative2(0);
+            let (r, l) = released_at(joint, start, &d);
             let dr = r - r_n.map(H::from_re);
             let th = cayley_inverse(&(l * l_n.map(H::from_re).transpose()));
             let d1 = |v: H| v.eps1.unwrap_generic(Const::<1>, U1)[0];
             let d2 = |v: H| v.eps1eps2.unwrap_generic(Const::<1>, Const::<1>)[0];
-            let taylor = |v: H| d1(v) + 0.5 * d2(v) * tau;
+            let taylor = |v: H| cst::<T>(d1(v)) + tau[k] * cst::<T>(0.5 * d2(v));
             stack(&dr.map(taylor), &th.map(taylor))
         };
         b.set_column(k, &column);
-        point.q[k] = end.q[k];
     }
     b
 }
@@ -183,6 +215,6 @@ fn released_at<J: JointKinematics + ?Sized, T: Scalar>(
     )
 }
 
-fn stack(a: &Vector3<f64>, b: &Vector3<f64>) -> Vector6<f64> {
+fn stack<T: Scalar>(a: &Vector3<T>, b: &Vector3<T>) -> Vector6<T> {
     Vector6::new(a.x, a.y, a.z, b.x, b.y, b.z)
 }

@@ -18,6 +18,7 @@
 //! variational map `N` of paper eqs 5–6 (`p_s = N p_Rm`) and the derivative of
 //! `Nᵀ g` that Newton's tangent needs. No kind writes a derivative by hand.
 
+use crate::incremental::{JointStep, NodePose};
 use flexmech_core::rotation::{exp, skew};
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Const, Matrix3, SMatrix, SVector, Vector3, Vector6, U1};
@@ -102,13 +103,16 @@ pub trait JointKinematics: Send + Sync + Debug {
     /// `u_R = r_R,ₙ₊₁ − r_R,ₙ` and `θ_R = cay⁻¹(Λ_R,ₙ₊₁ Λ_R,ₙᵀ)` (paper eq. 22;
     /// see [`crate::incremental`]). The default, for additive coordinates
     /// (`τ = qₙ₊₁ − qₙ`), is [`crate::incremental::additive_step_map`]; a kind
-    /// with a multiplicative rotation overrides it.
-    fn step_map(
+    /// with a multiplicative rotation overrides it. The end state is
+    /// `end ⊕ inc` (`inc` as in [`JointKinematics::released`]), so that
+    /// automatic differentiation can follow `B` as the end state moves.
+    fn step_map<T: Scalar>(
         &self,
         start: &ReleasedState,
         end: &ReleasedState,
-    ) -> SMatrix<f64, 6, MAX_RELEASED> {
-        crate::incremental::additive_step_map(self, start, end)
+        inc: &[T; MAX_RELEASED],
+    ) -> SMatrix<T, 6, MAX_RELEASED> {
+        crate::incremental::additive_step_map(self, start, end, inc)
     }
 
     /// The released rotation angle reported as `/joints/<name>/angle`.
@@ -157,6 +161,26 @@ pub trait JointMap: Send + Sync + Debug {
         state: &ReleasedState,
         g: &Vector6<f64>,
     ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>);
+    /// The incremental map `Ñ` over a step (paper eqs 21–23, [`JointStep`]),
+    /// for the master's poses and the released states at both ends.
+    fn incremental_step(
+        &self,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+    ) -> JointStep;
+
+    /// `Ñᵀ g` for a slave residual `g` held fixed, and its exact derivative
+    /// with respect to the local increments of the step's end state —
+    /// the master's end pose (`x ← x + δx`, `R ← exp(δφ̂)R`) and the released
+    /// coordinates — by forward-mode AD through `Ñ` (the conserving schemes'
+    /// Newton tangent; unused released columns are zero).
+    fn incremental_transfer(
+        &self,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+        g: &Vector6<f64>,
+    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>);
+
     /// `B` with `(u_R, θ_R) = B τ` over a step (see [`JointKinematics::step_map`]).
     fn step_map(&self, start: &ReleasedState, end: &ReleasedState)
         -> SMatrix<f64, 6, MAX_RELEASED>;
@@ -282,12 +306,45 @@ impl<J: JointKinematics> JointMap for J {
         (ntg, k)
     }
 
+    fn incremental_step(
+        &self,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+    ) -> JointStep {
+        JointStep::of(self, master, released, &[0.0; 6], &[0.0; MAX_RELEASED])
+    }
+
+    fn incremental_transfer(
+        &self,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+        g: &Vector6<f64>,
+    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>) {
+        type D = DualSVec64<LOCAL>;
+        let e: [D; LOCAL] = std::array::from_fn(|i| D::from_re(0.0).derivative(i));
+        let seed: [D; 6] = std::array::from_fn(|i| e[i]);
+        let inc: [D; MAX_RELEASED] = std::array::from_fn(|i| e[6 + i]);
+        let step = JointStep::of(self, master, released, &seed, &inc);
+        let t = step.transfer(&g.map(D::from_re));
+        let mut value = t.map(|v| v.re);
+        let mut k = SMatrix::<f64, LOCAL, LOCAL>::zeros();
+        for r in 0..LOCAL {
+            k.set_row(r, &t[r].eps.unwrap_generic(Const::<LOCAL>, U1).transpose());
+        }
+        for c in 6 + J::RELEASED..LOCAL {
+            value[c] = 0.0;
+            k.row_mut(c).fill(0.0);
+            k.column_mut(c).fill(0.0);
+        }
+        (value, k)
+    }
+
     fn step_map(
         &self,
         start: &ReleasedState,
         end: &ReleasedState,
     ) -> SMatrix<f64, 6, MAX_RELEASED> {
-        JointKinematics::step_map(self, start, end)
+        JointKinematics::step_map(self, start, end, &[0.0; MAX_RELEASED])
     }
 
     fn advance(&self, state: &mut ReleasedState, delta: &[f64]) {

@@ -30,12 +30,13 @@ impl JointKinematics for Spherical {
 
     /// The released increment is the rotation increment itself: `τ = θ_R`,
     /// `B = [0; I]`.
-    fn step_map(
+    fn step_map<T: Scalar>(
         &self,
         _start: &ReleasedState,
         _end: &ReleasedState,
-    ) -> SMatrix<f64, 6, MAX_RELEASED> {
-        let mut b = SMatrix::<f64, 6, MAX_RELEASED>::zeros();
+        _inc: &[T; MAX_RELEASED],
+    ) -> SMatrix<T, 6, MAX_RELEASED> {
+        let mut b = SMatrix::<T, 6, MAX_RELEASED>::zeros();
         b.fixed_view_mut::<3, 3>(3, 0)
             .copy_from(&Matrix3::identity());
         b

@@ -1332,3 +1332,90 @@ fn a_custom_joint_needs_only_its_profile() {
         },
     );
 }
+
+/// Central differences of `Ñᵀg` (quotients over `τ` inside `B`) agree with
+/// the derivative to their own truncation and round-off, ~1e-6 relative.
+const FD_TOL: f64 = 1e-5;
+
+#[test]
+fn incremental_transfer_derivative_matches_differences() {
+    property(
+        "6d. d(Ntilde^T g)/d(end state) by AD = central differences, every kind",
+        CASES,
+        (
+            params(),
+            released(),
+            pose(),
+            vec3(-1.0, 1.0),
+            vec3(-0.7, 0.7),
+            (
+                released_increment(),
+                released_increment(),
+                released_increment(),
+            ),
+        ),
+        |(p, q, m, u_m, w_m, (d0, d1, d2)), w| {
+            let theta_m = flexmech_core::rotation::tan_scaled(&w_m);
+            let (x1, r1) = (m.x + u_m, cayley(&theta_m) * m.r);
+            let g = Vector6::new(d0 + 0.2, 1.0, -2.0, 0.5, d1 + 0.3, -0.7);
+            for kind in all_kinds(&p, &q) {
+                if kind.skip_second_fd {
+                    continue;
+                }
+                let end = step_of(&kind, &[d0, d1, d2]);
+                let k = kind.map.released_count();
+                let at = |e: &SVector<f64, LOCAL>| {
+                    let x = x1 + e.fixed_rows::<3>(0);
+                    let r = flexmech_core::rotation::exp(&e.fixed_rows::<3>(3).into_owned()) * r1;
+                    let mut rel = end;
+                    let inc: Vec<f64> = (0..k).map(|c| e[6 + c]).collect();
+                    kind.map.advance(&mut rel, &inc);
+                    kind.map
+                        .incremental_step([(&m.x, &m.r), (&x, &r)], [&kind.state, &rel])
+                        .transfer(&g)
+                };
+                let (value, ad) = kind.map.incremental_transfer(
+                    [(&m.x, &m.r), (&x1, &r1)],
+                    [&kind.state, &end],
+                    &g,
+                );
+                // The same arithmetic in duals and in f64, up to the divided
+                // difference's cancellation (eps/τ at τ ≥ 1e-6).
+                w.check(
+                    &format!("{}: value", kind.name),
+                    (value - at(&SVector::zeros())).norm() / (1.0 + value.norm()),
+                    1e-9,
+                )?;
+                for c in 0..6 + k {
+                    // B switches form at |τ| = 1e-6: a released column whose
+                    // τ lies near it has no smooth stencil (skip it); a τ
+                    // below it takes a stencil that stays in the Taylor form.
+                    let tau = if c >= 6 && !kind.spherical {
+                        (end.q[c - 6] - kind.state.q[c - 6]).abs()
+                    } else {
+                        1.0
+                    };
+                    if (0.5e-6..=2e-6).contains(&tau) {
+                        continue;
+                    }
+                    // The divided difference inside B carries eps|F|/τ of
+                    // round-off: the stencil grows with τ to keep it below FD_TOL.
+                    let h = if tau < 1e-5 {
+                        1e-8
+                    } else {
+                        (0.1 * tau).clamp(1e-6, 1e-4)
+                    };
+                    let mut e = SVector::<f64, LOCAL>::zeros();
+                    e[c] = h;
+                    let fd = (at(&e) - at(&(-e))) / (2.0 * h);
+                    w.check(
+                        &format!("{}: column {c}", kind.name),
+                        (fd - ad.column(c)).norm() / (1.0 + ad.column(c).norm()),
+                        FD_TOL,
+                    )?;
+                }
+            }
+            Ok(())
+        },
+    );
+}
