@@ -11,7 +11,7 @@ use crate::record::JointRecord;
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::Configuration;
 use flexmech_joints::{JointStep, ReleasedState, LOCAL};
-use nalgebra::{DMatrix, Matrix3, Vector3, Vector6};
+use nalgebra::{DMatrix, Matrix3, SMatrix, SVector, Vector3, Vector6};
 
 /// Positions and rotations of every node and the released coordinates of
 /// every joint: the complete state of a mechanism.
@@ -218,26 +218,14 @@ impl Topology {
         state: &MechanismState,
         g: &[f64],
     ) -> Vec<DMatrix<f64>> {
-        let mut acc = g.to_vec();
-        let mut blocks = vec![DMatrix::zeros(0, 0); mech.joints.len()];
-        for &j in self.order.iter().rev() {
-            let joint = &mech.joints[j];
-            let (m, s) = (joint.master, joint.slave);
-            let gs = Vector6::from_column_slice(&acc[6 * s..6 * s + 6]);
-            let (ntg, h) = joint.map.transfer(
+        self.joint_blocks(mech, g, false, |j, m, gs| {
+            mech.joints[j].map.transfer(
                 &state.config.x[m],
                 &state.config.rot[m],
                 &state.released[j],
-                &gs,
-            );
-            for d in 0..6 {
-                acc[6 * m + d] += ntg[d];
-            }
-            let l = self.local_map(mech, j, false);
-            let hd = DMatrix::from_column_slice(LOCAL, LOCAL, h.as_slice());
-            blocks[j] = l.transpose() * hd * &l;
-        }
-        blocks
+                gs,
+            )
+        })
     }
 
     /// The joints' contribution to the conserving schemes' exact tangent,
@@ -253,25 +241,44 @@ impl Topology {
         end: &MechanismState,
         g: &[f64],
     ) -> Vec<DMatrix<f64>> {
-        let mut acc = g.to_vec();
-        let mut blocks = vec![DMatrix::zeros(0, 0); mech.joints.len()];
-        for &j in self.order.iter().rev() {
-            let joint = &mech.joints[j];
-            let (m, s) = (joint.master, joint.slave);
-            let gs = Vector6::from_column_slice(&acc[6 * s..6 * s + 6]);
-            let (t, h) = joint.map.incremental_transfer(
+        self.joint_blocks(mech, g, true, |j, m, gs| {
+            mech.joints[j].map.incremental_transfer(
                 [
                     (&start.config.x[m], &start.config.rot[m]),
                     (&end.config.x[m], &end.config.rot[m]),
                 ],
                 [&start.released[j], &end.released[j]],
-                &gs,
-            );
+                gs,
+            )
+        })
+    }
+
+    /// One dense block per joint from `transfer(j, master, g_s) = (Pᵀ g_s,
+    /// ∂(Pᵀ g_s)/∂local)` of its slave's accumulated residual, deepest slaves
+    /// first (each hands `Pᵀ g_s` to its master); rows through the masters'
+    /// rows when `rows`, else their columns.
+    fn joint_blocks(
+        &self,
+        mech: &Mechanism,
+        g: &[f64],
+        rows: bool,
+        transfer: impl Fn(
+            usize,
+            usize,
+            &Vector6<f64>,
+        ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>),
+    ) -> Vec<DMatrix<f64>> {
+        let mut acc = g.to_vec();
+        let mut blocks = vec![DMatrix::zeros(0, 0); mech.joints.len()];
+        for &j in self.order.iter().rev() {
+            let (m, s) = (mech.joints[j].master, mech.joints[j].slave);
+            let gs = Vector6::from_column_slice(&acc[6 * s..6 * s + 6]);
+            let (t, h) = transfer(j, m, &gs);
             for d in 0..6 {
                 acc[6 * m + d] += t[d];
             }
             let (lr, lc) = (
-                self.local_map(mech, j, true),
+                self.local_map(mech, j, rows),
                 self.local_map(mech, j, false),
             );
             let hd = DMatrix::from_column_slice(LOCAL, LOCAL, h.as_slice());
