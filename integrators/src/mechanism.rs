@@ -100,17 +100,27 @@ impl Mechanism {
         }
     }
 
-    /// The round-off floor of a residual norm: `4·eps·‖(force scale of each
-    /// element)‖₂` (see [`flexmech_core::Element::force_scale`]), with the
-    /// model's size taken as twice its initial radius about the origin. Below it
-    /// a residual is rounding noise, whatever the loads: long meshes of short,
-    /// axially stiff elements far from the origin have the highest floors.
+    /// The round-off floor of a residual norm in the initial configuration
+    /// (see [`Mechanism::round_off_floor_at`]).
     pub fn round_off_floor(&self) -> f64 {
+        self.round_off_floor_at(&self.mesh.positions)
+    }
+
+    /// The round-off floor of a residual norm with the nodes at `positions`:
+    /// `4·eps·‖(force scale of each element)‖₂` (see
+    /// [`flexmech_core::Element::force_scale`]), with the model's size taken as
+    /// twice its radius about the origin — the larger of the initial one and
+    /// the current one, since rounding grows with the coordinates as a
+    /// mechanism travels. Below it a residual is rounding noise, whatever the
+    /// loads: long meshes of short, axially stiff elements far from the
+    /// origin have the highest floors.
+    pub fn round_off_floor_at(&self, positions: &[Vector3<f64>]) -> f64 {
         let radius = 2.0
             * self
                 .mesh
                 .positions
                 .iter()
+                .chain(positions)
                 .map(|x| x.norm())
                 .fold(0.0, f64::max);
         let sum: f64 = self

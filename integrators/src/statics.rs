@@ -201,6 +201,7 @@ pub fn solve_static(
         let target = (lambda + control.step()).min(next_planned);
         let target = if target > 1.0 - 1e-12 { 1.0 } else { target };
         let saved = prob.state.clone();
+        prob.floor = mech.round_off_floor_at(&prob.state.config.x);
         if let (true, Some((before, before_step))) = (driven, &previous) {
             prob.topo.extrapolate(
                 mech,

@@ -79,16 +79,21 @@ fn missing_file_and_unsupported_features_are_named() {
         stderr.contains("/nonexistent/model.toml") && stderr.contains("cannot read"),
         "{stderr}"
     );
-    // Quadratic elements in a conserving scheme are valid model syntax but
-    // not solvable: refused with the key named, and nothing half-solved.
+    // Quadratic elements in the paper's energy–momentum scheme are valid
+    // model syntax but not solvable (the paper's force is the 2-node one):
+    // refused with the key named, and nothing half-solved.
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("dyn.toml");
     let spinning =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/dynamics/spinning_beam.toml");
     let text = std::fs::read_to_string(spinning)
         .unwrap()
-        .replace("elements = 10", "elements = 5\nnodes_per_element = 3");
-    assert!(text.contains("nodes_per_element = 3"));
+        .replace("elements = 10", "elements = 5\nnodes_per_element = 3")
+        .replace(
+            "integrator = \"energy-momentum\"",
+            "integrator = \"energy-momentum-paper\"",
+        );
+    assert!(text.contains("nodes_per_element = 3") && text.contains("energy-momentum-paper"));
     std::fs::write(&model, text).unwrap();
     let out = flexmech()
         .arg("run")

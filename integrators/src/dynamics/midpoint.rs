@@ -510,7 +510,7 @@ pub fn solve(
             nodal: vec![0.0; 6 * nodes],
             inertia_abs: vec![0.0; 6 * nodes],
             scratch: vec![0.0; n_eq],
-            floor: mech.round_off_floor(),
+            floor: mech.round_off_floor_at(&state.config.x),
         };
         let outcome = match scheme {
             Scheme::Momentum => newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq)

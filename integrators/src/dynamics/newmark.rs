@@ -285,7 +285,7 @@ pub fn solve(
             nodal: vec![0.0; 6 * nodes],
             abs: vec![0.0; 6 * nodes],
             scratch: vec![0.0; n_eq],
-            floor: mech.round_off_floor(),
+            floor: mech.round_off_floor_at(&state.config.x),
         };
         match newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq) {
             Ok(report) => {
