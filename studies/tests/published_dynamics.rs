@@ -285,6 +285,7 @@ fn right_angle_cantilever_published_extremes() {
         let run = Run::completed(CANTILEVER, integrator, None);
         let t = run.time();
         assert!((t.last().unwrap() - 30.0).abs() < 1e-9);
+        run.assert_no_halvings(0.05, &what);
         let z = |label: &str| -> Vec<f64> {
             run.rows(&format!("/nodes/{label}/displacement"))
                 .iter()
@@ -433,6 +434,7 @@ fn flying_spaghetti_free_flight_is_conservative() {
         let run = Run::completed(SPAGHETTI, integrator, None);
         let t = run.time();
         assert!((t.last().unwrap() - 15.0).abs() < 1e-9);
+        run.assert_no_halvings(0.1, &what);
         let lin = run.rows("/momentum/linear");
         let l = lin.last().unwrap();
         assert!(
