@@ -77,6 +77,11 @@ impl<const N: usize> BeamElement<N> {
         &self.strain0[..N - 1]
     }
 
+    /// Nodal triads `Λᵢ = Rᵢ Λ₀ᵢ` (public form of the kernels' helper).
+    pub fn nodal_triads(&self, rot: &[Matrix3<f64>; N]) -> [Matrix3<f64>; N] {
+        self.triads(rot)
+    }
+
     /// Nodal triads `Λᵢ = Rᵢ Λ₀ᵢ`.
     pub(crate) fn triads<T: Scalar>(&self, rot: &[Matrix3<T>; N]) -> [Matrix3<T>; N] {
         std::array::from_fn(|i| rot[i] * self.lambda0[i].map(cst::<T>))

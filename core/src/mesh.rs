@@ -3,7 +3,7 @@
 //! numbering is global and contiguous per beam.
 
 use crate::element::BeamElement;
-use crate::rotation::exp;
+use crate::rotation::{exp, log};
 use crate::section::Section;
 use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
@@ -91,6 +91,38 @@ impl Element {
         }
     }
 
+    /// The rotation vectors between the element's nodal triads that its
+    /// interpolation takes principal logarithms of: `log(Λ₁ᵀΛ₂)` (2-node), or
+    /// `log(Λ_rᵀΛᵢ)` of the end nodes relative to the middle one (3-node). A
+    /// logarithm is principal (`|·| ≤ π`): past π it wraps silently, so the
+    /// solvers watch these ([`Element::ROTATION_LIMIT`]).
+    pub fn relative_rotations(&self, rot: &[Matrix3<f64>]) -> Vec<Vector3<f64>> {
+        match self {
+            Element::Linear(e) => {
+                let (_, r) = gather(&e.nodes, &[], rot);
+                let l = e.nodal_triads(&r);
+                vec![log(&(l[0].transpose() * l[1]))]
+            }
+            Element::Quadratic(e) => {
+                let (_, r) = gather(&e.nodes, &[], rot);
+                let l = e.nodal_triads(&r);
+                vec![
+                    log(&(l[1].transpose() * l[0])),
+                    log(&(l[1].transpose() * l[2])),
+                ]
+            }
+        }
+    }
+
+    /// The largest rotation between an element's nodes that a solution may
+    /// reach (3π/4): well short of the logarithm's branch cut at π, so a
+    /// step that would cross it is caught before it can wrap.
+    pub const ROTATION_LIMIT: f64 = 0.75 * std::f64::consts::PI;
+
+    /// The largest change of those rotations in one step (π/2): a wrap
+    /// turns the vector by almost 2π, far beyond it.
+    pub const ROTATION_STEP_LIMIT: f64 = 0.5 * std::f64::consts::PI;
+
     /// Residual (internal force, `6N`) and tangent (`6N × 6N`, column-major)
     /// in a global configuration, written into `r` and `k`.
     pub fn residual_tangent(
@@ -123,7 +155,7 @@ fn gather<const N: usize>(
     rot: &[Matrix3<f64>],
 ) -> ([Vector3<f64>; N], [Matrix3<f64>; N]) {
     (
-        std::array::from_fn(|i| x[nodes[i]]),
+        std::array::from_fn(|i| x.get(nodes[i]).copied().unwrap_or_default()),
         std::array::from_fn(|i| rot[nodes[i]]),
     )
 }

@@ -15,6 +15,38 @@ pub enum SolveError {
     /// The tangent could not be factorised (a mechanism or unsupported DOF).
     #[error("singular tangent: {0}")]
     Singular(String),
+    /// An element turned too far between its nodes for its interpolation to
+    /// follow (see [`crate::rotation_guard`]); `beam` names it where the
+    /// caller knows the beams (empty otherwise).
+    #[error(
+        "element {element}{beam} turns by {angle:.3} rad between its nodes at t = {time} \
+         (by {change:.3} rad in the last step): an element's interpolation follows at most \
+         {limit:.3} rad between its nodes, {step_limit:.3} rad per step (it would wrap past π \
+         and lose the strain); use more elements, or smaller steps",
+        limit = flexmech_core::Element::ROTATION_LIMIT,
+        step_limit = flexmech_core::Element::ROTATION_STEP_LIMIT
+    )]
+    ElementRotation {
+        element: usize,
+        beam: String,
+        time: f64,
+        angle: f64,
+        change: f64,
+    },
+    /// A prescribed nodal rotation changed by more than the step limit in one
+    /// step (see [`crate::rotation_guard`]).
+    #[error(
+        "prescribed[{index}] turns its node by {change:.3} rad in the step to t = {time}: a \
+         prescribed rotation is applied as one rotation by the change of its value, which is \
+         ambiguous past π (2π is no rotation at all); keep it below {limit:.3} rad per step \
+         with more load steps (statics) or a smaller dt (dynamics)",
+        limit = flexmech_core::Element::ROTATION_STEP_LIMIT
+    )]
+    PrescribedRotationStep {
+        index: usize,
+        time: f64,
+        change: f64,
+    },
     /// The mechanism is inconsistent (for example a DOF that no element touches).
     #[error("invalid mechanism: {0}")]
     InvalidMechanism(String),

@@ -11,6 +11,7 @@ pub mod linsolve;
 pub mod mechanism;
 pub mod newton;
 pub mod record;
+pub mod rotation_guard;
 pub mod statics;
 pub mod step_control;
 

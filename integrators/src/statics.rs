@@ -14,6 +14,7 @@ use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonSettings, NewtonSystem};
 use crate::record::{Energies, StepRecord};
+use crate::rotation_guard::RotationGuard;
 use crate::step_control::StepControl;
 use flexmech_core::Configuration;
 use nalgebra::Vector3;
@@ -181,6 +182,7 @@ pub fn solve_static(
     let (mut r, mut dq) = (vec![0.0; n], vec![0.0; n]);
     let nominal = 1.0 / settings.load_steps as f64;
     let mut control = StepControl::with(nominal, settings.max_halvings, GROW_AFTER);
+    let mut guard = RotationGuard::new(mech, &prob.state);
     let (mut lambda, mut steps) = (0.0f64, 0usize);
     // Kinematically driven mechanisms start each step from the secant
     // prediction, which carries the rigid motion downstream of a driven joint;
@@ -218,6 +220,7 @@ pub fn solve_static(
                 previous = Some((saved, dt));
                 lambda = target;
                 steps += 1;
+                guard.accept(mech, &prob.state, lambda)?;
                 on_step(&record(mech, &prob.state, &prob.fext, lambda, dt, &report));
                 control.succeeded();
             }

@@ -215,7 +215,8 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
                 wall_time_s: wall,
             })
         }
-        Err(error) => {
+        Err(mut error) => {
+            name_the_beam(model, &mut error);
             let file = sink
                 .writer
                 .finish(&layout::failed_status(&error.to_string()), wall)?;
@@ -224,6 +225,40 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
                 error,
                 file,
             })
+        }
+    }
+}
+
+/// Names the model's own entries in an error: the beam (and the element
+/// within it) of an element — elements are numbered beam after beam, in the
+/// model's order — and the `[[prescribed]]` entry of a prescribed nodal DOF
+/// (the mechanism numbers only the nodal ones).
+fn name_the_beam(model: &Model, error: &mut SolveError) {
+    if let SolveError::PrescribedRotationStep { index, .. } = error {
+        if let Some(i) = model
+            .prescribed
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| matches!(p, crate::model::PrescribedSpec::NodeDof { .. }))
+            .nth(*index)
+            .map(|(i, _)| i)
+        {
+            *index = i;
+        }
+    }
+    if let SolveError::ElementRotation { element, beam, .. } = error {
+        let mut first = 0;
+        for b in &model.beams {
+            if *element < first + b.elements {
+                *beam = format!(
+                    " (element {} of beam \"{}\", which has {})",
+                    *element - first,
+                    b.name,
+                    b.elements
+                );
+                return;
+            }
+            first += b.elements;
         }
     }
 }

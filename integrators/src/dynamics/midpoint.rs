@@ -32,6 +32,7 @@ use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSystem};
 use crate::record::{Energies, StepRecord};
+use crate::rotation_guard::RotationGuard;
 use crate::statics::strain_energy;
 use flexmech_core::conserving::{MidRotation, Pose, Pose3};
 use flexmech_core::rotation::{cayley_inverse, exp, log};
@@ -437,6 +438,7 @@ pub fn solve(
     let mut state = initial_state(mech);
     let mut topo = Topology::new(mech, &state)?;
     topo.impose(mech, &mut state, 0.0);
+    let mut guard = RotationGuard::new(mech, &state);
     let n_eq = topo.dofs.n_eq;
     let inertia = Inertia::new(&mech.mesh, settings.mass);
     let mut asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
@@ -530,6 +532,7 @@ pub fn solve(
                 // The drivers' work: exact for these schemes (Σ pᵢ·gᵢ = ΔH − W_loads).
                 driver_work += increment_work(&state.config, &sys.end.config, &sys.nodal, true);
                 let end = sys.end;
+                guard.accept(mech, &end, t + dt)?;
                 let (v1, w1) = end_motion(&state.config, &end.config, &v, &w, dt);
                 for (j, rate) in rates.iter_mut().enumerate() {
                     *rate = released_rate(&state.released[j], &end.released[j], rate.len(), dt);

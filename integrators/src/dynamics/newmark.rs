@@ -21,6 +21,7 @@ use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSystem};
 use crate::record::StepRecord;
+use crate::rotation_guard::RotationGuard;
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::{Configuration, Inertia};
 use nalgebra::{Const, Matrix3, Vector3, U1};
@@ -212,6 +213,7 @@ pub fn solve(
     let mut state = initial_state(mech);
     let mut topo = Topology::new(mech, &state)?;
     topo.impose(mech, &mut state, 0.0);
+    let mut guard = RotationGuard::new(mech, &state);
     let n_eq = topo.dofs.n_eq;
     let inertia = Inertia::new(&mech.mesh, settings.mass);
     let mut asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
@@ -318,6 +320,7 @@ pub fn solve(
                         .push(kin.w[i] + (kin.alpha[i] * (1.0 - GAMMA) + al * GAMMA) * dt);
                     next.alpha.push(al);
                 }
+                guard.accept(mech, &end, t + dt)?;
                 state = end;
                 kin = next;
                 t = control.advance(t, dt);

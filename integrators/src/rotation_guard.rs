@@ -1,0 +1,86 @@
+//! Guard against a silent wrap of the elements' interpolation: the
+//! strain-invariant interpolation takes principal logarithms of the rotations
+//! between an element's nodes (`|φ| ≤ π`), so an element turned past π
+//! between its nodes would be read as turned the other way — a straight beam
+//! "rolled" six times would report no strain at all. After every converged
+//! step each element's relative rotations must stay below
+//! [`Element::ROTATION_LIMIT`] and change by less than
+//! [`Element::ROTATION_STEP_LIMIT`]; otherwise the analysis stops with
+//! [`SolveError::ElementRotation`], whose fix is more elements (or smaller
+//! steps). A prescribed nodal rotation is applied as a rotation by the
+//! change of its value, which is ambiguous past π (a change of 2π is no
+//! rotation at all): its change per step must stay below the same step
+//! limit ([`SolveError::PrescribedRotationStep`]).
+
+use crate::constraints::MechanismState;
+use crate::error::SolveError;
+use crate::mechanism::Mechanism;
+use flexmech_core::{Configuration, Element};
+use nalgebra::Vector3;
+
+/// The relative rotations of the last accepted state.
+#[derive(Debug, Clone)]
+pub(crate) struct RotationGuard {
+    previous: Vec<Vec<Vector3<f64>>>,
+    prescribed: Vec<f64>,
+}
+
+impl RotationGuard {
+    /// The guard at the initial (or any accepted) state.
+    pub(crate) fn new(mech: &Mechanism, state: &MechanismState) -> Self {
+        Self {
+            previous: rotations(mech, &state.config),
+            prescribed: state.prescribed.clone(),
+        }
+    }
+
+    /// Checks the converged state at `time` and accepts it.
+    pub(crate) fn accept(
+        &mut self,
+        mech: &Mechanism,
+        state: &MechanismState,
+        time: f64,
+    ) -> Result<(), SolveError> {
+        for (index, (p, (now, before))) in mech
+            .prescribed
+            .iter()
+            .zip(state.prescribed.iter().zip(&self.prescribed))
+            .enumerate()
+        {
+            let change = (now - before).abs();
+            if p.dof >= 3 && change > Element::ROTATION_STEP_LIMIT {
+                return Err(SolveError::PrescribedRotationStep {
+                    index,
+                    time,
+                    change,
+                });
+            }
+        }
+        let now = rotations(mech, &state.config);
+        for (element, (a, b)) in now.iter().zip(&self.previous).enumerate() {
+            for (phi, before) in a.iter().zip(b) {
+                let (angle, change) = (phi.norm(), (phi - before).norm());
+                if angle > Element::ROTATION_LIMIT || change > Element::ROTATION_STEP_LIMIT {
+                    return Err(SolveError::ElementRotation {
+                        element,
+                        beam: String::new(),
+                        time,
+                        angle,
+                        change,
+                    });
+                }
+            }
+        }
+        self.previous = now;
+        self.prescribed.clone_from(&state.prescribed);
+        Ok(())
+    }
+}
+
+fn rotations(mech: &Mechanism, config: &Configuration) -> Vec<Vec<Vector3<f64>>> {
+    mech.mesh
+        .elements
+        .iter()
+        .map(|e| e.relative_rotations(&config.rot))
+        .collect()
+}
