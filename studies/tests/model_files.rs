@@ -1260,3 +1260,43 @@ fn a_prescribed_dof_that_is_also_supported_is_refused() {
     let ok = text.replace("dof = \"rz\"", "dof = \"ry\"");
     assert!(parse(&ok).is_ok(), "{:?}", parse(&ok).err());
 }
+
+#[test]
+fn huge_sizes_are_refused_by_key_not_by_a_panic() {
+    // Sizes near i64::MAX once panicked with "capacity overflow" or aborted
+    // on a failed allocation; they are refused at validation, naming the key
+    // and the limit's reason.
+    let big = i64::MAX;
+    let text = BASE.replacen("elements = 2", &format!("elements = {big}"), 1);
+    expect_err(
+        &text,
+        "beam[0].elements",
+        &["must be <= 200000", "assembly memory"],
+    );
+    let text = with(&format!("[solver]\nload_steps = {big}\n"));
+    expect_err(&text, "solver.load_steps", &["must be <= 1000000"]);
+    let text = with("[solver]\nmax_iterations = 100000000000\n");
+    expect_err(&text, "solver.max_iterations", &["must be <= 1000"]);
+    let text = with("[solver]\nmax_halvings = 1000\n");
+    expect_err(&text, "solver.max_halvings", &["must be <= 50"]);
+    let text = with(&format!("[output]\nevery = {big}\n"));
+    expect_err(&text, "output.every", &["must be <= 1000000000"]);
+    // Many beams together: the total is limited too, at the beam that passes it.
+    let text = BASE
+        .replacen("elements = 2", "elements = 150000", 1)
+        .replacen("elements = 2", "elements = 60000", 1);
+    expect_err(
+        &text,
+        "beam[1].elements",
+        &["brings the model to 210000 elements"],
+    );
+    // A dynamic run of more than 1e7 steps.
+    let text = with(
+        "[solver]\nanalysis = \"dynamic\"\nintegrator = \"newmark\"\ndt = 1e-9\nt_end = 1.0\n",
+    );
+    expect_err(
+        &text,
+        "solver.dt",
+        &["t_end/dt = 1.000e9 steps", "larger dt"],
+    );
+}

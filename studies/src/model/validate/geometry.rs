@@ -3,6 +3,7 @@
 use std::f64::consts::TAU;
 use std::ops::Range;
 
+use super::limits;
 use super::{
     cross, dot, fmt_v, norm, quoted_list, sub, suggest_not_parallel, unit, Ctx, Res, ANGLE_TOL,
 };
@@ -104,6 +105,7 @@ impl Ctx<'_> {
 
     pub(super) fn beams(&self, raw: &[S<RawBeam>], sections: &[SectionSpec]) -> Res<Vec<BeamSpec>> {
         let mut out: Vec<BeamSpec> = Vec::new();
+        let mut total_elements = 0usize;
         for (i, entry) in raw.iter().enumerate() {
             let tk = format!("beam[{i}]");
             let k = |f: &str| format!("{tk}.{f}");
@@ -158,7 +160,19 @@ impl Ctx<'_> {
                 &hs,
                 "the number of elements, e.g. elements = 4",
             )?;
-            let elements = self.int_at_least(elements_s, &k("elements"), 1)?;
+            let elements = self.int_in(elements_s, &k("elements"), 1, limits::MAX_ELEMENTS)?;
+            total_elements += elements;
+            if total_elements > limits::MAX_ELEMENTS.0 as usize {
+                return Err(self.at(
+                    k("elements"),
+                    elements_s,
+                    format!(
+                        "brings the model to {total_elements} elements, more than {} ({})",
+                        limits::MAX_ELEMENTS.0,
+                        limits::MAX_ELEMENTS.1
+                    ),
+                ));
+            }
             let nodes_per_element = match &b.nodes_per_element {
                 None => 2,
                 Some(v) => match *v.get_ref() {

@@ -12,6 +12,7 @@ use super::types::*;
 
 mod geometry;
 mod joints;
+pub mod limits;
 mod loading;
 mod solver;
 
@@ -176,10 +177,19 @@ impl Ctx<'_> {
         }
     }
 
-    fn int_at_least(&self, v: &S<i64>, key: &str, min: i64) -> Res<usize> {
+    /// An integer in `[min, max]`; `max` is one of the documented [`limits`]
+    /// and the message says why it is there.
+    fn int_in(&self, v: &S<i64>, key: &str, min: i64, max: (i64, &str)) -> Res<usize> {
         let n = *v.get_ref();
         if n < min {
             return Err(self.at(key, v, format!("must be >= {min}, found {n}")));
+        }
+        if n > max.0 {
+            return Err(self.at(
+                key,
+                v,
+                format!("must be <= {} ({}), found {n}", max.0, max.1),
+            ));
         }
         usize::try_from(n).map_err(|_| self.at(key, v, format!("is too large, found {n}")))
     }

@@ -1,6 +1,6 @@
 //! The `[solver]` and `[output]` tables.
 
-use super::{quoted_list, Ctx, Res};
+use super::{limits, quoted_list, Ctx, Res};
 use crate::model::raw::{RawOutput, RawSolver, S};
 use crate::model::types::*;
 
@@ -84,6 +84,18 @@ impl Ctx<'_> {
                     format!("must be <= t_end = {t_end:?}, found {dt:?}"),
                 ));
             }
+            if t_end / dt > limits::MAX_TIME_STEPS {
+                return Err(self.at(
+                    "solver.dt",
+                    dt_s,
+                    format!(
+                        "gives t_end/dt = {:.3e} steps, more than the {:.0e} a run may take \
+                         (one stored record each); use a larger dt or a shorter t_end",
+                        t_end / dt,
+                        limits::MAX_TIME_STEPS
+                    ),
+                ));
+            }
             Analysis::Dynamic {
                 integrator,
                 dt,
@@ -111,7 +123,7 @@ impl Ctx<'_> {
                 ));
             }
             let load_steps = match &s.load_steps {
-                Some(l) => self.int_at_least(l, "solver.load_steps", 1)?,
+                Some(l) => self.int_in(l, "solver.load_steps", 1, limits::MAX_LOAD_STEPS)?,
                 None => 10,
             };
             Analysis::Static { load_steps }
@@ -121,11 +133,11 @@ impl Ctx<'_> {
             None => 1e-10,
         };
         let max_iterations = match &s.max_iterations {
-            Some(m) => self.int_at_least(m, "solver.max_iterations", 1)?,
+            Some(m) => self.int_in(m, "solver.max_iterations", 1, limits::MAX_ITERATIONS)?,
             None => 25,
         };
         let max_halvings = match &s.max_halvings {
-            Some(m) => self.int_at_least(m, "solver.max_halvings", 0)?,
+            Some(m) => self.int_in(m, "solver.max_halvings", 0, limits::MAX_HALVINGS)?,
             None => 10,
         };
         let mass = match &s.mass {
@@ -160,7 +172,7 @@ impl Ctx<'_> {
         };
         let o = entry.get_ref();
         let every = match &o.every {
-            Some(e) => self.int_at_least(e, "output.every", 1)?,
+            Some(e) => self.int_in(e, "output.every", 1, limits::MAX_EVERY)?,
             None => 1,
         };
         let mut track: Vec<(String, NodeRef)> = Vec::new();
