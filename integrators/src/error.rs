@@ -67,4 +67,8 @@ pub enum NewtonFailure {
     },
     #[error("the linear solve failed: {0}")]
     LinearSolve(String),
+    /// The step converged but its result was rejected (a change too large
+    /// for one step, see [`crate::rotation_guard`]); a smaller step cures it.
+    #[error("step rejected: {0}")]
+    Rejected(String),
 }

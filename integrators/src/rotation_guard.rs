@@ -10,13 +10,35 @@
 //! steps). A prescribed nodal rotation is applied as a rotation by the
 //! change of its value, which is ambiguous past π (a change of 2π is no
 //! rotation at all): its change per step must stay below the same step
-//! limit ([`SolveError::PrescribedRotationStep`]).
+//! limit ([`SolveError::PrescribedRotationStep`]). A change too large for one
+//! step is retried with a smaller step; a rotation beyond the limit stops
+//! the analysis.
 
 use crate::constraints::MechanismState;
-use crate::error::SolveError;
+use crate::error::{NewtonFailure, SolveError};
 use crate::mechanism::Mechanism;
 use flexmech_core::{Configuration, Element};
 use nalgebra::Vector3;
+
+/// Whether a smaller step cures the guard's objection (a change too large
+/// for one step, not a rotation beyond the limit): the solvers then retry
+/// with a halved step ([`NewtonFailure::Rejected`]) instead of stopping.
+pub(crate) fn cured_by_smaller_steps(error: &SolveError) -> bool {
+    match error {
+        SolveError::ElementRotation { angle, .. } => *angle <= Element::ROTATION_LIMIT,
+        SolveError::PrescribedRotationStep { .. } => true,
+        _ => false,
+    }
+}
+
+/// The guard's objection as a step failure when smaller steps cure it.
+pub(crate) fn as_step_failure(error: SolveError) -> Result<NewtonFailure, SolveError> {
+    if cured_by_smaller_steps(&error) {
+        Ok(NewtonFailure::Rejected(error.to_string()))
+    } else {
+        Err(error)
+    }
+}
 
 /// The relative rotations of the last accepted state.
 #[derive(Debug, Clone)]

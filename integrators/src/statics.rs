@@ -14,7 +14,7 @@ use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonSettings, NewtonSystem};
 use crate::record::{Energies, StepRecord};
-use crate::rotation_guard::RotationGuard;
+use crate::rotation_guard::{as_step_failure, RotationGuard};
 use crate::step_control::StepControl;
 use flexmech_core::Configuration;
 use nalgebra::Vector3;
@@ -216,11 +216,15 @@ pub fn solve_static(
         mech.external_forces(target, &mut prob.fext);
         match newton::solve(&mut prob, &mut lu, &settings.newton, &mut r, &mut dq) {
             Ok(report) => {
+                if let Err(objection) = guard.accept(mech, &prob.state, target) {
+                    prob.state = saved;
+                    control.failed(target, as_step_failure(objection)?)?;
+                    continue;
+                }
                 let dt = target - lambda;
                 previous = Some((saved, dt));
                 lambda = target;
                 steps += 1;
-                guard.accept(mech, &prob.state, lambda)?;
                 on_step(&record(mech, &prob.state, &prob.fext, lambda, dt, &report));
                 control.succeeded();
             }

@@ -65,11 +65,33 @@ fn one_turn_on_one_element_is_refused() {
 }
 
 #[test]
-fn a_prescribed_turn_too_large_for_one_step_is_refused() {
+fn a_prescribed_turn_too_large_for_one_step_is_retried_smaller_or_refused() {
     // Two turns in one load step: the end node's prescribed rotation changes
     // by 4π, which as one rotation is none at all — the strip stayed straight
-    // and the run "completed". Refused, naming the entry and the fix.
-    let (message, _) = refused(&rolled(2.0, 20, 1));
+    // and the run "completed". Now the step is halved until the change is
+    // below π/2 (three halvings), and the strip rolls up twice exactly…
+    let model = parse_model(&rolled(2.0, 20, 1), Path::new("rolled.toml")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let file = run_model(&model, dir.path()).unwrap().file;
+    let strain: Vec<f64> = hdf5::File::open(file)
+        .unwrap()
+        .dataset("/energy/strain")
+        .unwrap()
+        .read_raw()
+        .unwrap();
+    let kappa = 2.0 * std::f64::consts::TAU / 10.0;
+    let exact = 0.5 * 100.0 * kappa * kappa * 10.0;
+    let last = *strain.last().unwrap();
+    assert!(
+        (last - exact).abs() <= 1e-6 * exact,
+        "strain energy {last} vs {exact}"
+    );
+    // … and without halvings allowed it is refused, naming the entry and the fix.
+    let text = rolled(2.0, 20, 1).replace(
+        "max_iterations = 30",
+        "max_iterations = 30\nmax_halvings = 0",
+    );
+    let (message, _) = refused(&text);
     assert!(
         message.contains("prescribed[0]") && message.contains("more load steps"),
         "{message}"

@@ -49,17 +49,26 @@ fn screw_free_shows_the_papers_claims() {
             r.min_dt()
         );
     }
-    // Newmark: energy blow-up, then failure after the step was halved down
-    // to nominal/2^8 (max_halvings = 8 in the model file).
+    // Newmark: energy blow-up, then failure — the blown-up arm bends so far
+    // that an element turns past the 3π/4 its interpolation follows, and the
+    // run is stopped with that reason (measured t = 5.36 s; before that
+    // guard, it failed at 5.375 s after 8 step halvings).
     let t_fail = nm.failure_time.expect("Newmark must fail");
     assert!(t_fail > 1.0 && t_fail < 6.0, "failure at {t_fail}");
-    assert!(nm.status.contains("8 step halvings"), "{}", nm.status);
+    assert!(
+        nm.status.contains("8 step halvings") || nm.status.contains("between its nodes"),
+        "{}",
+        nm.status
+    );
+    assert!(
+        nm.reduced_steps() > 0,
+        "the blow-up is met with step halvings first"
+    );
     assert!(
         nm.energy_drift() > 1.0,
         "Newmark energy drift {}",
         nm.energy_drift()
     );
-    assert!((nm.min_dt() - 0.02 / 256.0).abs() < 1e-12);
     // Before the blow-up Newmark's energy error is small: it *grows*.
     let early = nm
         .time

@@ -32,7 +32,7 @@ use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSystem};
 use crate::record::{Energies, StepRecord};
-use crate::rotation_guard::RotationGuard;
+use crate::rotation_guard::{as_step_failure, RotationGuard};
 use crate::statics::strain_energy;
 use flexmech_core::conserving::{MidRotation, Pose, Pose3};
 use flexmech_core::rotation::{cayley_inverse, exp, log};
@@ -529,10 +529,13 @@ pub fn solve(
         };
         match outcome {
             Ok((report, beta)) => {
+                if let Err(objection) = guard.accept(mech, &sys.end, t + dt) {
+                    control.failed(t + dt, as_step_failure(objection)?)?;
+                    continue;
+                }
                 // The drivers' work: exact for these schemes (Σ pᵢ·gᵢ = ΔH − W_loads).
                 driver_work += increment_work(&state.config, &sys.end.config, &sys.nodal, true);
                 let end = sys.end;
-                guard.accept(mech, &end, t + dt)?;
                 let (v1, w1) = end_motion(&state.config, &end.config, &v, &w, dt);
                 for (j, rate) in rates.iter_mut().enumerate() {
                     *rate = released_rate(&state.released[j], &end.released[j], rate.len(), dt);

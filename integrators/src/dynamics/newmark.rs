@@ -21,7 +21,7 @@ use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSystem};
 use crate::record::StepRecord;
-use crate::rotation_guard::RotationGuard;
+use crate::rotation_guard::{as_step_failure, RotationGuard};
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::{Configuration, Inertia};
 use nalgebra::{Const, Matrix3, Vector3, U1};
@@ -291,6 +291,10 @@ pub fn solve(
         };
         match newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq) {
             Ok(report) => {
+                if let Err(objection) = guard.accept(mech, &sys.end, t + dt) {
+                    control.failed(t + dt, as_step_failure(objection)?)?;
+                    continue;
+                }
                 let r_end = sys.topo.driver_reactions(mech, &sys.end, &sys.nodal);
                 let r_start = r_prev.take().unwrap_or_else(|| r_end.clone());
                 driver_work += driver_increment_work(mech, &state, &sys.end, &r_start, &r_end);
@@ -320,7 +324,6 @@ pub fn solve(
                         .push(kin.w[i] + (kin.alpha[i] * (1.0 - GAMMA) + al * GAMMA) * dt);
                     next.alpha.push(al);
                 }
-                guard.accept(mech, &end, t + dt)?;
                 state = end;
                 kin = next;
                 t = control.advance(t, dt);
