@@ -42,10 +42,16 @@ pub enum RunError {
         first: PathBuf,
     },
     /// The solver stopped; `file` holds the steps computed before.
-    #[error("{model}: {error} (steps computed so far are in {})", file.display())]
+    #[error(
+        "{}: model \"{model}\": {error} (steps computed so far are in {})",
+        path.display(),
+        file.display()
+    )]
     Solve {
         model: String,
-        error: SolveError,
+        /// The model file.
+        path: PathBuf,
+        error: Box<SolveError>,
         file: PathBuf,
     },
 }
@@ -222,7 +228,8 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
                 .finish(&layout::failed_status(&error.to_string()), wall)?;
             Err(RunError::Solve {
                 model: model.name.clone(),
-                error,
+                path: model.path.clone(),
+                error: Box::new(error),
                 file,
             })
         }

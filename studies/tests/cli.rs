@@ -137,6 +137,11 @@ fn failed_solve_keeps_a_valid_file_with_the_steps_so_far() {
     assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("no convergence"), "{stderr}");
+    // The message names the model file as well as the model.
+    assert!(
+        stderr.contains("hard.toml: model \"rollup-linear\""),
+        "{stderr}"
+    );
     let f = hdf5::File::open(dir.path().join("rollup-linear.h5")).unwrap();
     let status: hdf5::types::VarLenUnicode = f.attr("status").unwrap().read_scalar().unwrap();
     assert!(

@@ -1300,3 +1300,11 @@ fn huge_sizes_are_refused_by_key_not_by_a_panic() {
         &["t_end/dt = 1.000e9 steps", "larger dt"],
     );
 }
+
+#[test]
+fn a_name_too_long_for_a_file_name_is_refused_by_key() {
+    // A 300-character name once gave an HDF5 error about the output path.
+    let long = "a".repeat(300);
+    let text = BASE.replace("name = \"base\"", &format!("name = \"{long}\""));
+    expect_err(&text, "name", &["at most 200 bytes"]);
+}

@@ -625,6 +625,12 @@ fn slurm_array_variables_select_the_shard() {
             ..
         })
     ));
+    // An id near 2⁶⁴ − 1 (once wrapped to "shard 0/4", 0 runs, exit 0).
+    let huge = slurm(Some("18446744073709551615"), Some("4"), None).shard();
+    assert!(
+        matches!(huge, Err(ShardError::SlurmOutOfRange { .. })),
+        "{huge:?}"
+    );
     let e = slurm(Some("4"), Some("4"), None).shard().unwrap_err();
     assert!(matches!(e, ShardError::SlurmOutOfRange { .. }));
     assert!(e.to_string().contains("--array=0-3"), "{e}");

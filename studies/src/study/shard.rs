@@ -216,7 +216,10 @@ impl SlurmArray {
         if id < min || step == 0 || (id - min) % step != 0 {
             return Err(out_of_range);
         }
-        let k = (id - min) / step + 1;
+        // (id − min)/step + 1 overflows for an id near 2⁶⁴ − 1: out of range too.
+        let Some(k) = ((id - min) / step).checked_add(1) else {
+            return Err(out_of_range);
+        };
         if count == 0 || k > count {
             return Err(out_of_range);
         }

@@ -21,3 +21,6 @@ pub const MAX_TIME_STEPS: f64 = 1.0e7;
 pub const MAX_HALVINGS: (i64, &str) = (50, "step halvings: 2^-50 of a step");
 /// Output stride.
 pub const MAX_EVERY: (i64, &str) = (1_000_000_000, "steps between stored records");
+/// Bytes of a model `name`, which becomes the file name `<name>.h5` (file
+/// systems allow 255 bytes per name; studies add run suffixes).
+pub const MAX_NAME_BYTES: usize = 200;

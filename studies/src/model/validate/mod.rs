@@ -277,6 +277,8 @@ impl Ctx<'_> {
             Some("must not start with '.'")
         } else if s.chars().any(char::is_control) {
             Some("must not contain control characters")
+        } else if s.len() > limits::MAX_NAME_BYTES {
+            Some("must be at most 200 bytes long (file systems allow 255 per file name)")
         } else {
             None
         };
