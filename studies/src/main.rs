@@ -108,15 +108,25 @@ fn main() -> ExitCode {
                     run_model(&m, &out)
                 });
                 match outcome {
-                    Ok(s) => println!(
-                        "{}: completed, {} steps ({} written, {} Newton iterations) in {:.2} s -> {}",
-                        path.display(),
-                        s.steps,
-                        s.written,
-                        s.iterations,
-                        s.wall_time_s,
-                        s.file.display()
-                    ),
+                    Ok(s) => {
+                        let warned = if s.warnings.is_empty() {
+                            ""
+                        } else {
+                            " with a warning"
+                        };
+                        println!(
+                            "{}: completed{warned}, {} steps ({} written, {} Newton iterations) in {:.2} s -> {}",
+                            path.display(),
+                            s.steps,
+                            s.written,
+                            s.iterations,
+                            s.wall_time_s,
+                            s.file.display()
+                        );
+                        for w in &s.warnings {
+                            eprintln!("warning: {}: {w}", path.display());
+                        }
+                    }
                     Err(e) => {
                         failed += 1;
                         eprintln!("error: {e}");

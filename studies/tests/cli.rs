@@ -179,3 +179,68 @@ fn two_models_with_the_same_name_in_one_run_are_refused() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(stdout.matches("completed").count(), 1, "{stdout}");
 }
+
+#[test]
+fn a_completed_run_whose_energy_balance_is_off_says_so() {
+    // Newmark on the free screw to t = 5 s: the run completes while its
+    // energy has grown by 78 % of the energy scale — once reported as a
+    // plain "completed". Now the summary line, stderr and the file say so;
+    // the energy–momentum run of the same model has nothing to report.
+    let dir = tempfile::tempdir().unwrap();
+    let paper = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper/screw_free.toml");
+    let text = std::fs::read_to_string(paper).unwrap();
+    let write = |integrator: &str| {
+        let model = dir.path().join(format!("{integrator}.toml"));
+        let t = text
+            .replace(
+                "integrator = \"energy-momentum\"",
+                &format!("integrator = \"{integrator}\""),
+            )
+            .replace("t_end = 6.0", "t_end = 5.0")
+            .replace(
+                "name = \"screw_free\"",
+                &format!("name = \"screw-{integrator}\""),
+            );
+        assert!(t.contains("t_end = 5.0") && t.contains(integrator));
+        std::fs::write(&model, t).unwrap();
+        model
+    };
+    let out = flexmech()
+        .arg("run")
+        .arg(write("newmark"))
+        .arg(write("energy-momentum"))
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(
+        stdout.contains("newmark.toml: completed with a warning"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("energy-momentum.toml: completed,"),
+        "{stdout}"
+    );
+    assert!(
+        stderr.contains("warning:")
+            && stderr.contains("energy balance")
+            && stderr.contains("smaller dt"),
+        "{stderr}"
+    );
+    let attr = |file: &str| {
+        let h = hdf5::File::open(dir.path().join(file)).unwrap();
+        h.attr("warnings").ok().map(|a| {
+            a.read_scalar::<hdf5::types::VarLenUnicode>()
+                .unwrap()
+                .to_string()
+        })
+    };
+    let w = attr("screw-newmark.h5").expect("a warnings attribute");
+    assert!(w.contains("energy balance"), "{w}");
+    assert!(attr("screw-energy-momentum.h5").is_none());
+}

@@ -16,6 +16,8 @@ pub const ATTR_VERSION: &str = "version";
 pub const ATTR_STATUS: &str = "status";
 /// Root attribute: wall-clock time of the run in seconds (written by `finish`).
 pub const ATTR_WALL_TIME: &str = "wall_time_s";
+/// Root attribute: warnings about a completed result (absent when none).
+pub const ATTR_WARNINGS: &str = "warnings";
 /// Attribute on datasets and groups: a one-line human-readable meaning.
 pub const ATTR_DESCRIPTION: &str = "description";
 /// Attribute on `/nodes/<label>` (extension): the node index in the model.

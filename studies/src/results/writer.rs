@@ -778,6 +778,15 @@ impl ResultWriter {
         Ok(path)
     }
 
+    /// Sets the root attribute `warnings`: what the run's checks found
+    /// doubtful in a result that completed (e.g. an energy balance off by more
+    /// than its threshold). Absent when there is nothing to say.
+    pub fn warn(&mut self, text: &str) -> Result<(), ResultError> {
+        set_str_attr(&self.file, names::ATTR_WARNINGS, text).ctx(&self.path, || {
+            format!("writing root attribute {}", names::ATTR_WARNINGS)
+        })
+    }
+
     /// Number of steps appended successfully (`T`).
     pub fn steps_written(&self) -> usize {
         self.steps
