@@ -13,7 +13,8 @@ set -e
 source "$(dirname "$0")/env.sh"
 OUT="${1:-results}"
 cargo build --release --bin flexmech
-./target/release/flexmech reproduce --out "$OUT"
-./target/release/flexmech run data/benchmarks/*.toml data/statics/*.toml data/dynamics/*.toml --out "$OUT/models"
+FLEXMECH="${CARGO_TARGET_DIR:-target}/release/flexmech"
+"$FLEXMECH" reproduce --out "$OUT"
+"$FLEXMECH" run data/benchmarks/*.toml data/statics/*.toml data/dynamics/*.toml --out "$OUT/models"
 cargo test --release -p flexmech-studies --test published_dynamics -- --ignored
 echo "results written to $OUT/ (figures in $OUT/charts/, summary in $OUT/summary.md)"
