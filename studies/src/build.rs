@@ -225,6 +225,21 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         let x0 = &mechanism.mesh.positions;
         let (expected, _) = map.slave(&x0[master], &nalgebra::Matrix3::identity(), &initial);
         let gap = (x0[slave] - expected).norm();
+        if !gap.is_finite() {
+            // A profile that evaluates to NaN or ∞ (a tiny period, huge
+            // coefficients, a pitch of 1e308) would pass a plain comparison.
+            return Err(ModelError::new(
+                &model.path,
+                format!("joint[{j}]"),
+                None,
+                format!(
+                    "joint `{}`: its released translation at the initial angle is not a finite \
+                     number ({expected:?}); check the joint's parameters (pitch, radius, \
+                     profile coefficients or table, period) and its `angle`",
+                    spec.name
+                ),
+            ));
+        }
         if gap > 1e-9 * scale {
             let p = |x: &Vector3<f64>| format!("({:.6}, {:.6}, {:.6})", x.x, x.y, x.z);
             return Err(ModelError::new(

@@ -234,3 +234,19 @@ fn prescribed_end_rotation_rolls_the_strip_into_a_circle() {
     let exact = 0.5 * 100.0 * (2.0 * std::f64::consts::PI / 10.0f64).powi(2) * 10.0;
     assert!((e.last().unwrap() - exact).abs() <= 1e-8 * exact);
 }
+
+#[test]
+fn a_released_translation_that_is_not_finite_is_a_clear_error() {
+    // A pitch of 1e308 at an initial angle of 10 rad puts the slave at
+    // infinity; the comparison with the slave's position once let it pass.
+    let text = std::fs::read_to_string(data("screw_driven.toml"))
+        .unwrap()
+        .replace("pitch = 0.05", "pitch = 1e308\nangle = 10.0");
+    assert!(text.contains("pitch = 1e308"));
+    let model = flexmech_studies::model::parse_model(&text, Path::new("inf.toml")).unwrap();
+    let err = flexmech_studies::build(&model).unwrap_err().to_string();
+    assert!(
+        err.contains("inf.toml") && err.contains("joint[0]") && err.contains("not a finite"),
+        "{err}"
+    );
+}
