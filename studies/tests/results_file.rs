@@ -721,3 +721,34 @@ fn h5dump_lists_the_contract_names() {
         assert!(header.contains(name), "h5dump -H lacks {name}:\n{header}");
     }
 }
+
+#[test]
+fn a_second_writer_of_the_same_file_is_refused_and_the_first_result_survives() {
+    // Two processes writing one result file: the second once truncated the
+    // file before failing, and the first reported "completed" over an
+    // unreadable file. The second now fails before touching it.
+    let _serial = serial();
+    let path = tmp_path("locked.h5");
+    let first = write_steps(&path, 2);
+    match ResultWriter::create(&path, &meta()) {
+        Err(e @ ResultError::Busy { .. }) => {
+            let m = e.to_string();
+            assert!(
+                m.contains("another process is writing") && m.contains("locked.h5"),
+                "{m}"
+            );
+        }
+        other => panic!("expected Busy, got {other:?}"),
+    }
+    first.finish(layout::STATUS_COMPLETED, 1.0).expect("finish");
+    let file = hdf5::File::open(&path).expect("the first result is intact");
+    check_series(&file, 2);
+    assert_eq!(str_attr(&file, "status"), "completed");
+    drop(file);
+    // Finished: the lock is gone, and the file can be written again.
+    let mut lock = path.as_os_str().to_owned();
+    lock.push(".lock");
+    assert!(!std::path::Path::new(&lock).exists());
+    let again = ResultWriter::create(&path, &meta()).expect("free again");
+    again.finish(layout::STATUS_COMPLETED, 1.0).expect("finish");
+}

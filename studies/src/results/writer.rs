@@ -45,6 +45,29 @@ pub struct RunMeta {
 /// Everything that can go wrong while writing a result file.
 #[derive(Debug, thiserror::Error)]
 pub enum ResultError {
+    /// Another process holds the result file's lock: creating the file
+    /// would truncate a result being written (or just finished) there.
+    #[error(
+        "{}: another process is writing this result file (its lock {} is held); wait for it \
+         to finish, or write to another --out directory",
+        .path.display(),
+        .lock.display()
+    )]
+    Busy {
+        /// The result file.
+        path: PathBuf,
+        /// The lock file beside it.
+        lock: PathBuf,
+    },
+    /// The lock file beside the result could not be locked.
+    #[error("{}: cannot lock the result file: {source}", .lock.display())]
+    Lock {
+        /// The lock file.
+        lock: PathBuf,
+        /// The system's error.
+        #[source]
+        source: std::io::Error,
+    },
     /// The HDF5 library reported an error.
     #[error("{}: HDF5 error while {what}: {source}", .path.display())]
     Hdf5 {
@@ -371,6 +394,10 @@ impl Datasets {
 pub struct ResultWriter {
     path: PathBuf,
     file: File,
+    /// The lock file beside the result, held (exclusively) while writing
+    /// (`None` where no file can be made there: creating the result fails
+    /// then anyway, with HDF5's reason).
+    lock: Option<(std::fs::File, PathBuf)>,
     sets: Datasets,
     initial_positions: Vec<[f64; 3]>,
     steps: usize,
@@ -437,6 +464,9 @@ impl ResultWriter {
             });
         }
 
+        // Lock before truncating: a second writer of the same file fails here
+        // and leaves the first one's result intact.
+        let lock = lock_result(path)?;
         let file = File::create(path).ctx(path, || "creating the file".to_owned())?;
         let attrs = [
             (names::ATTR_MODEL, meta.model_text.as_str()),
@@ -640,6 +670,7 @@ impl ResultWriter {
         Ok(Self {
             path: path.to_path_buf(),
             file,
+            lock,
             sets,
             initial_positions: meta.initial_positions.clone(),
             steps: 0,
@@ -749,6 +780,7 @@ impl ResultWriter {
         let Self {
             path,
             file,
+            lock,
             sets,
             steps,
             newton_len,
@@ -775,6 +807,11 @@ impl ResultWriter {
             })?;
         drop(sets);
         file.close().ctx(&path, || "closing the file".to_owned())?;
+        // The result is complete: release the lock and remove its file.
+        if let Some((handle, lock_path)) = lock {
+            drop(handle);
+            let _ = std::fs::remove_file(lock_path);
+        }
         Ok(path)
     }
 
@@ -795,5 +832,29 @@ impl ResultWriter {
     /// Path of the file being written.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+}
+
+/// Takes the exclusive lock `<result>.lock` (an advisory lock the system
+/// releases when the process ends, so a killed run leaves no stale lock).
+fn lock_result(path: &Path) -> Result<Option<(std::fs::File, PathBuf)>, ResultError> {
+    let mut name = path.as_os_str().to_owned();
+    name.push(".lock");
+    let lock = PathBuf::from(name);
+    let Ok(handle) = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&lock)
+    else {
+        return Ok(None);
+    };
+    match handle.try_lock() {
+        Ok(()) => Ok(Some((handle, lock))),
+        Err(std::fs::TryLockError::WouldBlock) => Err(ResultError::Busy {
+            path: path.to_path_buf(),
+            lock,
+        }),
+        Err(std::fs::TryLockError::Error(source)) => Err(ResultError::Lock { lock, source }),
     }
 }
