@@ -1,5 +1,6 @@
 //! Typed failures of the solvers. Every variant says where (time, step) and why.
 
+use crate::free_motion::FreeMotion;
 use thiserror::Error;
 
 /// Why a solve stopped.
@@ -47,6 +48,17 @@ pub enum SolveError {
         time: f64,
         change: f64,
     },
+    /// A converged state whose tangent is singular: the answer is not unique
+    /// (see [`crate::free_motion`]).
+    #[error(
+        "the mechanism is not held at t = {time}: its tangent is singular (condition number \
+         {condition:.1e}), so the solution is not unique — {motion}"
+    )]
+    Unrestrained {
+        time: f64,
+        condition: f64,
+        motion: Box<FreeMotion>,
+    },
     /// The mechanism is inconsistent (for example a DOF that no element touches).
     #[error("invalid mechanism: {0}")]
     InvalidMechanism(String),
@@ -67,6 +79,16 @@ pub enum NewtonFailure {
     },
     #[error("the linear solve failed: {0}")]
     LinearSolve(String),
+    /// The tangent at the converged iterate is singular (see
+    /// [`crate::newton::SINGULAR_CONDITION`]).
+    #[error("singular tangent (condition number {condition:.1e}): {motion}")]
+    Singular {
+        condition: f64,
+        motion: Box<FreeMotion>,
+        /// At the converged iterate (the answer is not unique: no smaller
+        /// step cures it), or at the start of the step (a smaller step may).
+        converged: bool,
+    },
     /// The step converged but its result was rejected (a change too large
     /// for one step, see [`crate::rotation_guard`]); a smaller step cures it.
     #[error("step rejected: {0}")]

@@ -7,11 +7,13 @@ pub mod constraints;
 pub mod dofs;
 pub mod dynamics;
 pub mod error;
+pub mod free_motion;
 pub mod linsolve;
 pub mod mechanism;
 pub mod newton;
 pub mod record;
 pub mod rotation_guard;
+pub mod stability;
 pub mod statics;
 pub mod step_control;
 

@@ -10,7 +10,16 @@
 //! are tiny, e.g. the first steps of a ramp, and stiff internal forces round).
 
 use crate::error::NewtonFailure;
-use crate::linsolve::SparseLu;
+use crate::free_motion::FreeMotion;
+use crate::linsolve::{SparseLu, TangentRef};
+
+/// Condition number (of the equilibrated tangent, see
+/// [`SparseLu::condition_estimate`]) above which a converged tangent is
+/// singular: `1/(100 ε)`. A mechanism's null direction gives `κ ≳ 1/ε`; a
+/// well-posed model stays orders of magnitude below (a slender cantilever of
+/// a thousand elements with `EA/EI = 10⁵` has `κ ≈ 10¹⁰`), and one above
+/// it cannot be solved to more than two digits anyway.
+pub const SINGULAR_CONDITION: f64 = 1.0 / (100.0 * f64::EPSILON);
 
 /// Iteration limits.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,6 +43,9 @@ pub trait NewtonSystem {
     fn floor(&self) -> f64 {
         0.0
     }
+    /// The null direction `mode` of a singular tangent (reduced unknowns) in
+    /// the mechanism's terms.
+    fn free_motion(&self, mode: &[f64], tangent: TangentRef) -> FreeMotion;
 }
 
 /// Outcome of a converged solve.
@@ -48,13 +60,31 @@ pub struct NewtonReport {
 }
 
 /// Runs Newton's method from the system's current iterate. `r` and `dq` are
-/// caller-owned scratch vectors of length `n_eq`.
+/// caller-owned scratch vectors of length `n_eq`. A singular tangent at the
+/// start of the solve or at the converged iterate ends it in
+/// [`NewtonFailure::Singular`] (see [`check_regular`]); one met on the way
+/// (a wild iterate) is left to the failure it causes, which step control
+/// can cure.
 pub fn solve<S: NewtonSystem>(
     sys: &mut S,
     lu: &mut SparseLu,
     settings: &NewtonSettings,
     r: &mut [f64],
     dq: &mut [f64],
+) -> Result<NewtonReport, NewtonFailure> {
+    let mut factored = false;
+    let report = iterate(sys, lu, settings, r, dq, &mut factored)?;
+    check_regular(sys, lu, factored, true)?;
+    Ok(report)
+}
+
+fn iterate<S: NewtonSystem>(
+    sys: &mut S,
+    lu: &mut SparseLu,
+    settings: &NewtonSettings,
+    r: &mut [f64],
+    dq: &mut [f64],
+    factored: &mut bool,
 ) -> Result<NewtonReport, NewtonFailure> {
     let mut history = Vec::with_capacity(settings.max_iterations + 1);
     let mut previous_norm = f64::INFINITY;
@@ -86,6 +116,10 @@ pub fn solve<S: NewtonSystem>(
         }
         lu.factor(sys.tangent_values())
             .map_err(NewtonFailure::LinearSolve)?;
+        if it == 0 {
+            check_regular(sys, lu, true, false)?;
+        }
+        *factored = true;
         for (d, v) in dq.iter_mut().zip(r.iter()) {
             *d = -v;
         }
@@ -96,6 +130,41 @@ pub fn solve<S: NewtonSystem>(
         iterations: settings.max_iterations,
         residual: *history.last().unwrap_or(&f64::NAN),
     })
+}
+
+/// Refuses a converged iterate whose tangent is singular (its solution is
+/// one of infinitely many: a mechanism). `factored`: whether `lu` holds a
+/// factorisation from this solve (otherwise the current tangent is
+/// factorised first); `converged`: whether the iterate is the solution (or
+/// the start of the step). Costs two triangular solves.
+pub(crate) fn check_regular<S: NewtonSystem>(
+    sys: &S,
+    lu: &mut SparseLu,
+    factored: bool,
+    converged: bool,
+) -> Result<(), NewtonFailure> {
+    if sys.tangent_values().is_empty() {
+        return Ok(());
+    }
+    if !factored {
+        lu.factor(sys.tangent_values())
+            .map_err(NewtonFailure::LinearSolve)?;
+    }
+    let (condition, mode) = lu.condition_estimate(sys.tangent_values());
+    if condition > SINGULAR_CONDITION {
+        return Err(NewtonFailure::Singular {
+            condition,
+            motion: Box::new(sys.free_motion(
+                &mode,
+                TangentRef {
+                    pattern: lu.pattern(),
+                    values: sys.tangent_values(),
+                },
+            )),
+            converged,
+        });
+    }
+    Ok(())
 }
 
 /// Whether a residual of norm `norm` sits at the round-off floor and has

@@ -58,4 +58,8 @@ pub struct StepRecord {
     pub quaternions: Vec<[f64; 4]>,
     /// One record per joint, in model order.
     pub joints: Vec<JointRecord>,
+    /// Statics: the number of negative eigenvalues of the converged reduced
+    /// tangent (see [`crate::stability`]); non-zero means the equilibrium
+    /// is unstable (past a bifurcation or limit point). `None` in dynamics.
+    pub negative_pivots: Option<usize>,
 }

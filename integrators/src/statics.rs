@@ -10,11 +10,13 @@
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::{NewtonFailure, SolveError};
-use crate::linsolve::SparseLu;
+use crate::free_motion::FreeMotion;
+use crate::linsolve::{SparseLu, TangentRef};
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonSettings, NewtonSystem};
 use crate::record::{Energies, StepRecord};
 use crate::rotation_guard::{as_step_failure, RotationGuard};
+use crate::stability::InertiaCount;
 use crate::step_control::StepControl;
 use flexmech_core::Configuration;
 use nalgebra::Vector3;
@@ -88,6 +90,10 @@ impl NewtonSystem for StaticProblem<'_> {
     fn floor(&self) -> f64 {
         self.floor
     }
+
+    fn free_motion(&self, mode: &[f64], tangent: TangentRef) -> FreeMotion {
+        FreeMotion::of(self.mech, &self.topo, &self.state.config.x, mode, tangent)
+    }
 }
 
 /// Strain energy of the whole mesh (element energies summed in element order).
@@ -134,6 +140,7 @@ fn record(
             total: strain + potential,
             driver_work: 0.0,
         },
+        negative_pivots: None,
         momentum_linear: [0.0; 3],
         momentum_angular: [0.0; 3],
         positions: config.x.iter().map(|x| [x.x, x.y, x.z]).collect(),
@@ -168,6 +175,7 @@ pub fn solve_static(
     let n = topo.dofs.n_eq;
     let asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
     let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
+    let mut inertia = InertiaCount::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
     let nodes = mech.mesh.node_count();
     let mut prob = StaticProblem {
         mech,
@@ -225,7 +233,9 @@ pub fn solve_static(
                 previous = Some((saved, dt));
                 lambda = target;
                 steps += 1;
-                on_step(&record(mech, &prob.state, &prob.fext, lambda, dt, &report));
+                let mut step = record(mech, &prob.state, &prob.fext, lambda, dt, &report);
+                step.negative_pivots = inertia.negative_eigenvalues(&prob.asm.values);
+                on_step(&step);
                 control.succeeded();
             }
             Err(reason) => {

@@ -80,7 +80,31 @@ impl StepControl {
     }
 
     /// A step to `time` failed: halve, or give up with the reason.
+    /// A converged state with a singular tangent ends the analysis at once
+    /// (no step size makes a non-unique answer unique); a singular tangent at
+    /// the start of a step (which a wild predictor can give) is retried
+    /// smaller, and told as what it is when the smallest step meets it too.
     pub(crate) fn failed(&mut self, time: f64, reason: NewtonFailure) -> Result<(), SolveError> {
+        if let NewtonFailure::Singular {
+            condition,
+            motion,
+            converged,
+        } = reason
+        {
+            if converged || self.level >= self.max_halvings {
+                return Err(SolveError::Unrestrained {
+                    time,
+                    condition,
+                    motion,
+                });
+            }
+            return self.failed(
+                time,
+                NewtonFailure::Rejected(format!(
+                    "singular tangent at the start of the step (condition number {condition:.1e})"
+                )),
+            );
+        }
         if self.level >= self.max_halvings {
             return Err(SolveError::NoConvergence {
                 time,

@@ -3,6 +3,7 @@
 
 pub mod build;
 pub mod charts;
+mod checks;
 pub mod model;
 pub mod reproduce;
 pub mod results;

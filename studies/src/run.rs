@@ -3,12 +3,15 @@
 //! `status = "failed: …"` and every step computed before the failure.
 
 use crate::build::{build, Built};
+use crate::checks::{Balance, Stability};
 use crate::model::{Analysis, IntegratorKind, MassKind, Model, ModelError};
 use crate::results::{layout, ResultError, ResultWriter, RunMeta};
 use flexmech_integrators::dynamics::{
     energy_momentum, energy_momentum_paper, momentum, newmark, DynamicSettings,
 };
-use flexmech_integrators::{solve_static, NewtonSettings, SolveError, StaticSettings, StepRecord};
+use flexmech_integrators::{
+    solve_static, Mechanism, NewtonSettings, SolveError, StaticSettings, StepRecord,
+};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use thiserror::Error;
@@ -74,56 +77,16 @@ pub struct RunSummary {
     pub warnings: Vec<String>,
 }
 
-/// The energy balance a dynamic run is checked against: the largest change
-/// of (total energy − drivers' work) relative to the energy scale (the
-/// largest of the initial energy, kinetic and strain energies and drive
-/// work met in the run). Checked for dynamic runs whose applied loads are
-/// constant in time. The conserving schemes keep it at the Newton
-/// tolerance, Newmark within ~1e-3 on well-resolved runs; beyond 5 % the
-/// result is not to be trusted without a look.
-pub const ENERGY_BALANCE_WARNING: f64 = 5e-2;
-
-/// Tracks a dynamic run's energy balance, `total − driver_work`.
-#[derive(Debug, Default)]
-struct Balance {
-    first: Option<f64>,
-    worst: f64,
-    scale: f64,
-}
-
-impl Balance {
-    fn push(&mut self, s: &StepRecord) {
-        let e = &s.energy;
-        let b = e.total - e.driver_work;
-        let b0 = *self.first.get_or_insert(b);
-        self.worst = self.worst.max((b - b0).abs());
-        for v in [e.total, e.kinetic, e.strain, e.driver_work] {
-            if v.is_finite() {
-                self.scale = self.scale.max(v.abs());
-            }
-        }
-    }
-
-    /// The warning, when the balance is off by more than the threshold.
-    fn warning(&self) -> Option<String> {
-        let drift = self.worst / self.scale.max(f64::MIN_POSITIVE);
-        // A NaN drift (a blown-up energy) warns too.
-        (self.first.is_some() && (drift > ENERGY_BALANCE_WARNING || drift.is_nan())).then(|| {
-            format!(
-                "energy balance: total energy − drive work changed by {drift:.2e} of the \
-                 energy scale (threshold {ENERGY_BALANCE_WARNING:.0e}); the step may be too \
-                 large for this integrator, or the solution blew up: check with a smaller dt \
-                 or integrator = \"energy-momentum\""
-            )
-        })
-    }
-}
+pub use crate::checks::ENERGY_BALANCE_WARNING;
 
 /// Keeps every `every`-th step and always the last one.
-struct Sink {
+struct Sink<'a> {
     writer: ResultWriter,
+    mech: &'a Mechanism,
     /// The energy balance, for dynamic runs.
     balance: Option<Balance>,
+    /// The stability of the load path, for static runs.
+    stability: Option<Stability>,
     every: usize,
     count: usize,
     iterations: usize,
@@ -131,10 +94,13 @@ struct Sink {
     error: Option<ResultError>,
 }
 
-impl Sink {
+impl Sink<'_> {
     fn push(&mut self, step: &StepRecord) {
         if let Some(b) = &mut self.balance {
-            b.push(step);
+            b.push(self.mech, step);
+        }
+        if let Some(s) = &mut self.stability {
+            s.push(step);
         }
         self.count += 1;
         self.iterations += step.iterations;
@@ -158,6 +124,17 @@ impl Sink {
             }
         }
     }
+}
+
+/// Whether the stability count of a static `model` is a stability
+/// statement (see [`Stability`]): no applied nodal moment, no prescribed
+/// nodal rotation.
+fn conservative(model: &Model) -> bool {
+    model.loads.iter().all(|l| l.moment == [0.0; 3])
+        && model.prescribed.iter().all(|p| match p {
+            crate::model::PrescribedSpec::NodeDof { dof, .. } => *dof < 3,
+            crate::model::PrescribedSpec::JointAngle { .. } => true,
+        })
 }
 
 /// Runs `model` and writes `out_dir/<name>.h5`.
@@ -200,15 +177,12 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
         joint_names: model.joints.iter().map(|j| j.name.clone()).collect(),
     };
     let writer = ResultWriter::create(&file, &meta)?;
+    let dynamic = matches!(model.solver.analysis, Analysis::Dynamic { .. });
     let mut sink = Sink {
         writer,
-        // Loads that vary in time do work the records do not account for
-        // yet (their potential −f(t)·u is not conserved): the balance is
-        // checked where the loads are constant (gravity, dead loads without
-        // a time function) and drivers do the rest.
-        balance: (matches!(model.solver.analysis, Analysis::Dynamic { .. })
-            && model.loads.iter().all(|l| l.time.is_none()))
-        .then(Balance::default),
+        mech,
+        balance: dynamic.then(Balance::default),
+        stability: (!dynamic).then(|| Stability::new(conservative(model))),
         every: model.output.every.max(1),
         count: 0,
         iterations: 0,
@@ -277,6 +251,7 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
                 .as_ref()
                 .and_then(Balance::warning)
                 .into_iter()
+                .chain(sink.stability.as_ref().and_then(Stability::warning))
                 .collect();
             if !warnings.is_empty() {
                 sink.writer.warn(&warnings.join("; "))?;
@@ -292,7 +267,7 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
             })
         }
         Err(mut error) => {
-            name_the_beam(model, &mut error);
+            name_the_beam(model, &built, &mut error);
             let file = sink
                 .writer
                 .finish(&layout::failed_status(&error.to_string()), wall)?;
@@ -309,8 +284,28 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
 /// Names the model's own entries in an error: the beam (and the element
 /// within it) of an element — elements are numbered beam after beam, in the
 /// model's order — and the `[[prescribed]]` entry of a prescribed nodal DOF
-/// (the mechanism numbers only the nodal ones).
-fn name_the_beam(model: &Model, error: &mut SolveError) {
+/// (the mechanism numbers only the nodal ones), and the nodes of a free
+/// motion.
+fn name_the_beam(model: &Model, built: &Built, error: &mut SolveError) {
+    if let SolveError::Unrestrained { motion, .. } = error {
+        motion.labels = motion
+            .nodes
+            .iter()
+            .map(|&n| {
+                built
+                    .beam_nodes
+                    .iter()
+                    .enumerate()
+                    .find_map(|(b, nodes)| {
+                        nodes
+                            .iter()
+                            .position(|&m| m == n)
+                            .map(|k| model.node_label(crate::model::NodeRef { beam: b, node: k }))
+                    })
+                    .unwrap_or_else(|| format!("node {n}"))
+            })
+            .collect();
+    }
     if let SolveError::PrescribedRotationStep { index, .. } = error {
         if let Some(i) = model
             .prescribed

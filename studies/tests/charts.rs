@@ -373,6 +373,7 @@ fn record(step: usize) -> StepRecord {
         positions: vec![[0.0; 3], [1.0 - 0.1 * t * t, 0.0, 0.4 * t]],
         quaternions: vec![[1.0, 0.0, 0.0, 0.0]; 2],
         joints: vec![],
+        negative_pivots: None,
     }
 }
 

@@ -134,6 +134,7 @@ fn record(step: usize) -> StepRecord {
             released_translation: [k, 0.0, -k],
             constraint_error: 1e-12 * k,
         }],
+        negative_pivots: None,
     }
 }
 

@@ -28,7 +28,9 @@ use super::{midpoint, DynamicSettings, Motion, Scheme};
 use crate::error::{NewtonFailure, SolveError};
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
-use crate::newton::{at_floor, diverged, NewtonReport, NewtonSettings, NewtonSystem};
+use crate::newton::{
+    at_floor, check_regular, diverged, NewtonReport, NewtonSettings, NewtonSystem,
+};
 use crate::record::StepRecord;
 use flexmech_core::conserving::MidRotation;
 use flexmech_core::rotation::cayley_inverse;
@@ -176,6 +178,7 @@ pub(super) fn solve_step(
             || res_e <= settings.tolerance
             || energy.abs() <= 64.0 * f64::EPSILON * e_scale + sys.floor() * increments;
         if g_ok && e_ok {
+            check_regular(sys, lu, it > 0, true)?;
             let beta_out = if determined { beta } else { f64::NAN };
             return Ok((
                 NewtonReport {

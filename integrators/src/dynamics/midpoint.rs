@@ -28,7 +28,8 @@ use super::{DynamicSettings, Motion, StepControl, GROW_AFTER};
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::SolveError;
-use crate::linsolve::SparseLu;
+use crate::free_motion::FreeMotion;
+use crate::linsolve::{SparseLu, TangentRef};
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSystem};
 use crate::record::{Energies, StepRecord};
@@ -405,6 +406,10 @@ impl NewtonSystem for MidpointStep<'_> {
     fn floor(&self) -> f64 {
         self.floor
     }
+
+    fn free_motion(&self, mode: &[f64], tangent: TangentRef) -> FreeMotion {
+        FreeMotion::of(self.mech, self.topo, &self.end.config.x, mode, tangent)
+    }
 }
 
 /// Runs a midpoint scheme from `initial` over `[0, t_end]`, reporting a record
@@ -614,6 +619,7 @@ pub fn dynamic_record(
             total: kinetic + strain + potential,
             driver_work: 0.0,
         },
+        negative_pivots: None,
         momentum_linear: [lin.x, lin.y, lin.z],
         momentum_angular: [ang.x, ang.y, ang.z],
         positions: config.x.iter().map(|x| [x.x, x.y, x.z]).collect(),

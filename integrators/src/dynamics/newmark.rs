@@ -17,7 +17,8 @@ use super::{slave_velocities, DynamicSettings, Motion, StepControl, GROW_AFTER};
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
 use crate::error::SolveError;
-use crate::linsolve::SparseLu;
+use crate::free_motion::FreeMotion;
+use crate::linsolve::{SparseLu, TangentRef};
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSystem};
 use crate::record::StepRecord;
@@ -149,6 +150,10 @@ impl NewtonSystem for NewmarkStep<'_> {
 
     fn floor(&self) -> f64 {
         self.floor
+    }
+
+    fn free_motion(&self, mode: &[f64], tangent: TangentRef) -> FreeMotion {
+        FreeMotion::of(self.mech, self.topo, &self.end.config.x, mode, tangent)
     }
 }
 

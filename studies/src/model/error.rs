@@ -29,9 +29,9 @@ impl ModelError {
     ) -> Self {
         ModelError {
             file: file.into(),
-            key: key.into(),
+            key: shorten(&key.into()),
             line,
-            message: message.into(),
+            message: shorten(&message.into()),
         }
     }
 
@@ -56,6 +56,35 @@ impl ModelError {
     pub fn message(&self) -> &str {
         &self.message
     }
+}
+
+/// Longest word (run of non-blank characters) an error message repeats from
+/// the file: a key or value longer than this is cut, with its length told.
+const ECHO_WORD: usize = 80;
+/// Longest message: the rest is cut, with its length told.
+const ECHO_MESSAGE: usize = 4000;
+
+/// Cuts what a message echoes from the file to a readable size (a 1 MB key
+/// is quoted by its first characters and its length, not in full).
+fn shorten(text: &str) -> String {
+    let mut out = String::with_capacity(text.len().min(ECHO_MESSAGE + 64));
+    for (k, word) in text.split(' ').enumerate() {
+        if k > 0 {
+            out.push(' ');
+        }
+        if word.chars().count() > ECHO_WORD {
+            let head: String = word.chars().take(ECHO_WORD / 2).collect();
+            out.push_str(&format!("{head}… ({} bytes)", word.len()));
+        } else {
+            out.push_str(word);
+        }
+    }
+    if out.chars().count() > ECHO_MESSAGE {
+        let total = out.len();
+        out = out.chars().take(ECHO_MESSAGE).collect();
+        out.push_str(&format!("… (message cut, {total} bytes)"));
+    }
+    out
 }
 
 impl fmt::Display for ModelError {

@@ -168,7 +168,7 @@ fn table_header(trimmed: &str) -> Option<(bool, String)> {
 
 /// Makes serde's wording read as model-file wording.
 fn reword(message: &str) -> String {
-    message
+    without_type_names(message)
         .replace("unknown field", "unknown key")
         .replace("missing field", "missing key")
         .replace("duplicate field", "duplicate key")
@@ -176,6 +176,28 @@ fn reword(message: &str) -> String {
         .replace("expected i64", "expected an integer")
         .replace("expected usize", "expected a non-negative integer")
         .replace("expected a sequence", "expected a list")
+}
+
+/// Replaces the loader's internal type names (`struct RawBeam with 8
+/// elements`) by what the file should hold (`a table of keys`).
+fn without_type_names(message: &str) -> String {
+    let mut out = message.to_string();
+    while let Some(start) = out.find("struct Raw") {
+        let rest = &out[start + "struct ".len()..];
+        let name_len = rest
+            .find(|c: char| !c.is_alphanumeric())
+            .unwrap_or(rest.len());
+        let mut end = start + "struct ".len() + name_len;
+        if let Some(tail) = out[end..].strip_prefix(" with ") {
+            if let Some(n) = tail.find(" elements") {
+                if tail[..n].bytes().all(|b| b.is_ascii_digit()) {
+                    end += " with ".len() + n + " elements".len();
+                }
+            }
+        }
+        out.replace_range(start..end, "a table (keys = values)");
+    }
+    out
 }
 
 /// Turns a TOML syntax error into a [`ModelError`].

@@ -70,6 +70,8 @@ pub const SOLVER_DT: &str = "/solver/dt";
 pub const SOLVER_RESIDUAL: &str = "/solver/residual";
 /// T: energy–momentum β (NaN for other integrators).
 pub const SOLVER_BETA: &str = "/solver/beta";
+/// Statics: negative eigenvalues of the converged tangent per step (`i64`).
+pub const SOLVER_NEGATIVE_PIVOTS: &str = "/solver/negative_pivots";
 /// Flat (extension): every step's Newton residual history, concatenated.
 pub const SOLVER_NEWTON_RESIDUALS: &str = "/solver/newton_residuals";
 /// T+1 (u64, extension): step k's history is

@@ -24,6 +24,7 @@
 //! | `/solver/dt` | T | step size actually used (after halvings) |
 //! | `/solver/residual` | T | final scaled residual norm |
 //! | `/solver/beta` | T | energy–momentum β (NaN for other integrators) |
+//! | `/solver/negative_pivots` | T, `i64` | *extension, statics only:* negative eigenvalues of the converged reduced tangent (> 0: unstable equilibrium; −1: undefined) |
 //! | `/solver/newton_residuals` | Σ iterations | *extension:* every step's scaled residual history, concatenated |
 //! | `/solver/newton_offsets` | T+1, `u64` | *extension:* step k's history is `newton_residuals[offsets[k]..offsets[k+1]]`; `offsets[0] = 0` |
 //! | `/nodes/<label>/position` | T×3 | tracked node's position |

@@ -342,6 +342,8 @@ struct Datasets {
     dt: Series,
     residual: Series,
     beta: Series,
+    /// Statics only.
+    negative_pivots: Option<Series>,
     newton_residuals: Series,
     newton_offsets: Series,
     nodes: Vec<NodeSets>,
@@ -369,6 +371,7 @@ impl Datasets {
             &self.config_quaternion,
         ]
         .into_iter()
+        .chain(self.negative_pivots.iter())
         .chain(
             self.nodes
                 .iter()
@@ -539,6 +542,19 @@ impl ResultWriter {
             &[],
             "energy-momentum beta of the step (NaN for other integrators)",
         )?;
+        let negative_pivots = (meta.integrator == "static")
+            .then(|| {
+                Series::time_series::<i64>(
+                    &file,
+                    path,
+                    names::SOLVER_NEGATIVE_PIVOTS,
+                    &[],
+                    "number of negative eigenvalues of the converged reduced tangent (negative \
+                     pivots of its LDLT factorisation); > 0: the equilibrium is unstable; -1: \
+                     undefined (a zero pivot)",
+                )
+            })
+            .transpose()?;
         let newton_residuals = Series::create::<f64>(
             &file,
             path,
@@ -659,6 +675,7 @@ impl ResultWriter {
             dt,
             residual,
             beta,
+            negative_pivots,
             newton_residuals,
             newton_offsets,
             nodes,
@@ -738,6 +755,10 @@ impl ResultWriter {
         s.dt.push_scalar(t, step.dt, path)?;
         s.residual.push_scalar(t, step.residual, path)?;
         s.beta.push_scalar(t, step.beta, path)?;
+        if let Some(set) = &s.negative_pivots {
+            let count = step.negative_pivots.map_or(-1, |n| n as i64);
+            set.push_scalar(t, count, path)?;
+        }
 
         let history = &step.residual_history;
         let end = self.newton_len + history.len();

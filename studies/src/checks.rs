@@ -1,0 +1,151 @@
+//! The checks every completed run passes before it is called "completed"
+//! without a word: the energy balance of a dynamic run and the stability of
+//! a static load path. Each watches the converged steps as they come and
+//! gives a warning (stderr, the summary line and the result file's root
+//! attribute `warnings`) when the result is doubtful.
+
+use flexmech_integrators::{Mechanism, StepRecord};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+
+/// The energy balance a dynamic run is checked against: the largest change
+/// of `T + Π − W_loads − W_drivers` (kinetic and strain energy less the work
+/// of the applied loads — gravity, dead forces and moments, with their time
+/// functions — and of the drivers since t = 0) relative to the energy scale
+/// (the largest of these terms met in the run). The conserving schemes keep
+/// it at the Newton tolerance plus the O(Δt²) error of the trapezoidal load
+/// work, Newmark within ~1e-3 on well-resolved runs; beyond 5 % the result is
+/// not to be trusted without a look.
+pub const ENERGY_BALANCE_WARNING: f64 = 5e-2;
+
+/// Tracks a dynamic run's energy balance.
+#[derive(Debug, Default)]
+pub(crate) struct Balance {
+    first: Option<f64>,
+    worst: f64,
+    scale: f64,
+    /// Work of the applied loads since t = 0: the trapezoidal rule over
+    /// each step, `½(fₙ + fₙ₊₁)·Δx + ½(mₙ + mₙ₊₁)·Δθ` per node, with `Δθ`
+    /// the step's spatial rotation vector (exact for constant forces).
+    load_work: f64,
+    /// The previous step's node positions, orientations and loads.
+    previous: Option<Snapshot>,
+}
+
+/// Node positions, orientations (quaternions) and nodal loads of a step.
+type Snapshot = (Vec<[f64; 3]>, Vec<[f64; 4]>, Vec<f64>);
+
+impl Balance {
+    /// Takes in a converged step of `mech`.
+    pub(crate) fn push(&mut self, mech: &Mechanism, s: &StepRecord) {
+        let mut loads = vec![0.0; 6 * s.positions.len()];
+        mech.external_forces(s.time, &mut loads);
+        if let Some((x0, q0, f0)) = &self.previous {
+            for n in 0..s.positions.len() {
+                let dx = Vector3::from(s.positions[n]) - Vector3::from(x0[n]);
+                let turn = quaternion(s.quaternions[n]) * quaternion(q0[n]).inverse();
+                let dtheta = turn.scaled_axis();
+                for c in 0..3 {
+                    let (force, moment) = (6 * n + c, 6 * n + 3 + c);
+                    self.load_work += 0.5 * (f0[force] + loads[force]) * dx[c];
+                    self.load_work += 0.5 * (f0[moment] + loads[moment]) * dtheta[c];
+                }
+            }
+        }
+        let e = &s.energy;
+        let b = e.kinetic + e.strain - self.load_work - e.driver_work;
+        let b0 = *self.first.get_or_insert(b);
+        self.worst = self.worst.max((b - b0).abs());
+        for v in [e.kinetic, e.strain, self.load_work, e.driver_work, b0] {
+            if v.is_finite() {
+                self.scale = self.scale.max(v.abs());
+            }
+        }
+        self.previous = Some((s.positions.clone(), s.quaternions.clone(), loads));
+    }
+
+    /// The warning, when the balance is off by more than the threshold.
+    pub(crate) fn warning(&self) -> Option<String> {
+        let drift = self.worst / self.scale.max(f64::MIN_POSITIVE);
+        // A NaN drift (a blown-up energy) warns too.
+        (self.first.is_some() && (drift > ENERGY_BALANCE_WARNING || drift.is_nan())).then(|| {
+            format!(
+                "energy balance: kinetic + strain energy − work of loads and drives changed by \
+                 {drift:.2e} of the energy scale (threshold {ENERGY_BALANCE_WARNING:.0e}); the \
+                 step may be too large for this integrator, or the solution blew up: check with \
+                 a smaller dt or integrator = \"energy-momentum\""
+            )
+        })
+    }
+}
+
+fn quaternion(q: [f64; 4]) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]))
+}
+
+/// Tracks a static run's stability: the negative eigenvalues of the
+/// converged tangent at each load factor.
+///
+/// The count is the stability of the equilibrium when the problem is
+/// conservative in the unknowns the solver uses — dead forces, gravity,
+/// supports, joints and their drives (the Euler column loses stability at
+/// `π²EI/4L²` to the load step). Two inputs make the tangent's symmetric part
+/// something else than a Hessian: an applied nodal moment (a dead moment is
+/// not conservative for finite 3D rotations) and a prescribed nodal rotation
+/// (held on the rotation increments, not on a conserved constraint). The
+/// count is still written for such models, but it warns only for the others.
+#[derive(Debug)]
+pub(crate) struct Stability {
+    /// Whether the count is a stability statement (see above).
+    conservative: bool,
+    /// The first load factor with a negative eigenvalue, and the most met.
+    unstable: Option<(f64, usize)>,
+    /// A step whose count is undefined (an exactly zero pivot).
+    undefined: Option<f64>,
+}
+
+impl Stability {
+    /// A watch for a model that is `conservative` in the above sense.
+    pub(crate) fn new(conservative: bool) -> Self {
+        Self {
+            conservative,
+            unstable: None,
+            undefined: None,
+        }
+    }
+
+    /// Takes in a converged step.
+    pub(crate) fn push(&mut self, s: &StepRecord) {
+        match s.negative_pivots {
+            Some(0) => {}
+            Some(n) => {
+                let (_, most) = self.unstable.get_or_insert((s.time, n));
+                *most = (*most).max(n);
+            }
+            None => {
+                self.undefined.get_or_insert(s.time);
+            }
+        }
+    }
+
+    /// The warning, when some equilibrium on the path was unstable.
+    pub(crate) fn warning(&self) -> Option<String> {
+        if !self.conservative {
+            return None;
+        }
+        if let Some((lambda, most)) = self.unstable {
+            return Some(format!(
+                "stability: the equilibrium is unstable from load factor {lambda:.4} on (up to \
+                 {most} negative eigenvalue(s) of the tangent, /solver/negative_pivots): the \
+                 path followed is past a bifurcation or limit point, where the real structure \
+                 would buckle or snap; add a small imperfection (a load or geometry \
+                 perturbation) to follow the buckled branch"
+            ));
+        }
+        self.undefined.map(|lambda| {
+            format!(
+                "stability: the tangent at load factor {lambda:.4} has an exactly zero pivot, so \
+                 its stability is undefined (a bifurcation point)"
+            )
+        })
+    }
+}
