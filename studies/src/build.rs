@@ -290,5 +290,6 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         motion: Motion::rest(0),
     };
     built.motion = initial_motion(model, &built);
+    crate::initial_check::check(model, &built.mechanism, &built.beam_nodes, &built.motion)?;
     Ok(built)
 }
