@@ -4,6 +4,7 @@
 pub mod build;
 pub mod charts;
 mod checks;
+pub mod fuzz;
 mod initial_check;
 pub mod model;
 pub mod reproduce;

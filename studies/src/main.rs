@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 use flexmech_studies::charts::plot_datasets;
 use flexmech_studies::model::load_model;
 use flexmech_studies::reproduce::{reproduce, ReproduceOptions};
-use flexmech_studies::{run_model, RunError};
+use flexmech_studies::{build, run_model, RunError};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -30,6 +30,16 @@ enum Command {
         /// Output directory for the result files.
         #[arg(long, short, default_value = "results")]
         out: PathBuf,
+    },
+    /// Check model files without solving them: parse, validate every key and
+    /// build the mechanism (every derived quantity at t = 0 must be finite).
+    ///
+    /// Prints `<file>: ok (…)` per valid model; errors name the file, line,
+    /// key and fix, as `run` does.
+    Check {
+        /// Model files (TOML, see MODEL_FORMAT.md).
+        #[arg(required = true)]
+        models: Vec<PathBuf>,
     },
     /// Reproduce the paper's examples (data/paper) with all three integrators.
     ///
@@ -135,6 +145,32 @@ fn main() -> ExitCode {
             }
             if failed > 0 {
                 eprintln!("{failed} of {} model(s) failed", models.len());
+                ExitCode::FAILURE
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+        Command::Check { models } => {
+            let mut failed = 0;
+            for path in &models {
+                match load_model(path).and_then(|m| build(&m).map(|b| (m, b))) {
+                    Ok((m, b)) => println!(
+                        "{}: ok (model \"{}\": {} beams, {} elements, {} joints, {} nodes)",
+                        path.display(),
+                        m.name,
+                        m.beams.len(),
+                        b.mechanism.mesh.elements.len(),
+                        m.joints.len(),
+                        b.mechanism.mesh.node_count()
+                    ),
+                    Err(e) => {
+                        failed += 1;
+                        eprintln!("error: {e}");
+                    }
+                }
+            }
+            if failed > 0 {
+                eprintln!("{failed} of {} model(s) refused", models.len());
                 ExitCode::FAILURE
             } else {
                 ExitCode::SUCCESS
