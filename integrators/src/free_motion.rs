@@ -17,7 +17,7 @@
 //! * otherwise the nodes and joints that the null direction found by
 //!   [`crate::linsolve::SparseLu::condition_estimate`] moves.
 
-use crate::constraints::Topology;
+use crate::dofs::DofMap;
 use crate::linsolve::TangentRef;
 use crate::mechanism::Mechanism;
 use nalgebra::{DMatrix, Matrix6, SymmetricEigen, Vector3, Vector6};
@@ -53,11 +53,13 @@ pub struct FreeMotion {
 }
 
 impl FreeMotion {
-    /// Describes the singular tangent `tangent` (reduced unknowns of
-    /// `topo`, nodes at `x`) with null direction `mode`.
+    /// Describes the singular tangent `tangent` of `mech` (reduced unknowns
+    /// with node maps `dofs` and, per joint, the equations of its released
+    /// coordinates `released_eqs`; nodes at `x`) with null direction `mode`.
     pub fn of(
         mech: &Mechanism,
-        topo: &Topology,
+        dofs: &DofMap,
+        released_eqs: &[Vec<Option<usize>>],
         x: &[Vector3<f64>],
         mode: &[f64],
         tangent: TangentRef,
@@ -70,9 +72,8 @@ impl FreeMotion {
             .fold(0.0f64, f64::max);
         let length = if length > 0.0 { length } else { 1.0 };
         let mut motion = Self::default();
-        let free = free_rigid_motions(mech, topo, x, centre, length, tangent);
+        let free = free_rigid_motions(mech, dofs, x, centre, length, tangent);
         motion.describe_rigid(&free, centre, length);
-        let dofs = &topo.dofs;
         let p: Vec<Vector6<f64>> = (0..dofs.nodes.len())
             .map(|n| dofs.node_increment(n, mode))
             .collect();
@@ -91,10 +92,9 @@ impl FreeMotion {
                 .flatten()
                 .fold(0.0f64, |m, &e| m.max(mode[e].abs()))
         };
-        let joint_top = topo.released_eqs.iter().map(released).fold(0.0, f64::max);
+        let joint_top = released_eqs.iter().map(released).fold(0.0, f64::max);
         let scale = top.max(joint_top);
-        motion.joints = topo
-            .released_eqs
+        motion.joints = released_eqs
             .iter()
             .zip(&mech.joints)
             .filter(|(eqs, _)| released(eqs) > MOVES * scale)
@@ -168,13 +168,13 @@ impl FreeMotion {
 /// tangent does not resist.
 fn free_rigid_motions(
     mech: &Mechanism,
-    topo: &Topology,
+    dofs: &DofMap,
     x: &[Vector3<f64>],
     centre: Vector3<f64>,
     length: f64,
     tangent: TangentRef,
 ) -> Vec<Vector6<f64>> {
-    let n = topo.dofs.n_eq;
+    let n = dofs.n_eq;
     let d = tangent.equilibration();
     let norm = tangent.scaled_norm(&d);
     let mut slave = vec![false; x.len()];
@@ -187,7 +187,7 @@ fn free_rigid_motions(
     let mut y = Vec::with_capacity(6);
     for i in 0..6 {
         let mut q = vec![0.0; n];
-        for (node, map) in topo.dofs.nodes.iter().enumerate() {
+        for (node, map) in dofs.nodes.iter().enumerate() {
             if slave[node] {
                 continue;
             }

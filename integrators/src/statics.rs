@@ -92,7 +92,15 @@ impl NewtonSystem for StaticProblem<'_> {
     }
 
     fn free_motion(&self, mode: &[f64], tangent: TangentRef) -> FreeMotion {
-        FreeMotion::of(self.mech, &self.topo, &self.state.config.x, mode, tangent)
+        let topo = &self.topo;
+        FreeMotion::of(
+            self.mech,
+            &topo.dofs,
+            &topo.released_eqs,
+            &self.state.config.x,
+            mode,
+            tangent,
+        )
     }
 }
 

@@ -153,7 +153,15 @@ impl NewtonSystem for NewmarkStep<'_> {
     }
 
     fn free_motion(&self, mode: &[f64], tangent: TangentRef) -> FreeMotion {
-        FreeMotion::of(self.mech, self.topo, &self.end.config.x, mode, tangent)
+        let topo = &self.topo;
+        FreeMotion::of(
+            self.mech,
+            &topo.dofs,
+            &topo.released_eqs,
+            &self.end.config.x,
+            mode,
+            tangent,
+        )
     }
 }
 
