@@ -211,6 +211,72 @@ impl<const N: usize> BeamElement<N> {
     }
 }
 
+impl<const N: usize> BeamElement<N> {
+    /// [`Self::residual_tangent_ad`] with the tangent's second derivative
+    /// taken along the increments of nodes `1..N` only (`E = 6N − 6`
+    /// hyper-dual lanes instead of `6N`); node 0's columns follow from
+    /// objectivity. The residual `r` turns with the element and does not see
+    /// a translation: `Σₙ ∂r/∂xₙ = 0` and
+    /// `Σₙ (∂r/∂εₙ − (∂r/∂xₙ) x̂ₙ) = −r̂` (each 3-block `f` of `r`
+    /// contributing `f̂`), so `∂r/∂x₀ = −Σ_{n≥1} ∂r/∂xₙ` and
+    /// `∂r/∂ε₀ = −r̂ + Σₙ (∂r/∂xₙ) x̂ₙ − Σ_{n≥1} ∂r/∂εₙ`.
+    pub fn residual_tangent_invariant<const D: usize, const E: usize>(
+        &self,
+        x: &[Vector3<f64>; N],
+        rot: &[Matrix3<f64>; N],
+    ) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
+        assert!(
+            D == 6 * N && E + 6 == D,
+            "residual_tangent_invariant: D = 6N, E = D - 6"
+        );
+        type H<const D: usize, const E: usize> = HyperDualSVec64<D, E>;
+        let e1 = |k: usize| H::<D, E>::from_re(0.0).derivative1(k);
+        let e2 = |k: usize| H::<D, E>::from_re(0.0).derivative2(k);
+        let v = |f: &dyn Fn(usize) -> H<D, E>, k: usize| Vector3::new(f(k), f(k + 1), f(k + 2));
+        let zero = Vector3::from_element(H::<D, E>::from_re(0.0));
+        let lane2 = |i: usize, k: usize| {
+            if i == 0 {
+                zero
+            } else {
+                v(&e2, 6 * (i - 1) + k)
+            }
+        };
+        let xd: [Vector3<H<D, E>>; N] =
+            std::array::from_fn(|i| x[i].map(H::<D, E>::from_re) + v(&e1, 6 * i) + lane2(i, 0));
+        let rd: [Matrix3<H<D, E>>; N] = std::array::from_fn(|i| {
+            exp(&v(&e1, 6 * i + 3)) * exp(&lane2(i, 3)) * rot[i].map(H::<D, E>::from_re)
+        });
+        let e = self.energy(&xd, &rd);
+        let r: SVector<f64, D> = e.eps1.unwrap_generic(Const::<D>, U1);
+        let partial: SMatrix<f64, D, E> = e.eps1eps2.unwrap_generic(Const::<D>, Const::<E>);
+        let mut k = SMatrix::<f64, D, D>::zeros();
+        k.columns_mut(6, E).copy_from(&partial);
+        let mut jx0 = SMatrix::<f64, D, 3>::zeros();
+        let mut je0 = SMatrix::<f64, D, 3>::zeros();
+        for n in 0..N {
+            let jx = k.fixed_columns::<3>(6 * n).into_owned();
+            if n > 0 {
+                jx0 -= jx;
+                je0 -= k.fixed_columns::<3>(6 * n + 3);
+            }
+        }
+        // Σₙ (∂r/∂xₙ) x̂ₙ with node 0's own column block.
+        let mut moment = jx0 * x[0].cross_matrix();
+        for n in 1..N {
+            moment += k.fixed_columns::<3>(6 * n) * x[n].cross_matrix();
+        }
+        je0 += moment;
+        for block in 0..2 * N {
+            let f = Vector3::new(r[3 * block], r[3 * block + 1], r[3 * block + 2]);
+            let mut rows = je0.fixed_view_mut::<3, 3>(3 * block, 0);
+            rows -= f.cross_matrix();
+        }
+        k.fixed_columns_mut::<3>(0).copy_from(&jx0);
+        k.fixed_columns_mut::<3>(3).copy_from(&je0);
+        (r, k)
+    }
+}
+
 impl BeamElement<2> {
     /// Closed-form internal force of the 2-node element (one-point rule), the
     /// exact gradient of its energy:

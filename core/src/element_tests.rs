@@ -216,6 +216,16 @@ proptest! {
             let col = (e.energy_gradient::<18>(&xp, &rp) - e.energy_gradient::<18>(&xm, &rm)) / (2.0 * h);
             prop_assert!(rel((col - k.column(j)).norm(), k.norm()) <= 1e-6, "column {j}");
         }
+        // The kernel the solvers use (node 0's columns from objectivity)
+        // equals the full hyper-dual tangent to round-off, for 2 and 3 nodes.
+        let (r3, k3) = e.residual_tangent_invariant::<18, 12>(&x, &rot);
+        prop_assert!(rel((r3 - r).norm(), r.norm()) <= 1e-12);
+        prop_assert!(rel((k3 - k).norm(), k.norm()) <= 1e-10, "k3 {k3} k {k}");
+        let (e2, x02) = arc::<2>(0.9);
+        let (x2, rot2) = deformed(&x02, &du[..2], &dr[..2], su, sr);
+        let (_, k2) = e2.residual_tangent_ad::<12>(&x2, &rot2);
+        let (_, k2i) = e2.residual_tangent_invariant::<12, 6>(&x2, &rot2);
+        prop_assert!(rel((k2i - k2).norm(), k2.norm()) <= 1e-10);
     }
 }
 

@@ -141,7 +141,7 @@ impl Element {
             }
             Element::Quadratic(e) => {
                 let (xe, re) = gather(&e.nodes, x, rot);
-                let (rv, km) = e.residual_tangent_ad::<18>(&xe, &re);
+                let (rv, km) = e.residual_tangent_invariant::<18, 12>(&xe, &re);
                 r.copy_from_slice(rv.as_slice());
                 k.copy_from_slice(km.as_slice());
             }
