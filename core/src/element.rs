@@ -253,18 +253,15 @@ impl<const N: usize> BeamElement<N> {
         k.columns_mut(6, E).copy_from(&partial);
         let mut jx0 = SMatrix::<f64, D, 3>::zeros();
         let mut je0 = SMatrix::<f64, D, 3>::zeros();
-        for n in 0..N {
+        // Σₙ (∂r/∂xₙ) x̂ₙ, node 0's block included once it is known.
+        let mut moment = SMatrix::<f64, D, 3>::zeros();
+        for (n, xn) in x.iter().enumerate().skip(1) {
             let jx = k.fixed_columns::<3>(6 * n).into_owned();
-            if n > 0 {
-                jx0 -= jx;
-                je0 -= k.fixed_columns::<3>(6 * n + 3);
-            }
+            jx0 -= jx;
+            je0 -= k.fixed_columns::<3>(6 * n + 3);
+            moment += jx * xn.cross_matrix();
         }
-        // Σₙ (∂r/∂xₙ) x̂ₙ with node 0's own column block.
-        let mut moment = jx0 * x[0].cross_matrix();
-        for n in 1..N {
-            moment += k.fixed_columns::<3>(6 * n) * x[n].cross_matrix();
-        }
+        moment += jx0 * x[0].cross_matrix();
         je0 += moment;
         for block in 0..2 * N {
             let f = Vector3::new(r[3 * block], r[3 * block + 1], r[3 * block + 2]);
