@@ -180,18 +180,36 @@ impl Assembler {
                 w.k_red.gemm_tr(1.0, rows, &w.tmp, 0.0);
             });
         self.values.iter_mut().for_each(|v| *v = 0.0);
+        self.scatter_forces(mesh);
+        for (w, s) in self.work.iter().zip(&self.slots) {
+            for (&p, &v) in s.pos.iter().zip(w.k_red.as_slice()) {
+                self.values[p] += v;
+            }
+        }
+    }
+
+    /// The internal nodal forces only ([`Self::nodal`], [`Self::nodal_abs`];
+    /// the tangent values are left as they were): for a residual check that
+    /// no factorisation follows.
+    pub fn assemble_residual(&mut self, mesh: &Mesh, config: &Configuration) {
+        self.work
+            .par_iter_mut()
+            .zip(mesh.elements.par_iter())
+            .for_each(|(w, el)| el.internal_force_into(&config.x, &config.rot, w.r.as_mut_slice()));
+        self.scatter_forces(mesh);
+    }
+
+    /// Sums the elements' forces (in the work buffers) into the nodal forces.
+    fn scatter_forces(&mut self, mesh: &Mesh) {
         self.nodal.iter_mut().for_each(|v| *v = 0.0);
         self.nodal_abs.iter_mut().for_each(|v| *v = 0.0);
-        for ((w, el), s) in self.work.iter().zip(&mesh.elements).zip(&self.slots) {
+        for (w, el) in self.work.iter().zip(&mesh.elements) {
             for (a, &nd) in el.nodes().iter().enumerate() {
                 for d in 0..6 {
                     let v = w.r[6 * a + d];
                     self.nodal[6 * nd + d] += v;
                     self.nodal_abs[6 * nd + d] += v.abs();
                 }
-            }
-            for (&p, &v) in s.pos.iter().zip(w.k_red.as_slice()) {
-                self.values[p] += v;
             }
         }
     }

@@ -35,7 +35,18 @@ pub trait NewtonSystem {
     /// Evaluates the reduced residual into `r` and the tangent into the
     /// solver's value array at the current iterate; returns the force scale.
     fn evaluate(&mut self, r: &mut [f64]) -> f64;
-    /// CSC values of the tangent from the last [`NewtonSystem::evaluate`].
+    /// The residual only, at the current iterate (into `r`; returns the
+    /// force scale). Newton calls it first at every iterate and brings the
+    /// tangent up to date ([`NewtonSystem::update_tangent`]) only where a
+    /// factorisation follows — not at the converged iterate. Default: the
+    /// whole [`NewtonSystem::evaluate`].
+    fn residual(&mut self, r: &mut [f64]) -> f64 {
+        self.evaluate(r)
+    }
+    /// Computes the tangent at the current iterate after a
+    /// [`NewtonSystem::residual`] that left it out (default: nothing to do).
+    fn update_tangent(&mut self) {}
+    /// CSC values of the tangent from the last evaluation that computed it.
     fn tangent_values(&self) -> &[f64];
     /// Applies the increment `dq` to the current iterate.
     fn apply(&mut self, dq: &[f64]);
@@ -89,7 +100,7 @@ fn iterate<S: NewtonSystem>(
     let mut history = Vec::with_capacity(settings.max_iterations + 1);
     let mut previous_norm = f64::INFINITY;
     for it in 0..=settings.max_iterations {
-        let scale = sys.evaluate(r);
+        let scale = sys.residual(r);
         let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
         let res = if norm == 0.0 {
             0.0
@@ -114,6 +125,7 @@ fn iterate<S: NewtonSystem>(
         if it == settings.max_iterations {
             break;
         }
+        sys.update_tangent();
         lu.factor(sys.tangent_values())
             .map_err(NewtonFailure::LinearSolve)?;
         if it == 0 {
@@ -138,7 +150,7 @@ fn iterate<S: NewtonSystem>(
 /// factorised first); `converged`: whether the iterate is the solution (or
 /// the start of the step). Costs two triangular solves.
 pub(crate) fn check_regular<S: NewtonSystem>(
-    sys: &S,
+    sys: &mut S,
     lu: &mut SparseLu,
     factored: bool,
     converged: bool,
@@ -147,6 +159,7 @@ pub(crate) fn check_regular<S: NewtonSystem>(
         return Ok(());
     }
     if !factored {
+        sys.update_tangent();
         lu.factor(sys.tangent_values())
             .map_err(NewtonFailure::LinearSolve)?;
     }

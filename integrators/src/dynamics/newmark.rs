@@ -67,14 +67,23 @@ struct NewmarkStep<'a> {
     nodal: Vec<f64>,
     abs: Vec<f64>,
     scratch: Vec<f64>,
+    /// The residual of a tangent update (the same values as the check's).
+    r_tangent: Vec<f64>,
     floor: f64,
 }
 
-impl NewtonSystem for NewmarkStep<'_> {
-    fn evaluate(&mut self, r: &mut [f64]) -> f64 {
+impl NewmarkStep<'_> {
+    /// The residual into `r` (returns the force scale) and, if `tangent`,
+    /// the tangent values.
+    fn evaluate_with(&mut self, r: &mut [f64], tangent: bool) -> f64 {
         self.topo.refresh(self.mech, &self.end);
-        self.asm
-            .assemble(&self.mech.mesh, &self.topo.dofs, &self.end.config);
+        if tangent {
+            self.asm
+                .assemble(&self.mech.mesh, &self.topo.dofs, &self.end.config);
+        } else {
+            self.asm
+                .assemble_residual(&self.mech.mesh, &self.end.config);
+        }
         let (dt, start, prev) = (self.dt, self.start, self.prev);
         for (g, (fi, fe)) in self
             .nodal
@@ -93,12 +102,14 @@ impl NewtonSystem for NewmarkStep<'_> {
                 self.nodal[6 * i + c] += m * a1[c];
                 self.abs[6 * i + c] += (m * a1[c]).abs();
             }
-            self.asm.add_node_block(
-                &self.topo.dofs,
-                (i, 0),
-                (j, 0),
-                &(Matrix3::identity() * (m / (BETA * dt * dt))),
-            );
+            if tangent {
+                self.asm.add_node_block(
+                    &self.topo.dofs,
+                    (i, 0),
+                    (j, 0),
+                    &(Matrix3::identity() * (m / (BETA * dt * dt))),
+                );
+            }
         }
         // Rotational inertia Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), by AD in a spin of Rₙ₊₁.
         type D = DualSVec64<3>;
@@ -124,20 +135,40 @@ impl NewtonSystem for NewmarkStep<'_> {
                 self.abs[6 * i + 3 + c] += m[c].re.abs();
                 k.set_row(c, &m[c].eps.unwrap_generic(Const::<3>, U1).transpose());
             }
-            self.asm.add_node_block(&self.topo.dofs, (i, 3), (i, 3), &k);
+            if tangent {
+                self.asm.add_node_block(&self.topo.dofs, (i, 3), (i, 3), &k);
+            }
         }
         self.topo.dofs.reduce(&self.nodal, r);
         // Joints: the derivative of Nᵀg with the slave's full residual
         // (internal + inertial − external).
-        let blocks = self
-            .topo
-            .geometric_blocks(self.mech, &self.end, &self.nodal);
-        for (b, block) in blocks.iter().enumerate() {
-            self.asm.add_block(b, block);
+        if tangent {
+            let blocks = self
+                .topo
+                .geometric_blocks(self.mech, &self.end, &self.nodal);
+            for (b, block) in blocks.iter().enumerate() {
+                self.asm.add_block(b, block);
+            }
         }
         let dofs = &self.topo.dofs;
         let f_ext = dofs.reduced_norm(&self.fext, &mut self.scratch);
         f_ext.max(dofs.reduced_norm(&self.abs, &mut self.scratch))
+    }
+}
+
+impl NewtonSystem for NewmarkStep<'_> {
+    fn evaluate(&mut self, r: &mut [f64]) -> f64 {
+        self.evaluate_with(r, true)
+    }
+
+    fn residual(&mut self, r: &mut [f64]) -> f64 {
+        self.evaluate_with(r, false)
+    }
+
+    fn update_tangent(&mut self) {
+        let mut r = std::mem::take(&mut self.r_tangent);
+        self.evaluate_with(&mut r, true);
+        self.r_tangent = r;
     }
 
     fn tangent_values(&self) -> &[f64] {
@@ -300,6 +331,7 @@ pub fn solve(
             nodal: vec![0.0; 6 * nodes],
             abs: vec![0.0; 6 * nodes],
             scratch: vec![0.0; n_eq],
+            r_tangent: vec![0.0; n_eq],
             floor: mech.round_off_floor_at(&state.config.x),
         };
         match newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq) {
