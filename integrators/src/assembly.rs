@@ -18,6 +18,31 @@ struct Slots {
     eqs: Vec<usize>,
     /// Position in the CSC value array of local pair (i, j), column-major `j·m + i`.
     pos: Vec<usize>,
+    /// For an element whose nodes are all independent (no joint touches
+    /// it: every node map column is a unit vector), the element DOF of each
+    /// local equation, `(element dof, local index)`: its reduced tangent is
+    /// a gather of the element tangent, with no products with node maps.
+    direct: Option<Vec<(usize, usize)>>,
+}
+
+/// The `(element dof, local index)` pairs of an element whose nodes are all
+/// independent (see [`Slots::direct`]), or `None`.
+fn direct_pairs(el: &Element, dofs: &DofMap, eqs: &[usize]) -> Option<Vec<(usize, usize)>> {
+    let mut pairs = Vec::with_capacity(eqs.len());
+    for (a, &nd) in el.nodes().iter().enumerate() {
+        let map = &dofs.nodes[nd];
+        if map.slave || map.rows.is_some() {
+            return None;
+        }
+        for (eq, col) in map.eqs.iter().zip(&map.cols) {
+            let d = col.iter().position(|&v| v == 1.0)?;
+            if col.iter().filter(|&&v| v != 0.0).count() != 1 {
+                return None;
+            }
+            pairs.push((6 * a + d, eqs.binary_search(eq).ok()?));
+        }
+    }
+    (pairs.len() == eqs.len()).then_some(pairs)
 }
 
 struct Work {
@@ -78,9 +103,11 @@ impl Assembler {
                 tmp: DMatrix::zeros(d, m),
                 k_red: DMatrix::zeros(m, m),
             });
+            let direct = direct_pairs(el, dofs, &eqs);
             slots.push(Slots {
                 eqs,
                 pos: Vec::new(),
+                direct,
             });
         }
         let mut extra: Vec<Slots> = Vec::with_capacity(blocks.len());
@@ -91,6 +118,7 @@ impl Assembler {
             extra.push(Slots {
                 eqs: eqs.clone(),
                 pos: Vec::new(),
+                direct: None,
             });
         }
         let mut col_ptr = Vec::with_capacity(n + 1);
@@ -154,6 +182,14 @@ impl Assembler {
             .zip(self.slots.par_iter())
             .for_each(|((w, (index, el)), s)| {
                 kernel(el, index, w.r.as_mut_slice(), w.k.as_mut_slice());
+                if let Some(pairs) = &s.direct {
+                    for &(lc, c) in pairs {
+                        for &(lr, r) in pairs {
+                            w.k_red[(r, c)] = w.k[(lr, lc)];
+                        }
+                    }
+                    return;
+                }
                 w.g.fill(0.0);
                 let split = el.nodes().iter().any(|&nd| dofs.nodes[nd].rows.is_some());
                 if split {

@@ -118,6 +118,7 @@ impl Topology {
             eqs.extend(released_eqs[j].iter().flatten());
             maps[joint.slave].eqs = eqs.clone();
             maps[joint.slave].cols = vec![Vector6::zeros(); eqs.len()];
+            maps[joint.slave].slave = true;
             local_eqs[j] = eqs;
         }
         let mut topo = Self {

@@ -20,6 +20,10 @@ pub struct NodeMap {
     /// the conserving schemes (rows of the incremental map `Ñ`, columns of
     /// the variational map `N`). `None`: the columns.
     pub rows: Option<Vec<Vector6<f64>>>,
+    /// Whether the node is a joint's slave (its columns and rows change with
+    /// the configuration); an independent node's columns are unit vectors
+    /// for good.
+    pub slave: bool,
 }
 
 impl NodeMap {
