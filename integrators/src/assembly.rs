@@ -176,45 +176,55 @@ impl Assembler {
     where
         F: Fn(&Element, usize, &mut [f64], &mut [f64]) + Sync,
     {
-        self.work
-            .par_iter_mut()
-            .zip(mesh.elements.par_iter().enumerate())
-            .zip(self.slots.par_iter())
-            .for_each(|((w, (index, el)), s)| {
-                kernel(el, index, w.r.as_mut_slice(), w.k.as_mut_slice());
-                if let Some(pairs) = &s.direct {
-                    for &(lc, c) in pairs {
-                        for &(lr, r) in pairs {
-                            w.k_red[(r, c)] = w.k[(lr, lc)];
-                        }
+        let element = |((w, (index, el)), s): ((&mut Work, (usize, &Element)), &Slots)| {
+            kernel(el, index, w.r.as_mut_slice(), w.k.as_mut_slice());
+            if let Some(pairs) = &s.direct {
+                for &(lc, c) in pairs {
+                    for &(lr, r) in pairs {
+                        w.k_red[(r, c)] = w.k[(lr, lc)];
                     }
-                    return;
                 }
-                w.g.fill(0.0);
-                let split = el.nodes().iter().any(|&nd| dofs.nodes[nd].rows.is_some());
-                if split {
-                    w.g_row.fill(0.0);
-                }
-                for (a, &nd) in el.nodes().iter().enumerate() {
-                    let map = &dofs.nodes[nd];
-                    for (k, (eq, col)) in map.eqs.iter().zip(&map.cols).enumerate() {
-                        let j = s
-                            .eqs
-                            .binary_search(eq)
-                            .expect("element equation list is complete");
-                        let row = &map.rows()[k];
-                        for d in 0..6 {
-                            w.g[(6 * a + d, j)] += col[d];
-                            if split {
-                                w.g_row[(6 * a + d, j)] += row[d];
-                            }
+                return;
+            }
+            w.g.fill(0.0);
+            let split = el.nodes().iter().any(|&nd| dofs.nodes[nd].rows.is_some());
+            if split {
+                w.g_row.fill(0.0);
+            }
+            for (a, &nd) in el.nodes().iter().enumerate() {
+                let map = &dofs.nodes[nd];
+                for (k, (eq, col)) in map.eqs.iter().zip(&map.cols).enumerate() {
+                    let j = s
+                        .eqs
+                        .binary_search(eq)
+                        .expect("element equation list is complete");
+                    let row = &map.rows()[k];
+                    for d in 0..6 {
+                        w.g[(6 * a + d, j)] += col[d];
+                        if split {
+                            w.g_row[(6 * a + d, j)] += row[d];
                         }
                     }
                 }
-                w.tmp.gemm(1.0, &w.k, &w.g, 0.0);
-                let rows = if split { &w.g_row } else { &w.g };
-                w.k_red.gemm_tr(1.0, rows, &w.tmp, 0.0);
-            });
+            }
+            w.tmp.gemm(1.0, &w.k, &w.g, 0.0);
+            let rows = if split { &w.g_row } else { &w.g };
+            w.k_red.gemm_tr(1.0, rows, &w.tmp, 0.0);
+        };
+        // One thread asked for: no hand-off to a worker at all.
+        if rayon::current_num_threads() == 1 {
+            self.work
+                .iter_mut()
+                .zip(mesh.elements.iter().enumerate())
+                .zip(&self.slots)
+                .for_each(element);
+        } else {
+            self.work
+                .par_iter_mut()
+                .zip(mesh.elements.par_iter().enumerate())
+                .zip(self.slots.par_iter())
+                .for_each(element);
+        }
         self.values.iter_mut().for_each(|v| *v = 0.0);
         self.scatter_forces(mesh);
         for (w, s) in self.work.iter().zip(&self.slots) {
@@ -228,10 +238,17 @@ impl Assembler {
     /// the tangent values are left as they were): for a residual check that
     /// no factorisation follows.
     pub fn assemble_residual(&mut self, mesh: &Mesh, config: &Configuration) {
-        self.work
-            .par_iter_mut()
-            .zip(mesh.elements.par_iter())
-            .for_each(|(w, el)| el.internal_force_into(&config.x, &config.rot, w.r.as_mut_slice()));
+        let element = |(w, el): (&mut Work, &Element)| {
+            el.internal_force_into(&config.x, &config.rot, w.r.as_mut_slice())
+        };
+        if rayon::current_num_threads() == 1 {
+            self.work.iter_mut().zip(&mesh.elements).for_each(element);
+        } else {
+            self.work
+                .par_iter_mut()
+                .zip(mesh.elements.par_iter())
+                .for_each(element);
+        }
         self.scatter_forces(mesh);
     }
 
@@ -275,6 +292,55 @@ impl Assembler {
                 if v != 0.0 {
                     self.add_entry(*ei, *ej, v);
                 }
+            }
+        }
+    }
+
+    /// Where [`Self::add_node_block`] of two independent nodes lands:
+    /// `(value position, a, b)` triples such that the block `k` adds
+    /// `k[(a, b)]` at each position — found once, so that a constant block
+    /// (a mass) is added every iteration without searching the pattern.
+    /// `None` when either node is a slave (its maps change with the
+    /// configuration).
+    pub fn node_block_slots(
+        &self,
+        dofs: &DofMap,
+        (i, ri): (usize, usize),
+        (j, cj): (usize, usize),
+    ) -> Option<Vec<(usize, usize, usize)>> {
+        let (mi, mj) = (&dofs.nodes[i], &dofs.nodes[j]);
+        if mi.slave || mj.slave || mi.rows.is_some() || mj.rows.is_some() {
+            return None;
+        }
+        let unit = |c: &nalgebra::Vector6<f64>| c.iter().position(|&v| v == 1.0);
+        let (cp, ri_idx) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        let mut out = Vec::new();
+        for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
+            let a = unit(ci)?;
+            if !(ri..ri + 3).contains(&a) {
+                continue;
+            }
+            for (ej, cjv) in mj.eqs.iter().zip(&mj.cols) {
+                let b = unit(cjv)?;
+                if !(cj..cj + 3).contains(&b) {
+                    continue;
+                }
+                let rows = &ri_idx[cp[*ej]..cp[*ej + 1]];
+                let p = rows.binary_search(ei).ok()?;
+                out.push((cp[*ej] + p, a - ri, b - cj));
+            }
+        }
+        Some(out)
+    }
+
+    /// Adds the node block `k` at the positions of
+    /// [`Self::node_block_slots`] (the same sums as
+    /// [`Self::add_node_block`]).
+    pub fn add_node_block_at(&mut self, slots: &[(usize, usize, usize)], k: &Matrix3<f64>) {
+        for &(p, a, b) in slots {
+            let v = k[(a, b)];
+            if v != 0.0 {
+                self.values[p] += v;
             }
         }
     }

@@ -53,6 +53,29 @@ fn angular_acceleration<T: flexmech_core::Scalar>(
     (big_omega - w_n.map(c) * c(dt) - a_n.map(c) * c(dt * dt * (0.5 - BETA))) / c(BETA * dt * dt)
 }
 
+/// Where the mass blocks land in the tangent values, found once per run:
+/// per translational mass entry `(i, j, m)` and per node's rotational
+/// inertia (`None` where a slave is involved: its maps change).
+struct MassSlots {
+    translational: Vec<Option<Vec<(usize, usize, usize)>>>,
+    rotational: Vec<Option<Vec<(usize, usize, usize)>>>,
+}
+
+impl MassSlots {
+    fn new(asm: &Assembler, dofs: &crate::dofs::DofMap, inertia: &Inertia) -> Self {
+        Self {
+            translational: inertia
+                .mass
+                .iter()
+                .map(|&(i, j, _)| asm.node_block_slots(dofs, (i, 0), (j, 0)))
+                .collect(),
+            rotational: (0..inertia.rotational.len())
+                .map(|i| asm.node_block_slots(dofs, (i, 3), (i, 3)))
+                .collect(),
+        }
+    }
+}
+
 struct NewmarkStep<'a> {
     mech: &'a Mechanism,
     topo: &'a mut Topology,
@@ -69,6 +92,8 @@ struct NewmarkStep<'a> {
     scratch: Vec<f64>,
     /// The residual of a tangent update (the same values as the check's).
     r_tangent: Vec<f64>,
+    /// Tangent positions of the mass blocks (see [`MassSlots`]).
+    slots: &'a MassSlots,
     floor: f64,
 }
 
@@ -103,12 +128,13 @@ impl NewmarkStep<'_> {
                 self.abs[6 * i + c] += (m * a1[c]).abs();
             }
             if tangent {
-                self.asm.add_node_block(
-                    &self.topo.dofs,
-                    (i, 0),
-                    (j, 0),
-                    &(Matrix3::identity() * (m / (BETA * dt * dt))),
-                );
+                let block = Matrix3::identity() * (m / (BETA * dt * dt));
+                match &self.slots.translational[k] {
+                    Some(at) => self.asm.add_node_block_at(at, &block),
+                    None => self
+                        .asm
+                        .add_node_block(&self.topo.dofs, (i, 0), (j, 0), &block),
+                }
             }
         }
         // Rotational inertia Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), by AD in a spin of Rₙ₊₁.
@@ -136,7 +162,10 @@ impl NewmarkStep<'_> {
                 k.set_row(c, &m[c].eps.unwrap_generic(Const::<3>, U1).transpose());
             }
             if tangent {
-                self.asm.add_node_block(&self.topo.dofs, (i, 3), (i, 3), &k);
+                match &self.slots.rotational[i] {
+                    Some(at) => self.asm.add_node_block_at(at, &k),
+                    None => self.asm.add_node_block(&self.topo.dofs, (i, 3), (i, 3), &k),
+                }
             }
         }
         self.topo.dofs.reduce(&self.nodal, r);
@@ -262,6 +291,7 @@ pub fn solve(
     let inertia = Inertia::new(&mech.mesh, settings.mass);
     let mut asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
     let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
+    let slots = MassSlots::new(&asm, &topo.dofs, &inertia);
     let (mut r, mut dq) = (vec![0.0; n_eq], vec![0.0; n_eq]);
     let mut fext = vec![0.0; 6 * nodes];
     mech.external_forces(0.0, &mut fext);
@@ -332,6 +362,7 @@ pub fn solve(
             abs: vec![0.0; 6 * nodes],
             scratch: vec![0.0; n_eq],
             r_tangent: vec![0.0; n_eq],
+            slots: &slots,
             floor: mech.round_off_floor_at(&state.config.x),
         };
         match newton::solve(&mut sys, &mut lu, &settings.newton, &mut r, &mut dq) {
