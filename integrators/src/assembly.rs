@@ -31,14 +31,7 @@ fn direct_pairs(el: &Element, dofs: &DofMap, eqs: &[usize]) -> Option<Vec<(usize
     let mut pairs = Vec::with_capacity(eqs.len());
     for (a, &nd) in el.nodes().iter().enumerate() {
         let map = &dofs.nodes[nd];
-        if map.slave || map.rows.is_some() {
-            return None;
-        }
-        for (eq, col) in map.eqs.iter().zip(&map.cols) {
-            let d = col.iter().position(|&v| v == 1.0)?;
-            if col.iter().filter(|&&v| v != 0.0).count() != 1 {
-                return None;
-            }
+        for (eq, d) in map.eqs.iter().zip(map.own_dofs()?) {
             pairs.push((6 * a + d, eqs.binary_search(eq).ok()?));
         }
     }
@@ -309,19 +302,14 @@ impl Assembler {
         (j, cj): (usize, usize),
     ) -> Option<Vec<(usize, usize, usize)>> {
         let (mi, mj) = (&dofs.nodes[i], &dofs.nodes[j]);
-        if mi.slave || mj.slave || mi.rows.is_some() || mj.rows.is_some() {
-            return None;
-        }
-        let unit = |c: &nalgebra::Vector6<f64>| c.iter().position(|&v| v == 1.0);
+        let (di, dj) = (mi.own_dofs()?, mj.own_dofs()?);
         let (cp, ri_idx) = (self.pattern.col_ptr(), self.pattern.row_idx());
         let mut out = Vec::new();
-        for (ei, ci) in mi.eqs.iter().zip(&mi.cols) {
-            let a = unit(ci)?;
+        for (ei, &a) in mi.eqs.iter().zip(&di) {
             if !(ri..ri + 3).contains(&a) {
                 continue;
             }
-            for (ej, cjv) in mj.eqs.iter().zip(&mj.cols) {
-                let b = unit(cjv)?;
+            for (ej, &b) in mj.eqs.iter().zip(&dj) {
                 if !(cj..cj + 3).contains(&b) {
                     continue;
                 }

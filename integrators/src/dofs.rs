@@ -31,6 +31,22 @@ impl NodeMap {
     pub fn rows(&self) -> &[Vector6<f64>] {
         self.rows.as_deref().unwrap_or(&self.cols)
     }
+
+    /// For an independent node (not a slave, rows equal to columns, every
+    /// column a unit vector), the nodal DOF (0..6) of each of its equations;
+    /// `None` otherwise. Such a node's map never changes.
+    pub fn own_dofs(&self) -> Option<Vec<usize>> {
+        if self.slave || self.rows.is_some() {
+            return None;
+        }
+        self.cols
+            .iter()
+            .map(|c| {
+                let d = c.iter().position(|&v| v == 1.0)?;
+                (c.iter().filter(|&&v| v != 0.0).count() == 1).then_some(d)
+            })
+            .collect()
+    }
 }
 
 /// The unknowns of a mechanism and every node's map.
