@@ -79,18 +79,18 @@ use nalgebra::{Matrix3, SVector, Vector3};
 pub const RIGID_STEP: f64 = 1e-7;
 
 /// The pieces of one element's step the discrete gradient is built from.
-struct Step<T: Scalar> {
+pub(crate) struct Step<T: Scalar> {
     /// Algebraic mean of the reference rotations.
-    lam_bar: Matrix3<T>,
+    pub(crate) lam_bar: Matrix3<T>,
     /// Mean chord `d̄`.
-    dbar: Vector3<T>,
+    pub(crate) dbar: Vector3<T>,
     /// The smooth operators `B`, `T` and the mismatches `δ − BΔθ`, `Δφ − TΔθ`.
-    b: Matrix3<T>,
-    t: Matrix3<T>,
-    b_miss: Vector3<T>,
-    t_miss: Vector3<T>,
+    pub(crate) b: Matrix3<T>,
+    pub(crate) t: Matrix3<T>,
+    pub(crate) b_miss: Vector3<T>,
+    pub(crate) t_miss: Vector3<T>,
     /// `Δθ/(|Δθ|² + ε²)`, the direction of the rank-one corrections.
-    direction: Vector3<T>,
+    pub(crate) direction: Vector3<T>,
 }
 
 /// Spatial tangent of the Cayley map: `δcay(c) cay(c)ᵀ = (Q(c) δc)^`,
@@ -137,7 +137,7 @@ pub(crate) fn secant_operators<T: Scalar>(
 }
 
 impl BeamElement<2> {
-    fn dg_step<T: Scalar>(&self, start: &Pose<T>, end: &Pose<T>) -> Step<T> {
+    pub(crate) fn dg_step<T: Scalar>(&self, start: &Pose<T>, end: &Pose<T>) -> Step<T> {
         let half = cst::<T>(0.5);
         let ends = [self.triads(&start.1), self.triads(&end.1)];
         let phi = ends.map(|l| log(&(l[0].transpose() * l[1])));

@@ -7,6 +7,7 @@ pub mod scalar;
 
 pub use scalar::{cst, Scalar};
 pub mod conserving;
+pub mod conserving_tangent;
 pub mod discrete_gradient;
 pub mod discrete_gradient_quadratic;
 pub mod element;

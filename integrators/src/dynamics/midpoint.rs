@@ -132,8 +132,11 @@ pub(super) fn midpoint_forces(
 /// scheme; the energy-consistent discrete gradient for the energy–momentum
 /// scheme; `q_k(Nₙ₊½, Mₙ₊½) + β q_k(N_d, 0)` with the algebraic mid rotation
 /// for the paper's energy–momentum scheme) and its derivative with respect
-/// to spatial increments of the end pose (`x ← x + η`, `R ← exp(η̂)R`), by
-/// forward-mode AD.
+/// to spatial increments of the end pose (`x ← x + η`, `R ← exp(η̂)R`):
+/// closed form for the momentum scheme, AD over the end spins with
+/// closed-form chord columns for the energy–momentum scheme
+/// ([`flexmech_core::conserving_tangent`]), forward-mode AD over all twelve
+/// increments for the paper's scheme.
 fn element_kernel(
     el: &Element,
     start: &Configuration,
@@ -147,28 +150,32 @@ fn element_kernel(
         Element::Linear(e) => e,
         Element::Quadratic(e) => return quadratic_kernel(e, start, end, r, k),
     };
-    type D = Dual12;
-    let (s, sd, ed) = seeded_poses(e, start, end);
-    let q = match scheme {
-        Scheme::EnergyMomentum => {
-            let (nbar, mbar) = averaged_resultants(e, &s, &ed);
-            e.discrete_gradient_force(&sd, &ed, &nbar, &mbar)
-        }
-        Scheme::Momentum | Scheme::EnergyMomentumPaper => {
+    let pose = |c: &Configuration| -> Pose<f64> {
+        let n = e.nodes;
+        ([c.x[n[0]], c.x[n[1]]], [c.rot[n[0]], c.rot[n[1]]])
+    };
+    let (q, jac) = match scheme {
+        Scheme::Momentum => e.momentum_force_tangent(&pose(start), &pose(end)),
+        Scheme::EnergyMomentum => e.energy_momentum_force_tangent(&pose(start), &pose(end)),
+        Scheme::EnergyMomentumPaper => {
+            type D = Dual12;
+            let (s, sd, ed) = seeded_poses(e, start, end);
             let (mut q, qd) = midpoint_forces(e, &s, &sd, &ed, scheme.mid_rotation(), beta != 0.0);
             if let Some(qd) = qd {
                 q += qd * D::from_re(beta);
             }
-            q
+            for i in 0..12 {
+                r[i] = q[i].re;
+                let row = q[i].eps.unwrap_generic(Const::<12>, U1);
+                for j in 0..12 {
+                    k[j * 12 + i] = row[j];
+                }
+            }
+            return;
         }
     };
-    for i in 0..12 {
-        r[i] = q[i].re;
-        let row = q[i].eps.unwrap_generic(Const::<12>, U1);
-        for j in 0..12 {
-            k[j * 12 + i] = row[j];
-        }
-    }
+    r.copy_from_slice(q.as_slice());
+    k.copy_from_slice(jac.as_slice());
 }
 
 /// Element kernel for 3-node elements, in both conserving schemes: the
