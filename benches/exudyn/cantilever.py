@@ -92,7 +92,6 @@ cpu1 = time.process_time()
 if a.static:
     s.staticSolver.numberOfLoadSteps = 10
     s.staticSolver.verboseMode = 0
-    s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
     mbs.SolveStatic(s)
     u = mbs.GetNodeOutput(nodes[-1], exu.OutputVariableType.Displacement)
     print(f'static tip displacement {u}; linear PL^3/(3EI) + PL/GA = {50*8/3000 + 50*2/1e6:.6f}')

@@ -3,16 +3,18 @@
 # CPU time (one thread each, paired rounds A B C, A B C, ...) and tip agreement.
 #
 #   benches/exudyn/compare.sh [ELEMENTS] [T_END] [ROUNDS]     (defaults 512 0.1 3)
-#   FLEXMECH=path/to/flexmech overrides the binary (default /tmp/flexmech-bench-bin)
+#   FLEXMECH=path/to/flexmech overrides the binary (default: this repository's
+#   target/release/flexmech; build it with `cargo build --release`)
 #
 # A = flexmech (Newmark, full Newton), whole-process CPU (its setup is negligible);
+# M = flexmech (Newmark, newton = "modified"), whole-process CPU;
 # B = Exudyn, full Newton; C = Exudyn, fastest setting (modified Newton, exudynCPPfast).
 # For B and C both the solve alone (time.process_time inside Python) and the whole
 # process (Python start-up, import and model build included) are reported.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 ne="${1:-512}"; tend="${2:-0.1}"; rounds="${3:-3}"
-bin="${FLEXMECH:-/tmp/flexmech-bench-bin}"
+bin="${FLEXMECH:-$here/../../target/release/flexmech}"
 export RAYON_NUM_THREADS=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
 out="$(mktemp -d)"; trap 'rm -rf "$out"' EXIT
 
@@ -20,6 +22,7 @@ out="$(mktemp -d)"; trap 'rm -rf "$out"' EXIT
 sed -e "0,/^name = .*/s//name = \"cantilever\"/" -e "s/^elements = .*/elements = $ne/" \
     -e "s/^t_end = .*/t_end = $tend/" -e "s/^every = .*/every = 1/" \
     "$here/../cantilever512.toml" > "$out/cantilever.toml"
+sed -e 's/^\[solver\]/[solver]\nnewton = "modified"/' "$out/cantilever.toml" > "$out/modified.toml"
 
 TIMEFORMAT='%U %S'
 cpu() {  # cpu LOGFILE CMD... : run CMD, its stdout to LOGFILE, print user+sys seconds
@@ -30,31 +33,40 @@ cpu() {  # cpu LOGFILE CMD... : run CMD, its stdout to LOGFILE, print user+sys s
 solve() { awk '/^cpu_solve_s/ {print $2}' "$1"; }
 
 echo "cantilever: $ne elements, t_end $tend, dt 1e-3, $rounds rounds, one thread each"
-printf '%-6s %10s | %10s %10s | %10s %10s\n' round "flexmech" "B solve" "B process" "C solve" "C process"
+printf '%-6s %10s %10s | %10s %10s | %10s %10s\n' round "A flexmech" "M modified" "B solve" "B process" "C solve" "C process"
 rows=()
 for r in $(seq 1 "$rounds"); do
     a=$(cpu "$out/a.log" "$bin" run "$out/cantilever.toml" --out "$out/fm")
+    m=$(cpu "$out/m.log" "$bin" run "$out/modified.toml" --out "$out/fmm")
     b=$(cpu "$out/b.log" python3 "$here/cantilever.py" --elements "$ne" --t-end "$tend" --csv "$out/full.csv")
     c=$(cpu "$out/c.log" python3 "$here/cantilever.py" --elements "$ne" --t-end "$tend" --fast --csv "$out/fast.csv")
     bs=$(solve "$out/b.log"); cs=$(solve "$out/c.log")
-    printf '%-6s %10s | %10s %10s | %10s %10s\n' "$r" "$a" "$bs" "$b" "$cs" "$c"
-    rows+=("$a $bs $b $cs $c")
+    printf '%-6s %10s %10s | %10s %10s | %10s %10s\n' "$r" "$a" "$m" "$bs" "$b" "$cs" "$c"
+    rows+=("$a $bs $b $cs $c $m")
 done
 printf '%s\n' "${rows[@]}" | awk '
     function med(x, n,   i, j, t) { for (i = 1; i <= n; i++) for (j = i + 1; j <= n; j++)
         if (x[j] < x[i]) { t = x[i]; x[i] = x[j]; x[j] = t } return x[int((n + 1) / 2)] }
-    { n++; r1[n] = $1 / $2; r2[n] = $1 / $3; r3[n] = $1 / $4; r4[n] = $1 / $5 }
-    END { printf "median ratio flexmech/Exudyn-full    : %.3f (solve only)  %.3f (whole process)\n", med(r1, n), med(r2, n)
-          printf "median ratio flexmech/Exudyn-fastest : %.3f (solve only)  %.3f (whole process)\n", med(r3, n), med(r4, n) }'
+    { n++; r1[n] = $1 / $2; r2[n] = $1 / $3; r3[n] = $1 / $4; r4[n] = $1 / $5
+      r5[n] = $6 / $2; r6[n] = $6 / $3; r7[n] = $6 / $4; r8[n] = $6 / $5 }
+    END { printf "median ratio A flexmech-full/Exudyn-full        : %.3f (solve only)  %.3f (whole process)\n", med(r1, n), med(r2, n)
+          printf "median ratio A flexmech-full/Exudyn-fastest     : %.3f (solve only)  %.3f (whole process)\n", med(r3, n), med(r4, n)
+          printf "median ratio M flexmech-modified/Exudyn-full    : %.3f (solve only)  %.3f (whole process)\n", med(r5, n), med(r6, n)
+          printf "median ratio M flexmech-modified/Exudyn-fastest : %.3f (solve only)  %.3f (whole process)\n", med(r7, n), med(r8, n) }'
 echo "flexmech: $(head -1 "$out/a.log")"
 grep -h '^exudyn' "$out/b.log" "$out/c.log"
 
-python3 - "$out/fm/cantilever.h5" "$out/full.csv" "$out/fast.csv" <<'PY'
+python3 - "$out/fm/cantilever.h5" "$out/full.csv" "$out/fast.csv" "$out/fmm/cantilever.h5" <<'PY'
 import sys, h5py, numpy as np
 with h5py.File(sys.argv[1]) as f:
     t, uz = f['/time'][:], f['/nodes/b.end/displacement'][:, 2]
 umax = np.abs(uz).max()
 print(f'flexmech tip uz: final {uz[-1]:.9f}, max {umax:.9f}')
+with h5py.File(sys.argv[4]) as f:
+    uzm = f['/nodes/b.end/displacement'][:, 2]
+    fac, its = f['/solver/factorizations'][:].sum(), f['/solver/iterations'][:].sum()
+print(f'flexmech modified Newton: max |uz_modified - uz_full| / max|uz| = {np.abs(uzm - uz).max() / umax:.2e}; '
+      f'{fac} factorisations, {its} iterations')
 for name, path in (('full Newton', sys.argv[2]), ('fastest', sys.argv[3])):
     e = np.loadtxt(path, delimiter=',', skiprows=1)
     assert len(e) == len(t) and np.allclose(e[:, 0], t, atol=1e-12), 'time grids differ'

@@ -48,6 +48,7 @@ fn bench(c: &mut Criterion) {
             newton: NewtonSettings {
                 tolerance: 1e-10,
                 max_iterations: 30,
+                modified: false,
             },
             max_halvings: 4,
             mass: MassKind::Consistent,

@@ -231,9 +231,18 @@ impl Assembler {
     /// the tangent values are left as they were): for a residual check that
     /// no factorisation follows.
     pub fn assemble_residual(&mut self, mesh: &Mesh, config: &Configuration) {
-        let element = |(w, el): (&mut Work, &Element)| {
-            el.internal_force_into(&config.x, &config.rot, w.r.as_mut_slice())
-        };
+        self.assemble_residual_with(mesh, |el, r| {
+            el.internal_force_into(&config.x, &config.rot, r)
+        });
+    }
+
+    /// [`Self::assemble_residual`] with the element forces of `kernel`
+    /// (element, its force out, ordered as the element's nodes).
+    pub fn assemble_residual_with<F>(&mut self, mesh: &Mesh, kernel: F)
+    where
+        F: Fn(&Element, &mut [f64]) + Sync,
+    {
+        let element = |(w, el): (&mut Work, &Element)| kernel(el, w.r.as_mut_slice());
         if rayon::current_num_threads() == 1 {
             self.work.iter_mut().zip(&mesh.elements).for_each(element);
         } else {

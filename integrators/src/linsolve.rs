@@ -79,6 +79,8 @@ pub struct SparseLu {
     factor_mem: MemBuffer,
     solve_mem: MemBuffer,
     factored: bool,
+    /// The key of the factorised matrix's form (see [`SparseLu::key`]).
+    key: f64,
 }
 
 impl SparseLu {
@@ -96,6 +98,7 @@ impl SparseLu {
             factor_mem: MemBuffer::new(req),
             solve_mem: MemBuffer::new(sreq),
             factored: false,
+            key: f64::NAN,
         })
     }
 
@@ -108,6 +111,7 @@ impl SparseLu {
     pub fn factor(&mut self, values: &[f64]) -> Result<(), String> {
         let mat = SparseColMatRef::new(self.pattern.as_ref(), values);
         self.factored = false;
+        self.key = f64::NAN;
         self.symbolic
             .factorize_numeric_lu(
                 &mut self.numeric,
@@ -119,6 +123,19 @@ impl SparseLu {
             .map_err(|e| format!("numeric LU failed: {e:?}"))?;
         self.factored = true;
         Ok(())
+    }
+
+    /// The key its owner attached to the current factorisation
+    /// ([`SparseLu::set_key`]; none after a plain [`SparseLu::factor`]):
+    /// modified Newton reuses a factorisation only for a system with the
+    /// same key (`NaN` never matches).
+    pub fn key(&self) -> Option<f64> {
+        (self.factored && !self.key.is_nan()).then_some(self.key)
+    }
+
+    /// Attaches `key` to the current factorisation.
+    pub fn set_key(&mut self, key: f64) {
+        self.key = key;
     }
 
     /// Solves `A x = rhs` in place with the last factorisation. Returns an

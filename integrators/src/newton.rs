@@ -28,7 +28,19 @@ pub struct NewtonSettings {
     pub tolerance: f64,
     /// Maximum number of linear solves.
     pub max_iterations: usize,
+    /// Modified Newton: keep a factorised tangent across iterations and
+    /// steps, and refactor only when it converges too slowly (a residual
+    /// not below [`MODIFIED_CONTRACTION`] times the previous one), when the
+    /// system's tangent changed form ([`NewtonSystem::tangent_key`], e.g. a
+    /// new step size) or at the first solve. The solution satisfies the same
+    /// tolerance; only the path to it differs. `false`: the exact tangent at
+    /// every iterate (quadratic convergence).
+    pub modified: bool,
 }
+
+/// Largest ratio of successive residuals modified Newton accepts before it
+/// refactors the tangent at the current iterate.
+pub const MODIFIED_CONTRACTION: f64 = 0.5;
 
 /// A nonlinear system `r(q) = 0` in the reduced unknowns.
 pub trait NewtonSystem {
@@ -50,6 +62,13 @@ pub trait NewtonSystem {
     fn tangent_values(&self) -> &[f64];
     /// Applies the increment `dq` to the current iterate.
     fn apply(&mut self, dq: &[f64]);
+    /// What the tangent's form depends on besides the iterate (the step size
+    /// of a dynamic step): modified Newton reuses a factorisation from an
+    /// earlier solve only when the key is the same. `NaN` (the default)
+    /// never matches, so such systems refactor at every solve.
+    fn tangent_key(&self) -> f64 {
+        f64::NAN
+    }
     /// Absolute residual norm below which the residual is round-off.
     fn floor(&self) -> f64 {
         0.0
@@ -64,6 +83,8 @@ pub trait NewtonSystem {
 pub struct NewtonReport {
     /// Linear solves performed.
     pub iterations: usize,
+    /// Tangent factorisations among them.
+    pub factorizations: usize,
     /// Final scaled residual.
     pub residual: f64,
     /// Scaled residual before each solve and at the end.
@@ -85,7 +106,9 @@ pub fn solve<S: NewtonSystem>(
 ) -> Result<NewtonReport, NewtonFailure> {
     let mut factored = false;
     let report = iterate(sys, lu, settings, r, dq, &mut factored)?;
-    check_regular(sys, lu, factored, true)?;
+    if !settings.modified {
+        check_regular(sys, lu, factored, true)?;
+    }
     Ok(report)
 }
 
@@ -99,6 +122,7 @@ fn iterate<S: NewtonSystem>(
 ) -> Result<NewtonReport, NewtonFailure> {
     let mut history = Vec::with_capacity(settings.max_iterations + 1);
     let mut previous_norm = f64::INFINITY;
+    let mut factorizations = 0;
     for it in 0..=settings.max_iterations {
         let scale = sys.residual(r);
         let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -115,6 +139,7 @@ fn iterate<S: NewtonSystem>(
         if res <= settings.tolerance || floored {
             return Ok(NewtonReport {
                 iterations: it,
+                factorizations,
                 residual: res,
                 history,
             });
@@ -125,11 +150,23 @@ fn iterate<S: NewtonSystem>(
         if it == settings.max_iterations {
             break;
         }
-        sys.update_tangent();
-        lu.factor(sys.tangent_values())
-            .map_err(NewtonFailure::LinearSolve)?;
-        if it == 0 {
-            check_regular(sys, lu, true, false)?;
+        let reuse = settings.modified
+            && if it == 0 {
+                lu.key() == Some(sys.tangent_key())
+            } else {
+                res < MODIFIED_CONTRACTION * history[it - 1]
+            };
+        if !reuse {
+            sys.update_tangent();
+            lu.factor(sys.tangent_values())
+                .map_err(NewtonFailure::LinearSolve)?;
+            lu.set_key(sys.tangent_key());
+            factorizations += 1;
+            // Full Newton checks the start of the solve (and the converged
+            // iterate, in `solve`); modified Newton every tangent it keeps.
+            if it == 0 || settings.modified {
+                check_regular(sys, lu, true, false)?;
+            }
         }
         *factored = true;
         for (d, v) in dq.iter_mut().zip(r.iter()) {

@@ -39,6 +39,9 @@ pub struct StepRecord {
     pub dt: f64,
     /// Newton iterations of the step.
     pub iterations: usize,
+    /// Tangent factorisations of the step (equal to `iterations` with full
+    /// Newton; fewer with modified Newton, which reuses one).
+    pub factorizations: usize,
     /// Final scaled residual norm.
     pub residual: f64,
     /// Scaled residual after each Newton iteration (index 0: before the first solve).

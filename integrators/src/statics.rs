@@ -138,6 +138,7 @@ fn record(
         time,
         dt,
         iterations: report.iterations,
+        factorizations: report.factorizations,
         residual: report.residual,
         residual_history: report.history.clone(),
         beta: f64::NAN,

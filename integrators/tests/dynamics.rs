@@ -54,6 +54,7 @@ fn spinning_beam_of(
         newton: NewtonSettings {
             tolerance: 1e-12,
             max_iterations: 30,
+            modified: false,
         },
         max_halvings: 6,
         mass,
@@ -226,6 +227,7 @@ fn tumbling_rigid_body_keeps_its_exact_energy_and_momentum() {
         newton: NewtonSettings {
             tolerance: 1e-12,
             max_iterations: 30,
+            modified: false,
         },
         max_halvings: 6,
         mass: MassKind::Consistent,

@@ -133,6 +133,7 @@ fn settings(dt: f64, t_end: f64) -> DynamicSettings {
         newton: NewtonSettings {
             tolerance: TOL,
             max_iterations: 40,
+            modified: false,
         },
         max_halvings: 4,
         mass: MassKind::Consistent,

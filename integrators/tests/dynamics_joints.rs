@@ -81,6 +81,7 @@ fn arm_descends_the_screw_with_the_rigid_body_acceleration() {
         newton: NewtonSettings {
             tolerance: 1e-10,
             max_iterations: 30,
+            modified: false,
         },
         max_halvings: 6,
         mass: MassKind::Consistent,
@@ -157,6 +158,7 @@ fn driven_screw_balances_energy_with_the_drive_work() {
         newton: NewtonSettings {
             tolerance: 1e-11,
             max_iterations: 30,
+            modified: false,
         },
         max_halvings: 6,
         mass: MassKind::Consistent,

@@ -82,6 +82,7 @@ fn settings(dt: f64) -> DynamicSettings {
         newton: NewtonSettings {
             tolerance: TOLERANCE,
             max_iterations: 30,
+            modified: false,
         },
         max_halvings: 6,
         mass: MassKind::Consistent,

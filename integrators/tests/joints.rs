@@ -108,6 +108,7 @@ fn settings(steps: usize) -> StaticSettings {
         newton: NewtonSettings {
             tolerance: 1e-10,
             max_iterations: 30,
+            modified: false,
         },
         max_halvings: 8,
     }

@@ -45,6 +45,7 @@ fn settings(steps: usize) -> StaticSettings {
         newton: NewtonSettings {
             tolerance: 1e-10,
             max_iterations: 25,
+            modified: false,
         },
         max_halvings: 10,
     }

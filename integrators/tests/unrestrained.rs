@@ -42,6 +42,7 @@ fn statics(mech: &Mechanism) -> Result<usize, SolveError> {
         newton: NewtonSettings {
             tolerance: 1e-10,
             max_iterations: 30,
+            modified: false,
         },
         max_halvings: 4,
     };
@@ -142,6 +143,7 @@ fn dynamics(rho_a: f64, rho_j: f64) -> (Mechanism, Motion, DynamicSettings) {
         newton: NewtonSettings {
             tolerance: 1e-12,
             max_iterations: 30,
+            modified: false,
         },
         max_halvings: 4,
         mass: MassKind::Consistent,

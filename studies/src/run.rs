@@ -197,6 +197,7 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
                 newton: NewtonSettings {
                     tolerance: model.solver.tolerance,
                     max_iterations: model.solver.max_iterations,
+                    modified: false,
                 },
                 max_halvings: model.solver.max_halvings,
             };
@@ -213,6 +214,7 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
                 newton: NewtonSettings {
                     tolerance: model.solver.tolerance,
                     max_iterations: model.solver.max_iterations,
+                    modified: model.solver.modified_newton,
                 },
                 max_halvings: model.solver.max_halvings,
                 mass: match model.solver.mass {

@@ -358,6 +358,7 @@ fn record(step: usize) -> StepRecord {
         time: t,
         dt: 0.1,
         iterations: 3,
+        factorizations: 3,
         residual: 1e-11,
         residual_history: vec![1.0, 1e-5, 1e-11],
         beta: f64::NAN,

@@ -216,6 +216,7 @@ fn base_file_parses_with_defaults() {
             max_iterations: 25,
             max_halvings: 10,
             mass: MassKind::Consistent,
+            modified_newton: false,
         }
     );
     assert_eq!(m.output.every, 1);

@@ -115,6 +115,7 @@ fn record(step: usize) -> StepRecord {
         time: 0.1 * (k + 1.0),
         dt: 0.01 / (k + 1.0),
         iterations: 3 + step,
+        factorizations: 1 + step,
         residual: 1e-10 * (k + 1.0),
         residual_history: history(step),
         beta: beta(step),

@@ -183,6 +183,7 @@ pub(super) fn solve_step(
             return Ok((
                 NewtonReport {
                     iterations: it,
+                    factorizations: it,
                     residual: res,
                     history,
                 },

@@ -178,6 +178,48 @@ fn element_kernel(
     k.copy_from_slice(jac.as_slice());
 }
 
+/// The element force of [`element_kernel`] alone (no derivative): for
+/// residual checks that no factorisation follows.
+fn element_force(
+    el: &Element,
+    start: &Configuration,
+    end: &Configuration,
+    scheme: Scheme,
+    beta: f64,
+    r: &mut [f64],
+) {
+    let q = match (el, scheme) {
+        (Element::Linear(e), Scheme::Momentum | Scheme::EnergyMomentum) => {
+            let n = e.nodes;
+            let s: Pose<f64> = (
+                [start.x[n[0]], start.x[n[1]]],
+                [start.rot[n[0]], start.rot[n[1]]],
+            );
+            let t: Pose<f64> = ([end.x[n[0]], end.x[n[1]]], [end.rot[n[0]], end.rot[n[1]]]);
+            let (n0, m0) = e.resultants(&s.0, &s.1);
+            let (n1, m1) = e.resultants(&t.0, &t.1);
+            let (nbar, mbar) = ((n0 + n1) * 0.5, (m0 + m1) * 0.5);
+            if scheme == Scheme::Momentum {
+                e.midpoint_force(&s, &t, &nbar, &mbar, MidRotation::Geodesic)
+            } else {
+                e.discrete_gradient_force(&s, &t, &nbar, &mbar)
+            }
+        }
+        (Element::Quadratic(e), _) => {
+            let n = e.nodes;
+            let s: Pose3<f64> = (n.map(|i| start.x[i]), n.map(|i| start.rot[i]));
+            let t: Pose3<f64> = (n.map(|i| end.x[i]), n.map(|i| end.rot[i]));
+            r.copy_from_slice(e.discrete_gradient_force(&s, &t).as_slice());
+            return;
+        }
+        (Element::Linear(_), Scheme::EnergyMomentumPaper) => {
+            let mut k = [0.0; 144];
+            return element_kernel(el, start, end, scheme, beta, r, &mut k);
+        }
+    };
+    r.copy_from_slice(q.as_slice());
+}
+
 /// Element kernel for 3-node elements, in both conserving schemes: the
 /// energy-consistent discrete gradient (FORMULATION §4.3; there is no
 /// paper form for them, so the momentum scheme uses it too and conserves
@@ -263,15 +305,23 @@ pub fn correction_size(mech: &Mechanism, start: &Configuration, end: &Configurat
     }
 }
 
-/// Inertial moment `(πₙ₊₁ − πₙ)/Δt` of one node and its derivative with
-/// respect to a spatial spin of the end rotation.
+/// Inertial moment `(πₙ₊₁ − πₙ)/Δt` of one node and, if `tangent`, its
+/// derivative with respect to a spatial spin of the end rotation (by AD;
+/// zero otherwise).
 fn inertial_moment(
     j0: &Matrix3<f64>,
     r_n: &Matrix3<f64>,
     r_end: &Matrix3<f64>,
     w_n: &Vector3<f64>,
     dt: f64,
+    tangent: bool,
 ) -> (Vector3<f64>, Matrix3<f64>) {
+    if !tangent {
+        return (
+            inertial_moment_at(j0, r_n, r_end, w_n, dt),
+            Matrix3::zeros(),
+        );
+    }
     type D = DualSVec64<3>;
     let eta = Vector3::new(
         D::from_re(0.0).derivative(0),
@@ -279,11 +329,7 @@ fn inertial_moment(
         D::from_re(0.0).derivative(2),
     );
     let r1 = exp(&eta) * r_end.map(D::from_re);
-    let rn = r_n.map(D::from_re);
-    let theta = cayley_inverse(&(r1 * rn.transpose()));
-    let w1 = rn.transpose() * theta * D::from_re(2.0 / dt) - w_n.map(D::from_re);
-    let pi_n = r_n * (j0 * w_n);
-    let m = (r1 * (j0.map(D::from_re) * w1) - pi_n.map(D::from_re)) / D::from_re(dt);
+    let m = inertial_moment_at(j0, r_n, &r1, w_n, dt);
     let mut k = Matrix3::zeros();
     let mut val = Vector3::zeros();
     for i in 0..3 {
@@ -291,6 +337,23 @@ fn inertial_moment(
         k.set_row(i, &m[i].eps.unwrap_generic(Const::<3>, U1).transpose());
     }
     (val, k)
+}
+
+/// `(πₙ₊₁ − πₙ)/Δt` for the end rotation `r1` (generic, for AD), with
+/// `Wₙ₊₁ = 2 Rₙᵀ cay⁻¹(Rₙ₊₁Rₙᵀ)/Δt − Wₙ`.
+fn inertial_moment_at<T: flexmech_core::Scalar>(
+    j0: &Matrix3<f64>,
+    r_n: &Matrix3<f64>,
+    r1: &Matrix3<T>,
+    w_n: &Vector3<f64>,
+    dt: f64,
+) -> Vector3<T> {
+    let c = |x: f64| T::from_subset(&x);
+    let rn = r_n.map(c);
+    let theta = cayley_inverse(&(*r1 * rn.transpose()));
+    let w1 = rn.transpose() * theta * c(2.0 / dt) - w_n.map(c);
+    let pi_n = r_n * (j0 * w_n);
+    (*r1 * (j0.map(c) * w1) - pi_n.map(c)) / c(dt)
 }
 
 /// One step of a midpoint scheme, as the [`NewtonSystem`] Newton solves.
@@ -316,6 +379,8 @@ pub struct MidpointStep<'a> {
     /// Magnitudes of the internal and inertial contributions (residual scale).
     pub inertia_abs: Vec<f64>,
     pub scratch: Vec<f64>,
+    /// The residual of a tangent update (the same values as the check's).
+    pub r_tangent: Vec<f64>,
     pub floor: f64,
 }
 
@@ -328,18 +393,26 @@ impl MidpointStep<'_> {
     }
 }
 
-impl NewtonSystem for MidpointStep<'_> {
-    fn evaluate(&mut self, r: &mut [f64]) -> f64 {
+impl MidpointStep<'_> {
+    /// The residual into `r` (returns the force scale) and, if `tangent`,
+    /// the tangent values.
+    fn evaluate_with(&mut self, r: &mut [f64], tangent: bool) -> f64 {
         self.topo.refresh(self.mech, &self.end);
         if !self.mech.joints.is_empty() {
             self.topo.refresh_rows(self.mech, self.start, &self.end);
         }
         let (start, end) = (&self.start.config, &self.end.config);
         let (scheme, beta) = (self.scheme, self.beta);
-        self.asm
-            .assemble_with(&self.mech.mesh, &self.topo.dofs, |el, _, re, ke| {
-                element_kernel(el, start, end, scheme, beta, re, ke)
+        if tangent {
+            self.asm
+                .assemble_with(&self.mech.mesh, &self.topo.dofs, |el, _, re, ke| {
+                    element_kernel(el, start, end, scheme, beta, re, ke)
+                });
+        } else {
+            self.asm.assemble_residual_with(&self.mech.mesh, |el, re| {
+                element_force(el, start, end, scheme, beta, re)
             });
+        }
         let dt = self.dt;
         for (g, (fi, fe)) in self
             .nodal
@@ -358,12 +431,14 @@ impl NewtonSystem for MidpointStep<'_> {
                 self.nodal[6 * i + c] += m * dv[c] / dt;
                 self.inertia_abs[6 * i + c] += (m * dv[c] / dt).abs();
             }
-            self.asm.add_node_block(
-                &self.topo.dofs,
-                (i, 0),
-                (j, 0),
-                &(Matrix3::identity() * (2.0 * m / (dt * dt))),
-            );
+            if tangent {
+                self.asm.add_node_block(
+                    &self.topo.dofs,
+                    (i, 0),
+                    (j, 0),
+                    &(Matrix3::identity() * (2.0 * m / (dt * dt))),
+                );
+            }
         }
         // Rotational inertia, node by node.
         for i in 0..self.inertia.rotational.len() {
@@ -377,15 +452,18 @@ impl NewtonSystem for MidpointStep<'_> {
                 &self.end.config.rot[i],
                 &self.w_n[i],
                 dt,
+                tangent,
             );
             for c in 0..3 {
                 self.nodal[6 * i + 3 + c] += m[c];
                 self.inertia_abs[6 * i + 3 + c] += m[c].abs();
             }
-            self.asm.add_node_block(&self.topo.dofs, (i, 3), (i, 3), &k);
+            if tangent {
+                self.asm.add_node_block(&self.topo.dofs, (i, 3), (i, 3), &k);
+            }
         }
         self.reduce_residual(&self.nodal, r);
-        if !self.mech.joints.is_empty() {
+        if tangent && !self.mech.joints.is_empty() {
             // ∂(Ñᵀ)/∂q g with the slaves' full residuals (see the module docs).
             let blocks =
                 self.topo
@@ -400,6 +478,27 @@ impl NewtonSystem for MidpointStep<'_> {
         let dofs = &self.topo.dofs;
         let f_ext = dofs.reduced_norm(&self.fext, &mut self.scratch);
         f_ext.max(dofs.reduced_norm(&self.inertia_abs, &mut self.scratch))
+    }
+}
+
+impl NewtonSystem for MidpointStep<'_> {
+    fn evaluate(&mut self, r: &mut [f64]) -> f64 {
+        self.evaluate_with(r, true)
+    }
+
+    fn residual(&mut self, r: &mut [f64]) -> f64 {
+        self.evaluate_with(r, false)
+    }
+
+    fn update_tangent(&mut self) {
+        let mut r = std::mem::take(&mut self.r_tangent);
+        r.resize(self.scratch.len(), 0.0);
+        self.evaluate_with(&mut r, true);
+        self.r_tangent = r;
+    }
+
+    fn tangent_key(&self) -> f64 {
+        self.dt
     }
 
     fn tangent_values(&self) -> &[f64] {
@@ -532,6 +631,7 @@ pub fn solve(
             nodal: vec![0.0; 6 * nodes],
             inertia_abs: vec![0.0; 6 * nodes],
             scratch: vec![0.0; n_eq],
+            r_tangent: vec![0.0; n_eq],
             floor: mech.round_off_floor_at(&state.config.x),
         };
         let outcome = match scheme {
@@ -624,6 +724,7 @@ pub fn dynamic_record(
         time,
         dt,
         iterations: report.map_or(0, |r| r.iterations),
+        factorizations: report.map_or(0, |r| r.factorizations),
         residual: report.map_or(0.0, |r| r.residual),
         residual_history: report.map_or_else(Vec::new, |r| r.history.clone()),
         beta: f64::NAN,

@@ -53,6 +53,23 @@ fn angular_acceleration<T: flexmech_core::Scalar>(
     (big_omega - w_n.map(c) * c(dt) - a_n.map(c) * c(dt * dt * (0.5 - BETA))) / c(BETA * dt * dt)
 }
 
+/// Inertial moment `Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁)` of node `i` for the end
+/// rotation `r1` (generic, for AD).
+fn inertial_moment<T: flexmech_core::Scalar>(
+    j0: &Matrix3<f64>,
+    r_n: &Matrix3<f64>,
+    r1: &Matrix3<T>,
+    prev: &Kinematics,
+    i: usize,
+    dt: f64,
+) -> Vector3<T> {
+    let c = |x: f64| T::from_subset(&x);
+    let a1 = angular_acceleration(r_n, r1, &prev.w[i], &prev.alpha[i], dt);
+    let w1 = (prev.w[i] + prev.alpha[i] * (dt * (1.0 - GAMMA))).map(c) + a1 * c(dt * GAMMA);
+    let jd = j0.map(c);
+    *r1 * (jd * a1 + w1.cross(&(jd * w1)))
+}
+
 /// Where the mass blocks land in the tangent values, found once per run:
 /// per translational mass entry `(i, j, m)` and per node's rotational
 /// inertia (`None` where a slave is involved: its maps change).
@@ -137,31 +154,36 @@ impl NewmarkStep<'_> {
                 }
             }
         }
-        // Rotational inertia Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), by AD in a spin of Rₙ₊₁.
-        type D = DualSVec64<3>;
+        // Rotational inertia Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), and its tangent by
+        // AD in a spin of Rₙ₊₁.
         for i in 0..self.inertia.rotational.len() {
             let j0 = self.inertia.rotational[i];
             if j0 == Matrix3::zeros() {
                 continue;
             }
-            let eta = Vector3::new(
-                D::from_re(0.0).derivative(0),
-                D::from_re(0.0).derivative(1),
-                D::from_re(0.0).derivative(2),
-            );
-            let r1 = exp(&eta) * self.end.config.rot[i].map(D::from_re);
-            let a1 = angular_acceleration(&start.rot[i], &r1, &prev.w[i], &prev.alpha[i], dt);
-            let w1 = (prev.w[i] + prev.alpha[i] * (dt * (1.0 - GAMMA))).map(D::from_re)
-                + a1 * D::from_re(dt * GAMMA);
-            let jd = j0.map(D::from_re);
-            let m = r1 * (jd * a1 + w1.cross(&(jd * w1)));
-            let mut k = Matrix3::zeros();
+            let (m, k) = if tangent {
+                type D = DualSVec64<3>;
+                let eta = Vector3::new(
+                    D::from_re(0.0).derivative(0),
+                    D::from_re(0.0).derivative(1),
+                    D::from_re(0.0).derivative(2),
+                );
+                let r1 = exp(&eta) * self.end.config.rot[i].map(D::from_re);
+                let m = inertial_moment(&j0, &start.rot[i], &r1, prev, i, dt);
+                let mut k = Matrix3::zeros();
+                for c in 0..3 {
+                    k.set_row(c, &m[c].eps.unwrap_generic(Const::<3>, U1).transpose());
+                }
+                (m.map(|v| v.re), Some(k))
+            } else {
+                let r1 = self.end.config.rot[i];
+                (inertial_moment(&j0, &start.rot[i], &r1, prev, i, dt), None)
+            };
             for c in 0..3 {
-                self.nodal[6 * i + 3 + c] += m[c].re;
-                self.abs[6 * i + 3 + c] += m[c].re.abs();
-                k.set_row(c, &m[c].eps.unwrap_generic(Const::<3>, U1).transpose());
+                self.nodal[6 * i + 3 + c] += m[c];
+                self.abs[6 * i + 3 + c] += m[c].abs();
             }
-            if tangent {
+            if let Some(k) = k {
                 match &self.slots.rotational[i] {
                     Some(at) => self.asm.add_node_block_at(at, &k),
                     None => self.asm.add_node_block(&self.topo.dofs, (i, 3), (i, 3), &k),
@@ -198,6 +220,10 @@ impl NewtonSystem for NewmarkStep<'_> {
         let mut r = std::mem::take(&mut self.r_tangent);
         self.evaluate_with(&mut r, true);
         self.r_tangent = r;
+    }
+
+    fn tangent_key(&self) -> f64 {
+        self.dt
     }
 
     fn tangent_values(&self) -> &[f64] {

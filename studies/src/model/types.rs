@@ -227,6 +227,9 @@ pub struct SolverSpec {
     pub max_iterations: usize,
     pub max_halvings: usize,
     pub mass: MassKind,
+    /// `newton = "modified"`: keep a factorised tangent while it converges
+    /// fast enough (dynamic analyses; default `"full"`).
+    pub modified_newton: bool,
 }
 
 #[derive(Debug, Clone, PartialEq)]

@@ -64,6 +64,9 @@ pub const MOMENTUM_ANGULAR: &str = "/momentum/angular";
 pub const SOLVER: &str = "/solver";
 /// T (u64): Newton iterations of the step.
 pub const SOLVER_ITERATIONS: &str = "/solver/iterations";
+/// T (u64): tangent factorisations of the step (*extension*; fewer than the
+/// iterations with modified Newton).
+pub const SOLVER_FACTORIZATIONS: &str = "/solver/factorizations";
 /// T: step size actually used (after halvings).
 pub const SOLVER_DT: &str = "/solver/dt";
 /// T: final scaled residual norm.

@@ -21,6 +21,7 @@
 //! | `/energy/driver_work` | T | work done by driven joint coordinates and prescribed DOFs since t = 0 (extension) |
 //! | `/momentum/linear`, `/momentum/angular` | T×3 | total momenta (angular about the origin) |
 //! | `/solver/iterations` | T, `u64` | Newton iterations of the step |
+//! | `/solver/factorizations` | T, `u64` | *extension:* tangent factorisations of the step (fewer than the iterations with `newton = "modified"`) |
 //! | `/solver/dt` | T | step size actually used (after halvings) |
 //! | `/solver/residual` | T | final scaled residual norm |
 //! | `/solver/beta` | T | energy–momentum β (NaN for other integrators) |

@@ -339,6 +339,7 @@ struct Datasets {
     momentum_linear: Series,
     momentum_angular: Series,
     iterations: Series,
+    factorizations: Series,
     dt: Series,
     residual: Series,
     beta: Series,
@@ -364,6 +365,7 @@ impl Datasets {
             &self.momentum_linear,
             &self.momentum_angular,
             &self.iterations,
+            &self.factorizations,
             &self.dt,
             &self.residual,
             &self.beta,
@@ -531,6 +533,13 @@ impl ResultWriter {
             &[],
             "Newton iterations of the step",
         )?;
+        let factorizations = Series::time_series::<u64>(
+            &file,
+            path,
+            names::SOLVER_FACTORIZATIONS,
+            &[],
+            "tangent factorisations of the step",
+        )?;
         let dt = f64s(
             names::SOLVER_DT,
             &[],
@@ -672,6 +681,7 @@ impl ResultWriter {
             momentum_linear,
             momentum_angular,
             iterations,
+            factorizations,
             dt,
             residual,
             beta,
@@ -752,6 +762,8 @@ impl ResultWriter {
         s.momentum_angular
             .push_row(t, step.momentum_angular, path)?;
         s.iterations.push_scalar(t, step.iterations as u64, path)?;
+        s.factorizations
+            .push_scalar(t, step.factorizations as u64, path)?;
         s.dt.push_scalar(t, step.dt, path)?;
         s.residual.push_scalar(t, step.residual, path)?;
         s.beta.push_scalar(t, step.beta, path)?;

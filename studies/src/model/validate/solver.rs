@@ -13,6 +13,7 @@ impl Ctx<'_> {
                 max_iterations: 25,
                 max_halvings: 10,
                 mass: MassKind::Consistent,
+                modified_newton: false,
             });
         };
         let hs = entry.span();
@@ -154,12 +155,49 @@ impl Ctx<'_> {
                 }
             },
         };
+        let modified_newton =
+            match &s.newton {
+                None => false,
+                Some(m) => {
+                    match m.get_ref().as_str() {
+                        "full" => false,
+                        "modified" => match &analysis {
+                            Analysis::Static { .. } => return Err(self.at(
+                                "solver.newton",
+                                m,
+                                "modified Newton is for dynamic analyses (a static path checks \
+                             the stability of every converged state with its exact tangent); \
+                             remove `newton` or set it to \"full\"",
+                            )),
+                            Analysis::Dynamic {
+                                integrator: IntegratorKind::EnergyMomentumPaper,
+                                ..
+                            } => return Err(self.at(
+                                "solver.newton",
+                                m,
+                                "the paper's energy-momentum scheme solves a bordered system with \
+                             the exact tangent at every iterate; use newton = \"full\", or \
+                             integrator = \"energy-momentum\"",
+                            )),
+                            Analysis::Dynamic { .. } => true,
+                        },
+                        other => {
+                            return Err(self.at(
+                                "solver.newton",
+                                m,
+                                format!("expected \"full\" or \"modified\", found \"{other}\""),
+                            ))
+                        }
+                    }
+                }
+            };
         Ok(SolverSpec {
             analysis,
             tolerance,
             max_iterations,
             max_halvings,
             mass,
+            modified_newton,
         })
     }
 
