@@ -1,6 +1,7 @@
 //! flexmech-studies: model files, the mechanism builder, runs that stream
 //! results into HDF5 files, and the `flexmech` command line.
 
+pub mod bench;
 pub mod build;
 pub mod charts;
 mod checks;

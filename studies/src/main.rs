@@ -77,6 +77,26 @@ enum Command {
         #[arg(long)]
         log: bool,
     },
+    /// Time steps of the yardstick cantilever (2 m, tip force, dt = 1e-3)
+    /// at several mesh sizes with each integrator, modified Newton and
+    /// 3-node elements.
+    ///
+    /// Prints the machine, then µs per step, µs per element-step and the
+    /// ratio to Newmark with full Newton at the same size (ratios carry over
+    /// between machines; absolute times on a shared machine do not). Writes
+    /// `<out>/bench.md` and the runs' result files under `<out>/`. Set
+    /// RAYON_NUM_THREADS=1 for one-thread figures.
+    Bench {
+        /// Element counts (2-node; 3-node runs use half as many elements).
+        #[arg(long, value_delimiter = ',', default_values_t = [32, 128, 512, 2048, 8192])]
+        elements: Vec<usize>,
+        /// Time steps per run.
+        #[arg(long, default_value_t = 20)]
+        steps: usize,
+        /// Output directory.
+        #[arg(long, short, default_value = "bench")]
+        out: PathBuf,
+    },
     /// Run a parameter study: a base model over a grid of key values.
     ///
     /// Writes `<out>/<name>/runs/<run id>.h5` per run, `summary.csv`,
@@ -235,6 +255,41 @@ fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
+        Command::Bench {
+            elements,
+            steps,
+            out,
+        } => {
+            use flexmech_studies::bench;
+            println!("{}", bench::machine());
+            let outcome = bench::bench(&elements, steps, &out, |t| {
+                println!(
+                    "{:>6} elements  {:<26} {:>9.0} µs/step  {:>7.2} µs/(element·step)",
+                    t.elements,
+                    t.case.label,
+                    t.per_step_us(),
+                    t.per_element_step_us()
+                );
+            });
+            match outcome {
+                Ok(timings) => {
+                    let table = bench::table(&timings);
+                    println!("\n{table}");
+                    let file = out.join("bench.md");
+                    let text = format!("{}\n\n{table}", bench::machine());
+                    if let Err(e) = std::fs::write(&file, text) {
+                        eprintln!("error: cannot write {}: {e}", file.display());
+                        return ExitCode::FAILURE;
+                    }
+                    println!("table: {}", file.display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
         Command::Study {
             study,
             out,

@@ -1,0 +1,215 @@
+//! `flexmech bench`: the cost per time step of the yardstick cantilever
+//! (`benches/cantilever512.toml`: a 2 m cantilever under a tip force,
+//! `dt = 1e-3`) at several mesh sizes, with each integrator and Newton
+//! variant and with 3-node elements, as microseconds per step and per
+//! element-step — and as ratios to Newmark with full Newton measured in the
+//! same run, which is what carries over between machines on a shared one.
+
+use crate::model::parse_model;
+use crate::run::{run_model, RunError};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// One configuration of the yardstick.
+#[derive(Debug, Clone, Copy)]
+pub struct Case {
+    /// Short label, e.g. `newmark/modified`.
+    pub label: &'static str,
+    pub integrator: &'static str,
+    pub newton: &'static str,
+    /// Nodes per element (3-node elements run with half as many elements,
+    /// so the unknowns are the same).
+    pub nodes_per_element: usize,
+}
+
+/// The configurations `flexmech bench` times; the first is the reference.
+pub const CASES: [Case; 6] = [
+    Case {
+        label: "newmark",
+        integrator: "newmark",
+        newton: "full",
+        nodes_per_element: 2,
+    },
+    Case {
+        label: "newmark/modified",
+        integrator: "newmark",
+        newton: "modified",
+        nodes_per_element: 2,
+    },
+    Case {
+        label: "momentum",
+        integrator: "momentum",
+        newton: "full",
+        nodes_per_element: 2,
+    },
+    Case {
+        label: "energy-momentum",
+        integrator: "energy-momentum",
+        newton: "full",
+        nodes_per_element: 2,
+    },
+    Case {
+        label: "energy-momentum/modified",
+        integrator: "energy-momentum",
+        newton: "modified",
+        nodes_per_element: 2,
+    },
+    Case {
+        label: "newmark/3-node",
+        integrator: "newmark",
+        newton: "full",
+        nodes_per_element: 3,
+    },
+];
+
+/// One timed run.
+#[derive(Debug, Clone)]
+pub struct Timing {
+    pub case: Case,
+    /// Elements of 2 nodes (or the 3-node mesh with the same unknowns).
+    pub elements: usize,
+    pub steps: usize,
+    pub iterations: usize,
+    /// Wall time of the solve, seconds.
+    pub seconds: f64,
+}
+
+impl Timing {
+    /// Microseconds per time step.
+    pub fn per_step_us(&self) -> f64 {
+        1e6 * self.seconds / self.steps as f64
+    }
+    /// Microseconds per step and per 2-node-equivalent element.
+    pub fn per_element_step_us(&self) -> f64 {
+        self.per_step_us() / self.elements as f64
+    }
+}
+
+/// The yardstick's model text for a case, `elements` (2-node equivalent)
+/// and `steps` steps of `dt = 1e-3`.
+pub fn model_text(case: &Case, elements: usize, steps: usize) -> String {
+    let mesh = if case.nodes_per_element == 3 {
+        format!(
+            "elements = {}\nnodes_per_element = 3",
+            (elements / 2).max(1)
+        )
+    } else {
+        format!("elements = {elements}")
+    };
+    format!(
+        r#"name = "bench"
+[[section]]
+name = "s"
+EA = 1.0e6
+GA = [1.0e6, 1.0e6]
+GJ = 1.0e3
+EI = [1.0e3, 1.0e3]
+rhoA = 1.0
+rhoJ = [1.0e-3, 5.0e-4, 5.0e-4]
+[[beam]]
+name = "b"
+section = "s"
+start = [0.0, 0.0, 0.0]
+end = [2.0, 0.0, 0.0]
+e2 = [0.0, 1.0, 0.0]
+{mesh}
+[[support]]
+node = "b.start"
+fixed = "all"
+[[load]]
+node = "b.end"
+force = [0.0, 0.0, 50.0]
+[solver]
+analysis = "dynamic"
+integrator = "{}"
+newton = "{}"
+dt = 1.0e-3
+t_end = {}
+[output]
+every = {steps}
+"#,
+        case.integrator,
+        case.newton,
+        steps as f64 * 1e-3
+    )
+}
+
+/// Times every case at every size, writing the result files under `out`.
+/// `progress` is called after each run.
+pub fn bench(
+    sizes: &[usize],
+    steps: usize,
+    out: &Path,
+    mut progress: impl FnMut(&Timing),
+) -> Result<Vec<Timing>, RunError> {
+    let mut timings = Vec::new();
+    for &elements in sizes {
+        for case in CASES {
+            let text = model_text(&case, elements, steps);
+            let path = PathBuf::from(format!(
+                "bench-{}-{elements}.toml",
+                case.label.replace('/', "-")
+            ));
+            let model = parse_model(&text, &path).map_err(RunError::from)?;
+            let dir = out.join(path.with_extension(""));
+            let summary = run_model(&model, &dir)?;
+            let t = Timing {
+                case,
+                elements,
+                // The summary counts the initial record too.
+                steps: summary.steps.saturating_sub(1).max(1),
+                iterations: summary.iterations,
+                seconds: summary.wall_time_s,
+            };
+            progress(&t);
+            timings.push(t);
+        }
+    }
+    Ok(timings)
+}
+
+/// The machine the figures come from: CPU model, logical CPUs, threads used.
+pub fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_owned())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
+    format!(
+        "{cpu}, {cpus} logical CPUs, {} assembly thread(s) (RAYON_NUM_THREADS), flexmech {}",
+        rayon::current_num_threads(),
+        env!("CARGO_PKG_VERSION")
+    )
+}
+
+/// A Markdown table of the timings, with each run's ratio to the reference
+/// case (Newmark, full Newton) at the same size.
+pub fn table(timings: &[Timing]) -> String {
+    let mut s = String::from(
+        "| elements | case | steps | iterations | µs/step | µs/(element·step) | / newmark |\n\
+         |---|---|---|---|---|---|---|\n",
+    );
+    for t in timings {
+        let reference = timings
+            .iter()
+            .find(|r| r.elements == t.elements && r.case.label == CASES[0].label)
+            .map_or(f64::NAN, |r| t.seconds / r.seconds);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {:.0} | {:.2} | {:.2} |",
+            t.elements,
+            t.case.label,
+            t.steps,
+            t.iterations,
+            t.per_step_us(),
+            t.per_element_step_us(),
+            reference
+        );
+    }
+    s
+}
