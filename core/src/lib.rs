@@ -3,6 +3,7 @@
 //! automatic differentiation (num-dual) runs through every kernel.
 
 pub mod rotation;
+pub mod rotation_derivatives;
 pub mod scalar;
 
 pub use scalar::{cst, Scalar};
@@ -11,6 +12,8 @@ pub mod conserving_tangent;
 pub mod discrete_gradient;
 pub mod discrete_gradient_quadratic;
 pub mod element;
+pub mod element_linear;
+pub mod element_quadratic;
 pub mod inertia;
 pub mod section;
 pub mod shape;

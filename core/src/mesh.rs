@@ -135,7 +135,7 @@ impl Element {
             }
             Element::Quadratic(e) => {
                 let (xe, re) = gather(&e.nodes, x, rot);
-                r.copy_from_slice(e.energy_gradient::<18>(&xe, &re).as_slice());
+                r.copy_from_slice(e.internal_force_quadratic(&xe, &re).as_slice());
             }
         }
     }
@@ -152,13 +152,13 @@ impl Element {
         match self {
             Element::Linear(e) => {
                 let (xe, re) = gather(&e.nodes, x, rot);
-                let (rv, km) = e.residual_tangent(&xe, &re);
+                let (rv, km) = e.residual_tangent_linear(&xe, &re);
                 r.copy_from_slice(rv.as_slice());
                 k.copy_from_slice(km.as_slice());
             }
             Element::Quadratic(e) => {
                 let (xe, re) = gather(&e.nodes, x, rot);
-                let (rv, km) = e.residual_tangent_invariant::<18, 12>(&xe, &re);
+                let (rv, km) = e.residual_tangent_quadratic(&xe, &re);
                 r.copy_from_slice(rv.as_slice());
                 k.copy_from_slice(km.as_slice());
             }

@@ -1,0 +1,158 @@
+//! Residual and tangent of the 2-node element through its invariant strain
+//! coordinates (FORMULATION §2), as for the 3-node element
+//! ([`crate::element_quadratic`]).
+//!
+//! With node 1's triad `Λ₁` as base, the one-point strains depend on the
+//! nodal unknowns only through six material coordinates
+//!
+//! ```text
+//! z = (φ, a),   φ = log(Λ₁ᵀΛ₂),   a = Λ₁ᵀ d,   d = x₂ − x₁
+//! Γ = exp(½φ̂)ᵀ a/L − Γ₀ = Λ_rᵀ d/L − Γ₀,   K = φ/L − K₀
+//! E = ½L (Γ·C_N Γ + K·C_M K)
+//! ```
+//!
+//! nonlinear only through `A = exp(p̂)ᵀ`, `p = ½φ` (three hyper-dual lanes).
+//! With `N = C_N Γ`, `M = C_M K`, `∂ᵢ = ∂/∂pᵢ`:
+//!
+//! ```text
+//! ∂E/∂φᵢ = ½ N·∂ᵢA a + Mᵢ,                 ∂E/∂a = AᵀN
+//! ∂²E/∂φᵢ∂φⱼ = ¼ (∂ⱼA a·C_N ∂ᵢA a/L + N·∂ᵢⱼA a) + (C_M)ᵢⱼ/L
+//! ∂²E/∂a∂φᵢ = ½ (∂ᵢAᵀN + AᵀC_N ∂ᵢA a/L),    ∂²E/∂a² = AᵀC_N A/L
+//! ```
+//!
+//! The map from the increments (`x ← x + η`, `R ← exp(ε̂)R`):
+//! `δφ = S(ε₂ − ε₁)`, `S = H⁻¹(φ)Λ₁ᵀ`; `δa = Λ₁ᵀ(η₂ − η₁ + d̂ ε₁)`. The
+//! residual is `r = Jᵀe` and the tangent `K = Jᵀ(∂²E/∂z²)J + G`, `G` the
+//! derivative of `Jᵀe` with `e` held: with `u = Sᵀe_φ`,
+//! `M_φ = Λ₁ ∂(H⁻ᵀ(φ)e_φ)/∂φ S`, `b = Λ₁ e_a`,
+//!
+//! ```text
+//! ∂r_ε₂/∂ε₁ = −û − M_φ,  ∂r_ε₂/∂ε₂ = M_φ,  ∂r_ε₁/∂ε₁ = û + M_φ + d̂ b̂,  ∂r_ε₁/∂ε₂ = −M_φ
+//! ∂r_η₁/∂ε₁ = b̂,  ∂r_η₂/∂ε₁ = −b̂,  ∂r_ε₁/∂η₁ = −b̂,  ∂r_ε₁/∂η₂ = b̂
+//! ```
+//!
+//! equal to the hyper-dual Hessian of the element energy
+//! ([`BeamElement::residual_tangent_ad`], the oracle) to round-off.
+
+use crate::element::BeamElement;
+use crate::rotation::{log, tangent_inverse};
+use crate::rotation_derivatives::{exp_transpose, tangent_inverse_transpose_derivative};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+
+impl BeamElement<2> {
+    /// Residual and consistent tangent of the 2-node element (module docs);
+    /// equal to [`BeamElement::residual_tangent_ad`].
+    pub fn residual_tangent_linear(
+        &self,
+        x: &[Vector3<f64>; 2],
+        rot: &[Matrix3<f64>; 2],
+    ) -> (SVector<f64, 12>, SMatrix<f64, 12, 12>) {
+        let lam = self.nodal_triads(rot);
+        let l = self.length;
+        let lt = lam[0].transpose();
+        let phi = log(&(lt * lam[1]));
+        let d = x[1] - x[0];
+        let a = lt * d;
+        let ad = exp_transpose(&(phi * 0.5));
+        let (am, da, dda) = (ad.value, ad.d1, ad.d2);
+        let (g0, k0) = self.initial_strains()[0];
+        let (cn, cm) = (
+            Matrix3::from_diagonal(&self.section.c_n),
+            Matrix3::from_diagonal(&self.section.c_m),
+        );
+        let n = cn * (am * a / l - g0);
+        let m = cm * (phi / l - k0);
+        let aa: [Vector3<f64>; 3] = std::array::from_fn(|i| da[i] * a);
+        // e and ∂²E/∂z² in z = (φ, a).
+        let mut e = SVector::<f64, 6>::zeros();
+        let mut hess = SMatrix::<f64, 6, 6>::zeros();
+        for i in 0..3 {
+            e[i] = 0.5 * n.dot(&aa[i]) + m[i];
+            for j in 0..3 {
+                hess[(i, j)] = 0.25 * (aa[j].dot(&(cn * aa[i])) / l + n.dot(&(dda[i][j] * a)))
+                    + cm[(i, j)] / l;
+            }
+            let phi_a = (da[i].transpose() * n + am.transpose() * (cn * aa[i]) / l) * 0.5;
+            for k in 0..3 {
+                hess[(i, 3 + k)] = phi_a[k];
+                hess[(3 + k, i)] = phi_a[k];
+            }
+        }
+        let ea = am.transpose() * n;
+        e.fixed_rows_mut::<3>(3).copy_from(&ea);
+        hess.fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&(am.transpose() * cn * am / l));
+        // J = ∂z/∂(η₁, ε₁, η₂, ε₂).
+        let s = tangent_inverse(&phi) * lt;
+        let mut j = SMatrix::<f64, 6, 12>::zeros();
+        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-s));
+        j.fixed_view_mut::<3, 3>(0, 9).copy_from(&s);
+        j.fixed_view_mut::<3, 3>(3, 0).copy_from(&(-lt));
+        j.fixed_view_mut::<3, 3>(3, 6).copy_from(&lt);
+        j.fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&(lt * d.cross_matrix()));
+        let r = j.transpose() * e;
+        let mut k = j.transpose() * hess * j;
+        // G: the derivative of Jᵀe with e held.
+        let e_phi = Vector3::new(e[0], e[1], e[2]);
+        let u = s.transpose() * e_phi;
+        let mphi = lam[0] * tangent_inverse_transpose_derivative(&phi, &e_phi) * s;
+        let b_hat = (lam[0] * ea).cross_matrix();
+        let mut add = |row: usize, col: usize, blk: Matrix3<f64>| {
+            let mut v = k.fixed_view_mut::<3, 3>(row, col);
+            v += blk;
+        };
+        add(9, 3, -u.cross_matrix() - mphi);
+        add(9, 9, mphi);
+        add(3, 3, u.cross_matrix() + mphi + d.cross_matrix() * b_hat);
+        add(3, 9, -mphi);
+        add(0, 3, b_hat);
+        add(6, 3, -b_hat);
+        add(3, 0, -b_hat);
+        add(3, 6, b_hat);
+        (r, k)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::element::BeamElement;
+    use crate::rotation::exp;
+    use crate::section::Section;
+    use nalgebra::{Matrix3, Vector3};
+    use proptest::prelude::*;
+
+    /// Both sides are exact: only round-off separates them.
+    const ORACLE_TOL: f64 = 1e-10;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        #[test]
+        fn residual_and_tangent_equal_the_hyper_dual_oracle(
+            du in prop::array::uniform6(-0.3..0.3f64),
+            dr in prop::array::uniform6(-1.2..1.2f64),
+            rigid in prop::array::uniform3(-2.5..2.5f64),
+        ) {
+            let sec = Section::new([2.0e4, 8.0e3, 9.0e3], [30.0, 45.0, 60.0], 1.0, [0.2, 0.1, 0.1]);
+            let x0 = [Vector3::new(0.1, 0.2, -0.3), Vector3::new(1.2, 0.6, -0.1)];
+            // Curved initial geometry: different initial triads at the nodes.
+            let l0 = [exp(&Vector3::new(0.1, 0.2, 0.3)), exp(&Vector3::new(-0.2, 0.4, 0.1))];
+            let e = BeamElement::new([0, 1], sec, (x0[1] - x0[0]).norm(), &x0, l0);
+            let q = exp(&Vector3::from(rigid));
+            let x: [Vector3<f64>; 2] = std::array::from_fn(|i| {
+                q * (x0[i] + Vector3::new(du[3 * i], du[3 * i + 1], du[3 * i + 2]))
+            });
+            let rot: [Matrix3<f64>; 2] = std::array::from_fn(|i| {
+                q * exp(&Vector3::new(dr[3 * i], dr[3 * i + 1], dr[3 * i + 2]))
+            });
+            let (r_ad, k_ad) = e.residual_tangent_ad::<12>(&x, &rot);
+            let (r, k) = e.residual_tangent_linear(&x, &rot);
+            let rel = |err: f64, size: f64| err / size.max(1.0);
+            prop_assert!(rel((r - r_ad).norm(), r_ad.norm()) <= ORACLE_TOL, "residual");
+            prop_assert!(rel((k - k_ad).norm(), k_ad.norm()) <= ORACLE_TOL, "tangent {}", (k - k_ad).norm());
+            // And the closed-form internal force.
+            prop_assert!(rel((e.internal_force(&x, &rot) - r).norm(), r.norm()) <= ORACLE_TOL);
+        }
+    }
+}
