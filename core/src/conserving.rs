@@ -14,7 +14,7 @@
 //! `x̄ = ½(xₙ + xₙ₊₁)`, which is what conserves linear and angular momentum.
 
 use crate::element::BeamElement;
-use crate::rotation::{exp, log};
+use crate::rotation::{exp, log, mm, mtm, mv};
 use crate::scalar::{cst, Scalar};
 use nalgebra::{Matrix3, SVector, Vector3};
 
@@ -43,13 +43,26 @@ impl BeamElement<2> {
         l1 * exp(&(log(&(l1.transpose() * l2)) * cst::<T>(0.5)))
     }
 
-    /// Material stress resultants `(N, M)` at the element's single Gauss point.
+    /// Material stress resultants `(N, M)` at the element's single Gauss
+    /// point: `N = C_N(Λ_rᵀd/L − Γ₀)`, `M = C_M(φ/L − K₀)` with
+    /// `φ = log(Λ₁ᵀΛ₂)`, `Λ_r = Λ₁ exp(½φ̂)`, `d = x₂ − x₁` (the general
+    /// [`BeamElement::stresses`] specialised to two nodes: there `ψ₁,₂ = ∓½φ`
+    /// and the Gauss point's triad is `Λ_r`).
     pub fn resultants<T: Scalar>(
         &self,
         x: &[Vector3<T>; 2],
         rot: &[Matrix3<T>; 2],
     ) -> (Vector3<T>, Vector3<T>) {
-        self.stresses(x, rot)[0]
+        let lam = self.triads(rot);
+        let phi = log(&mtm(&lam[0], &lam[1]));
+        let lam_r = mm(&lam[0], &exp(&(phi * cst::<T>(0.5))));
+        let l = cst::<T>(self.length);
+        let (g0, k0) = self.initial_strains()[0];
+        (
+            (mv(&lam_r.transpose(), &(x[1] - x[0])) / l - g0.map(cst::<T>))
+                .component_mul(&self.section.c_n.map(cst::<T>)),
+            (phi / l - k0.map(cst::<T>)).component_mul(&self.section.c_m.map(cst::<T>)),
+        )
     }
 
     /// `q_k` of paper eq. 17 between the poses at `n` and `n+1` for the
@@ -135,6 +148,18 @@ pub(crate) mod tests {
             ],
         );
         (start, end, theta)
+    }
+
+    #[test]
+    fn two_node_resultants_equal_the_general_stresses() {
+        let (e, x0) = element();
+        let (start, end, _) = poses(&x0, 1.0);
+        for pose in [start, end] {
+            let (n, m) = e.resultants(&pose.0, &pose.1);
+            let (ng, mg) = e.stresses(&pose.0, &pose.1)[0];
+            assert!((n - ng).norm() <= 1e-12 * ng.norm().max(1.0), "{n} {ng}");
+            assert!((m - mg).norm() <= 1e-12 * mg.norm().max(1.0), "{m} {mg}");
+        }
     }
 
     #[test]

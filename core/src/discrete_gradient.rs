@@ -64,7 +64,9 @@
 
 use crate::conserving::Pose;
 use crate::element::BeamElement;
-use crate::rotation::{cayley, cayley_inverse, exp, log, skew, tangent, tangent_inverse};
+use crate::rotation::{
+    cayley, cayley_inverse, exp, log, mm, mmt, mtm, mv, skew, tangent, tangent_inverse,
+};
 use crate::scalar::{cst, Scalar};
 use nalgebra::{Matrix3, SVector, Vector3};
 
@@ -118,21 +120,28 @@ pub(crate) fn secant_operators<T: Scalar>(
     let dtheta = th[1] - th[0];
     let tbar = (th[0] + th[1]) * half;
     // Λ₁ᵀΛ₂ advances by cay(c), c = Λ₁ᵀ C Δθ exactly.
-    let to_rel = lam1.transpose() * (Matrix3::identity() - skew(&tbar) * half)
+    let to_rel = mtm(lam1, &(Matrix3::identity() - skew(&tbar) * half))
         / (T::one() + th[0].dot(&th[1]) * quarter);
-    let c_half = to_rel * dtheta * half;
+    let c_half = mv(&to_rel, &dtheta) * half;
     // Jacobians of φ(c) = log(cay(c) exp(φ̂₀)) and g(c) at ½c (midpoint rule).
-    let phi_h = log(&(cayley(&c_half) * exp(phi0)));
-    let dphi_dc = tangent_inverse(&phi_h) * cayley_tangent(&c_half);
-    let g_h = cayley_inverse(&(exp(&(phi_h * half)) * exp(&(phi0 * (-half)))));
-    let dg_dc = cayley_tangent_inverse(&g_h) * tangent(&(phi_h * half)) * dphi_dc * half;
+    let exp_phi0_half = exp(&(phi0 * (-half)));
+    let phi_h = log(&mm(&cayley(&c_half), &exp(phi0)));
+    let dphi_dc = mm(&tangent_inverse(&phi_h), &cayley_tangent(&c_half));
+    let g_h = cayley_inverse(&mm(&exp(&(phi_h * half)), &exp_phi0_half));
+    let dg_dc = mm(
+        &mm(&cayley_tangent_inverse(&g_h), &tangent(&(phi_h * half))),
+        &dphi_dc,
+    ) * half;
     // θ_r − θ₁ = E b/(1 − ¼θ₁·b), b = Λ₁ g (Cayley composition).
-    let b = lam1 * cayley_inverse(&(exp(&(phi1 * half)) * exp(&(phi0 * (-half)))));
+    let b = mv(
+        lam1,
+        &cayley_inverse(&mm(&exp(&(phi1 * half)), &exp_phi0_half)),
+    );
     let e = (Matrix3::identity() + skew(&th[0]) * half + th[0] * th[0].transpose() * quarter)
         / (T::one() - th[0].dot(&b) * quarter);
     (
-        e * lam1 * dg_dc * to_rel - Matrix3::identity() * half,
-        dphi_dc * to_rel,
+        mm(&mm(&mm(&e, lam1), &dg_dc), &to_rel) - Matrix3::identity() * half,
+        mm(&dphi_dc, &to_rel),
     )
 }
 
@@ -140,12 +149,11 @@ impl BeamElement<2> {
     pub(crate) fn dg_step<T: Scalar>(&self, start: &Pose<T>, end: &Pose<T>) -> Step<T> {
         let half = cst::<T>(0.5);
         let ends = [self.triads(&start.1), self.triads(&end.1)];
-        let phi = ends.map(|l| log(&(l[0].transpose() * l[1])));
-        let lam_r = [0, 1].map(|k| ends[k][0] * exp(&(phi[k] * half)));
-        let theta = [0, 1].map(|i| cayley_inverse(&(end.1[i] * start.1[i].transpose())));
+        let phi = ends.map(|l| log(&mtm(&l[0], &l[1])));
+        let lam_r = [0, 1].map(|k| mm(&ends[k][0], &exp(&(phi[k] * half))));
+        let theta = [0, 1].map(|i| cayley_inverse(&mmt(&end.1[i], &start.1[i])));
         let dtheta = theta[1] - theta[0];
-        let delta =
-            cayley_inverse(&(lam_r[1] * lam_r[0].transpose())) - (theta[0] + theta[1]) * half;
+        let delta = cayley_inverse(&mmt(&lam_r[1], &lam_r[0])) - (theta[0] + theta[1]) * half;
         // The average of the operators seen from both ends is symmetric in
         // time, hence consistent at second order.
         let (bf, tf) = secant_operators(&ends[0][0], &phi[0], &phi[1], &theta);

@@ -19,7 +19,7 @@
 //! *spatial* spin increments (`Rᵢ ← exp(δφ̂ᵢ) Rᵢ`); the tangent is the
 //! derivative of that residual under the same increments.
 
-use crate::rotation::{exp, log, tangent, tangent_inverse};
+use crate::rotation::{exp, log, mm, tangent, tangent_inverse};
 use crate::scalar::{cst, Scalar};
 use crate::section::Section;
 use crate::shape::{lagrange, reduced_gauss};
@@ -84,7 +84,7 @@ impl<const N: usize> BeamElement<N> {
 
     /// Nodal triads `Λᵢ = Rᵢ Λ₀ᵢ`.
     pub(crate) fn triads<T: Scalar>(&self, rot: &[Matrix3<T>; N]) -> [Matrix3<T>; N] {
-        std::array::from_fn(|i| rot[i] * self.lambda0[i].map(cst::<T>))
+        std::array::from_fn(|i| mm(&rot[i], &self.lambda0[i].map(cst::<T>)))
     }
 
     /// Total (not yet reduced by the initial values) material strains

@@ -24,6 +24,39 @@ pub fn skew<T: Scalar>(a: &Vector3<T>) -> Matrix3<T> {
     Matrix3::new(z, -a.z, a.y, a.z, z, -a.x, -a.y, a.x, z)
 }
 
+/// `â² = a aᵀ − |a|² I`, written out (cheaper than `â â` on dual numbers).
+#[inline]
+pub fn skew_squared<T: Scalar>(a: &Vector3<T>) -> Matrix3<T> {
+    let n = a.norm_squared();
+    Matrix3::from_fn(|i, j| if i == j { a[i] * a[i] - n } else { a[i] * a[j] })
+}
+
+/// The product `a b` of 3 × 3 matrices written out: nalgebra's generic
+/// product spends several times as many scalar operations (`αAB + βC` with
+/// `α = β = 1` multiplied in), which dominates on dual numbers.
+#[inline]
+pub fn mm<T: Scalar>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    Matrix3::from_fn(|i, j| a[(i, 0)] * b[(0, j)] + a[(i, 1)] * b[(1, j)] + a[(i, 2)] * b[(2, j)])
+}
+
+/// `aᵀ b` of 3 × 3 matrices, written out (see [`mm`]).
+#[inline]
+pub fn mtm<T: Scalar>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    Matrix3::from_fn(|i, j| a[(0, i)] * b[(0, j)] + a[(1, i)] * b[(1, j)] + a[(2, i)] * b[(2, j)])
+}
+
+/// `a bᵀ` of 3 × 3 matrices, written out (see [`mm`]).
+#[inline]
+pub fn mmt<T: Scalar>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    Matrix3::from_fn(|i, j| a[(i, 0)] * b[(j, 0)] + a[(i, 1)] * b[(j, 1)] + a[(i, 2)] * b[(j, 2)])
+}
+
+/// `a v` for a 3 × 3 matrix, written out (see [`mm`]).
+#[inline]
+pub fn mv<T: Scalar>(a: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
+    Vector3::from_fn(|i, _| a[(i, 0)] * v[0] + a[(i, 1)] * v[1] + a[(i, 2)] * v[2])
+}
+
 /// The axial vector of the skew-symmetric part of `m`: `vee(â) = a`.
 #[inline]
 pub fn vee<T: Scalar>(m: &Matrix3<T>) -> Vector3<T> {
@@ -86,8 +119,7 @@ fn rodrigues_coefficients<T: Scalar>(t2: T) -> (T, T, T) {
 /// Exponential map (Rodrigues): `exp(ψ̂) = I + (sin ψ/ψ) ψ̂ + ((1−cos ψ)/ψ²) ψ̂²`.
 pub fn exp<T: Scalar>(psi: &Vector3<T>) -> Matrix3<T> {
     let (a, b, _) = rodrigues_coefficients(psi.norm_squared());
-    let k = skew(psi);
-    Matrix3::identity() + k * a + k * k * b
+    Matrix3::identity() + skew(psi) * a + skew_squared(psi) * b
 }
 
 /// Spatial tangent of the exponential map (paper eq. 4): with `Λ = exp(ψ̂)`,
@@ -96,8 +128,7 @@ pub fn exp<T: Scalar>(psi: &Vector3<T>) -> Matrix3<T> {
 /// The material tangent is `Hᵀ(ψ) = H(−ψ)`. `H(ψ) ψ = ψ`.
 pub fn tangent<T: Scalar>(psi: &Vector3<T>) -> Matrix3<T> {
     let (_, b, c) = rodrigues_coefficients(psi.norm_squared());
-    let k = skew(psi);
-    Matrix3::identity() + k * b + k * k * c
+    Matrix3::identity() + skew(psi) * b + skew_squared(psi) * c
 }
 
 /// Inverse of [`tangent`]:
@@ -119,8 +150,7 @@ pub fn tangent_inverse<T: Scalar>(psi: &Vector3<T>) -> Matrix3<T> {
         let h = t2.sqrt() * cst::<T>(0.5);
         (T::one() - h * h.cos() / h.sin()) / t2
     };
-    let k = skew(psi);
-    Matrix3::identity() - k * cst::<T>(0.5) + k * k * d
+    Matrix3::identity() - skew(psi) * cst::<T>(0.5) + skew_squared(psi) * d
 }
 
 /// Unit quaternion `(w, x, y, z)` of a rotation matrix, `w ≥ 0`
@@ -221,9 +251,8 @@ pub fn log<T: Scalar>(r: &Matrix3<T>) -> Vector3<T> {
 
 /// Cayley transform: `cay(θ) = I + 4/(4+|θ|²)·(θ̂ + ½θ̂²) = (I − ½θ̂)⁻¹(I + ½θ̂)`.
 pub fn cayley<T: Scalar>(theta: &Vector3<T>) -> Matrix3<T> {
-    let k = skew(theta);
     let f = cst::<T>(4.0) / (cst::<T>(4.0) + theta.norm_squared());
-    Matrix3::identity() + (k + k * k * cst::<T>(0.5)) * f
+    Matrix3::identity() + (skew(theta) + skew_squared(theta) * cst::<T>(0.5)) * f
 }
 
 /// Inverse Cayley transform: the tangent-scaled vector `θ` with `cay(θ) = Λ`

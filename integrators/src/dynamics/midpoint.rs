@@ -22,6 +22,7 @@
 //! ([`Topology::incremental_blocks`], AD through `Ñ`). Newton converges
 //! quadratically with joints too.
 
+use super::mass_slots::MassSlots;
 pub use super::Scheme;
 use super::{increment_work, slave_velocities};
 use super::{DynamicSettings, Motion, StepControl, GROW_AFTER};
@@ -381,6 +382,8 @@ pub struct MidpointStep<'a> {
     pub scratch: Vec<f64>,
     /// The residual of a tangent update (the same values as the check's).
     pub r_tangent: Vec<f64>,
+    /// Tangent positions of the mass blocks.
+    pub(crate) slots: &'a MassSlots,
     pub floor: f64,
 }
 
@@ -432,12 +435,9 @@ impl MidpointStep<'_> {
                 self.inertia_abs[6 * i + c] += (m * dv[c] / dt).abs();
             }
             if tangent {
-                self.asm.add_node_block(
-                    &self.topo.dofs,
-                    (i, 0),
-                    (j, 0),
-                    &(Matrix3::identity() * (2.0 * m / (dt * dt))),
-                );
+                let block = Matrix3::identity() * (2.0 * m / (dt * dt));
+                self.slots
+                    .add_translational(self.asm, &self.topo.dofs, k, (i, j), &block);
             }
         }
         // Rotational inertia, node by node.
@@ -459,7 +459,7 @@ impl MidpointStep<'_> {
                 self.inertia_abs[6 * i + 3 + c] += m[c].abs();
             }
             if tangent {
-                self.asm.add_node_block(&self.topo.dofs, (i, 3), (i, 3), &k);
+                self.slots.add_rotational(self.asm, &self.topo.dofs, i, &k);
             }
         }
         self.reduce_residual(&self.nodal, r);
@@ -562,6 +562,7 @@ pub fn solve(
     let inertia = Inertia::new(&mech.mesh, settings.mass);
     let mut asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
     let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
+    let slots = MassSlots::new(&asm, &topo.dofs, &inertia);
     let (mut r, mut dq) = (vec![0.0; n_eq], vec![0.0; n_eq]);
     let (mut v, mut w) = slave_velocities(mech, &topo, &state, initial);
     // Rates of the released coordinates, for the predictor.
@@ -632,6 +633,7 @@ pub fn solve(
             inertia_abs: vec![0.0; 6 * nodes],
             scratch: vec![0.0; n_eq],
             r_tangent: vec![0.0; n_eq],
+            slots: &slots,
             floor: mech.round_off_floor_at(&state.config.x),
         };
         let outcome = match scheme {

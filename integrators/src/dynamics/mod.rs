@@ -16,6 +16,7 @@
 
 pub mod energy_momentum;
 pub mod energy_momentum_paper;
+mod mass_slots;
 pub mod midpoint;
 pub mod momentum;
 pub mod newmark;

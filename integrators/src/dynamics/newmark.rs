@@ -12,6 +12,7 @@
 //! conserves neither energy nor angular momentum in general; the paper's
 //! screw example shows its energy growing until it fails.
 
+use super::mass_slots::MassSlots;
 use super::midpoint::dynamic_record;
 use super::{slave_velocities, DynamicSettings, Motion, StepControl, GROW_AFTER};
 use crate::assembly::Assembler;
@@ -70,29 +71,6 @@ fn inertial_moment<T: flexmech_core::Scalar>(
     *r1 * (jd * a1 + w1.cross(&(jd * w1)))
 }
 
-/// Where the mass blocks land in the tangent values, found once per run:
-/// per translational mass entry `(i, j, m)` and per node's rotational
-/// inertia (`None` where a slave is involved: its maps change).
-struct MassSlots {
-    translational: Vec<Option<Vec<(usize, usize, usize)>>>,
-    rotational: Vec<Option<Vec<(usize, usize, usize)>>>,
-}
-
-impl MassSlots {
-    fn new(asm: &Assembler, dofs: &crate::dofs::DofMap, inertia: &Inertia) -> Self {
-        Self {
-            translational: inertia
-                .mass
-                .iter()
-                .map(|&(i, j, _)| asm.node_block_slots(dofs, (i, 0), (j, 0)))
-                .collect(),
-            rotational: (0..inertia.rotational.len())
-                .map(|i| asm.node_block_slots(dofs, (i, 3), (i, 3)))
-                .collect(),
-        }
-    }
-}
-
 struct NewmarkStep<'a> {
     mech: &'a Mechanism,
     topo: &'a mut Topology,
@@ -146,12 +124,8 @@ impl NewmarkStep<'_> {
             }
             if tangent {
                 let block = Matrix3::identity() * (m / (BETA * dt * dt));
-                match &self.slots.translational[k] {
-                    Some(at) => self.asm.add_node_block_at(at, &block),
-                    None => self
-                        .asm
-                        .add_node_block(&self.topo.dofs, (i, 0), (j, 0), &block),
-                }
+                self.slots
+                    .add_translational(self.asm, &self.topo.dofs, k, (i, j), &block);
             }
         }
         // Rotational inertia Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), and its tangent by
@@ -184,10 +158,7 @@ impl NewmarkStep<'_> {
                 self.abs[6 * i + 3 + c] += m[c].abs();
             }
             if let Some(k) = k {
-                match &self.slots.rotational[i] {
-                    Some(at) => self.asm.add_node_block_at(at, &k),
-                    None => self.asm.add_node_block(&self.topo.dofs, (i, 3), (i, 3), &k),
-                }
+                self.slots.add_rotational(self.asm, &self.topo.dofs, i, &k);
             }
         }
         self.topo.dofs.reduce(&self.nodal, r);

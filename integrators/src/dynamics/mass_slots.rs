@@ -1,0 +1,60 @@
+//! Where the nodal mass and inertia blocks land in the tangent values,
+//! found once per run (the tangent's pattern does not change), so that each
+//! tangent assembly adds them without searching.
+
+use crate::assembly::Assembler;
+use crate::dofs::DofMap;
+use flexmech_core::Inertia;
+use nalgebra::Matrix3;
+
+/// Tangent positions per translational mass entry `(i, j, m)` and per
+/// node's rotational inertia (`None` where a slave is involved: its maps
+/// change with the iterate, and the block goes through them).
+pub(crate) struct MassSlots {
+    translational: Vec<Option<Vec<(usize, usize, usize)>>>,
+    rotational: Vec<Option<Vec<(usize, usize, usize)>>>,
+}
+
+impl MassSlots {
+    pub(crate) fn new(asm: &Assembler, dofs: &DofMap, inertia: &Inertia) -> Self {
+        Self {
+            translational: inertia
+                .mass
+                .iter()
+                .map(|&(i, j, _)| asm.node_block_slots(dofs, (i, 0), (j, 0)))
+                .collect(),
+            rotational: (0..inertia.rotational.len())
+                .map(|i| asm.node_block_slots(dofs, (i, 3), (i, 3)))
+                .collect(),
+        }
+    }
+
+    /// Adds `block` for mass entry `k = (i, j, m)` (translations of `i`, `j`).
+    pub(crate) fn add_translational(
+        &self,
+        asm: &mut Assembler,
+        dofs: &DofMap,
+        k: usize,
+        (i, j): (usize, usize),
+        block: &Matrix3<f64>,
+    ) {
+        match &self.translational[k] {
+            Some(at) => asm.add_node_block_at(at, block),
+            None => asm.add_node_block(dofs, (i, 0), (j, 0), block),
+        }
+    }
+
+    /// Adds `block` for the rotations of node `i`.
+    pub(crate) fn add_rotational(
+        &self,
+        asm: &mut Assembler,
+        dofs: &DofMap,
+        i: usize,
+        block: &Matrix3<f64>,
+    ) {
+        match &self.rotational[i] {
+            Some(at) => asm.add_node_block_at(at, block),
+            None => asm.add_node_block(dofs, (i, 3), (i, 3), block),
+        }
+    }
+}
