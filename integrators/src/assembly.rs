@@ -204,8 +204,9 @@ impl Assembler {
             let rows = if split { &w.g_row } else { &w.g };
             w.k_red.gemm_tr(1.0, rows, &w.tmp, 0.0);
         };
-        // One thread asked for: no hand-off to a worker at all.
-        if rayon::current_num_threads() == 1 {
+        // One thread asked for, or already on a worker (the runs of a study
+        // are the parallel work): no hand-off at all.
+        if sequential() {
             self.work
                 .iter_mut()
                 .zip(mesh.elements.iter().enumerate())
@@ -243,7 +244,7 @@ impl Assembler {
         F: Fn(&Element, &mut [f64]) + Sync,
     {
         let element = |(w, el): (&mut Work, &Element)| kernel(el, w.r.as_mut_slice());
-        if rayon::current_num_threads() == 1 {
+        if sequential() {
             self.work.iter_mut().zip(&mesh.elements).for_each(element);
         } else {
             self.work
@@ -352,4 +353,12 @@ impl Assembler {
             .expect("entry in the sparsity pattern");
         self.values[cp[col] + p] += v;
     }
+}
+
+/// Whether assembly runs on the calling thread: when one thread is asked
+/// for (`RAYON_NUM_THREADS=1`), or when the caller is itself a rayon worker
+/// (a study's runs in parallel), where splitting each element loop again only
+/// adds hand-offs between the same threads.
+fn sequential() -> bool {
+    rayon::current_num_threads() == 1 || rayon::current_thread_index().is_some()
 }
