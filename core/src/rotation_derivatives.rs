@@ -18,14 +18,25 @@ pub struct MatrixDerivatives {
 type H3 = HyperDualSVec64<3, 3>;
 
 fn split(m: Matrix3<H3>) -> MatrixDerivatives {
+    let mut d1 = [Matrix3::zeros(); 3];
+    let mut d2 = [[Matrix3::zeros(); 3]; 3];
+    for r in 0..3 {
+        for c in 0..3 {
+            let x = &m[(r, c)];
+            let e1 = x.eps1.unwrap_generic(Const::<3>, U1);
+            let e12 = x.eps1eps2.unwrap_generic(Const::<3>, Const::<3>);
+            for i in 0..3 {
+                d1[i][(r, c)] = e1[i];
+                for j in 0..3 {
+                    d2[i][j][(r, c)] = e12[(i, j)];
+                }
+            }
+        }
+    }
     MatrixDerivatives {
         value: m.map(|x| x.re),
-        d1: std::array::from_fn(|i| m.map(|x| x.eps1.unwrap_generic(Const::<3>, U1)[i])),
-        d2: std::array::from_fn(|i| {
-            std::array::from_fn(|j| {
-                m.map(|x| x.eps1eps2.unwrap_generic(Const::<3>, Const::<3>)[(i, j)])
-            })
-        }),
+        d1,
+        d2,
     }
 }
 

@@ -3,6 +3,7 @@
 //! the time integrators).
 
 pub mod assembly;
+pub mod band_lu;
 pub mod constraints;
 pub mod dofs;
 pub mod dynamics;
