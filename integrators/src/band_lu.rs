@@ -309,7 +309,11 @@ mod tests {
         let mut b = a.clone();
         band.solve(&mut a).unwrap();
         general.solve(&mut b).unwrap();
-        let diff = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        let diff = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
         let size = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         assert!(diff <= 1e-10 * size, "{diff:e} of {size:e}");
         // An arrow (diagonal plus a full first row and column: no ordering
