@@ -57,7 +57,9 @@ pub trait NewtonSystem {
     }
     /// Computes the tangent at the current iterate after a
     /// [`NewtonSystem::residual`] that left it out (default: nothing to do).
-    fn update_tangent(&mut self) {}
+    /// `scratch` (length `n_eq`) receives the residual the evaluation
+    /// computes alongside.
+    fn update_tangent(&mut self, _scratch: &mut [f64]) {}
     /// CSC values of the tangent from the last evaluation that computed it.
     fn tangent_values(&self) -> &[f64];
     /// Applies the increment `dq` to the current iterate.
@@ -157,7 +159,8 @@ fn iterate<S: NewtonSystem>(
                 res < MODIFIED_CONTRACTION * history[it - 1]
             };
         if !reuse {
-            sys.update_tangent();
+            // dq is free until the solve below.
+            sys.update_tangent(dq);
             lu.factor(sys.tangent_values())
                 .map_err(NewtonFailure::LinearSolve)?;
             lu.set_key(sys.tangent_key());
@@ -196,7 +199,7 @@ pub(crate) fn check_regular<S: NewtonSystem>(
         return Ok(());
     }
     if !factored {
-        sys.update_tangent();
+        sys.update_tangent(&mut vec![0.0; lu.pattern().nrows()]);
         lu.factor(sys.tangent_values())
             .map_err(NewtonFailure::LinearSolve)?;
     }

@@ -6,28 +6,11 @@ use flexmech_studies::model::parse_model;
 use flexmech_studies::run_model;
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::{drift, read};
+
 fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../data/dynamics")
-        .join(name)
-}
-
-fn read(file: &Path, dataset: &str) -> Vec<f64> {
-    hdf5::File::open(file)
-        .unwrap()
-        .dataset(dataset)
-        .unwrap()
-        .read_raw()
-        .unwrap()
-}
-
-fn drift(series: &[f64], width: usize) -> f64 {
-    let rows: Vec<&[f64]> = series.chunks(width).collect();
-    let norm = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let first = rows[0];
-    rows.iter()
-        .map(|r| norm(&r.iter().zip(first).map(|(a, b)| a - b).collect::<Vec<_>>()) / norm(first))
-        .fold(0.0, f64::max)
+    common::data(&format!("dynamics/{name}"))
 }
 
 fn run(integrator: &str) -> (PathBuf, tempfile::TempDir) {
@@ -45,18 +28,18 @@ fn run(integrator: &str) -> (PathBuf, tempfile::TempDir) {
 #[test]
 fn energy_momentum_conserves_everything_from_a_model_file() {
     let (file, _dir) = run("energy-momentum");
-    let t = read(&file, "/time");
+    let t = read::<f64>(&file, "/time");
     assert!((t.last().unwrap() - 20.0).abs() < 1e-9 && t[0] == 0.0);
-    let e = read(&file, "/energy/total");
+    let e = read::<f64>(&file, "/energy/total");
     let de = e
         .iter()
         .map(|v| (v - e[0]).abs() / e[0])
         .fold(0.0, f64::max);
     assert!(de <= 1e-9, "energy drift {de:e}");
-    assert!(drift(&read(&file, "/momentum/linear"), 3) <= 1e-9);
-    assert!(drift(&read(&file, "/momentum/angular"), 3) <= 1e-9);
+    assert!(drift(&read::<f64>(&file, "/momentum/linear"), 3) <= 1e-9);
+    assert!(drift(&read::<f64>(&file, "/momentum/angular"), 3) <= 1e-9);
     // β is reported for every step after the first record.
-    let beta = read(&file, "/solver/beta");
+    let beta = read::<f64>(&file, "/solver/beta");
     assert!(beta[0].is_nan() && beta[1..].iter().all(|b| b.is_finite()));
     let f = hdf5::File::open(&file).unwrap();
     let integrator: hdf5::types::VarLenUnicode =
@@ -67,11 +50,13 @@ fn energy_momentum_conserves_everything_from_a_model_file() {
 #[test]
 fn momentum_and_newmark_from_the_same_file() {
     let (file, _dir) = run("momentum");
-    assert!(drift(&read(&file, "/momentum/angular"), 3) <= 1e-9);
-    assert!(read(&file, "/solver/beta").iter().all(|b| b.is_nan()));
+    assert!(drift(&read::<f64>(&file, "/momentum/angular"), 3) <= 1e-9);
+    assert!(read::<f64>(&file, "/solver/beta")
+        .iter()
+        .all(|b| b.is_nan()));
     let (file, _dir2) = run("newmark");
-    assert!(drift(&read(&file, "/momentum/linear"), 3) <= 1e-9);
-    let e = read(&file, "/energy/total");
+    assert!(drift(&read::<f64>(&file, "/momentum/linear"), 3) <= 1e-9);
+    let e = read::<f64>(&file, "/energy/total");
     assert!(e.iter().all(|v| v.is_finite()));
 }
 
@@ -106,9 +91,9 @@ fn every_joint_kind_runs_with_every_integrator_from_a_model_file() {
     ];
     for integrator in ["newmark", "momentum", "energy-momentum"] {
         let (file, _dir) = run_chain(integrator);
-        assert!((read(&file, "/time").last().unwrap() - 1.0).abs() < 1e-9);
+        assert!((read::<f64>(&file, "/time").last().unwrap() - 1.0).abs() < 1e-9);
         for joint in JOINTS {
-            let c = read(&file, &format!("/joints/{joint}/constraint_error"));
+            let c = read::<f64>(&file, &format!("/joints/{joint}/constraint_error"));
             let worst = c.iter().copied().fold(0.0, f64::max);
             assert!(
                 worst <= 1e-12,
@@ -116,10 +101,10 @@ fn every_joint_kind_runs_with_every_integrator_from_a_model_file() {
             );
         }
         let (dl, dh) = (
-            drift(&read(&file, "/momentum/linear"), 3),
-            drift(&read(&file, "/momentum/angular"), 3),
+            drift(&read::<f64>(&file, "/momentum/linear"), 3),
+            drift(&read::<f64>(&file, "/momentum/angular"), 3),
         );
-        let e = read(&file, "/energy/total");
+        let e = read::<f64>(&file, "/energy/total");
         let de = e
             .iter()
             .map(|v| (v - e[0]).abs() / e[0])
@@ -181,14 +166,14 @@ fn a_long_run_does_not_stall_as_the_beam_travels() {
     let model = parse_model(&text, &path).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let file = run_model(&model, dir.path()).unwrap().file;
-    let t = read(&file, "/time");
+    let t = read::<f64>(&file, "/time");
     assert!((t.last().unwrap() - 70.0).abs() < 1e-9);
-    let e = read(&file, "/energy/total");
+    let e = read::<f64>(&file, "/energy/total");
     let de = e
         .iter()
         .map(|v| (v - e[0]).abs() / e[0])
         .fold(0.0, f64::max);
     assert!(de <= 1e-9, "energy drift {de:e}");
-    assert!(drift(&read(&file, "/momentum/linear"), 3) <= 1e-9);
-    assert!(drift(&read(&file, "/momentum/angular"), 3) <= 1e-9);
+    assert!(drift(&read::<f64>(&file, "/momentum/linear"), 3) <= 1e-9);
+    assert!(drift(&read::<f64>(&file, "/momentum/angular"), 3) <= 1e-9);
 }

@@ -9,29 +9,8 @@ use flexmech_studies::model::parse_model;
 use flexmech_studies::run_model;
 use std::path::{Path, PathBuf};
 
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../data")
-        .join(name)
-}
-
-fn read(file: &Path, dataset: &str) -> Vec<f64> {
-    hdf5::File::open(file)
-        .unwrap()
-        .dataset(dataset)
-        .unwrap()
-        .read_raw()
-        .unwrap()
-}
-
-fn read_u64(file: &Path, dataset: &str) -> Vec<u64> {
-    hdf5::File::open(file)
-        .unwrap()
-        .dataset(dataset)
-        .unwrap()
-        .read_raw()
-        .unwrap()
-}
+mod common;
+use common::{data, drift, read};
 
 /// Runs `model` (a data/ path) with `integrator` and `newton`.
 fn run(model: &str, integrator: &str, newton: &str) -> (PathBuf, tempfile::TempDir) {
@@ -48,18 +27,6 @@ fn run(model: &str, integrator: &str, newton: &str) -> (PathBuf, tempfile::TempD
     (file, dir)
 }
 
-/// Largest relative change of a conserved series (rows of `width`).
-fn drift(series: &[f64], width: usize) -> f64 {
-    let rows: Vec<&[f64]> = series.chunks(width).collect();
-    let norm = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>().sqrt();
-    rows.iter()
-        .map(|r| {
-            let d: Vec<f64> = r.iter().zip(rows[0]).map(|(a, b)| a - b).collect();
-            norm(&d) / norm(rows[0])
-        })
-        .fold(0.0, f64::max)
-}
-
 /// Newton's tolerance (1e-11 in the chain's file) accumulated over 100
 /// steps, on positions of size 1: well below this; an approximate
 /// solution (a step accepted before convergence) would be far above.
@@ -71,8 +38,8 @@ fn the_free_chain_follows_full_newton_with_every_joint_kind() {
         let (full, _d1) = run("dynamics/free_chain.toml", integrator, "full");
         let (modified, _d2) = run("dynamics/free_chain.toml", integrator, "modified");
         let (a, b) = (
-            read(&full, "/configuration/position"),
-            read(&modified, "/configuration/position"),
+            read::<f64>(&full, "/configuration/position"),
+            read::<f64>(&modified, "/configuration/position"),
         );
         assert_eq!(a.len(), b.len());
         let worst = a
@@ -80,11 +47,13 @@ fn the_free_chain_follows_full_newton_with_every_joint_kind() {
             .zip(&b)
             .map(|(x, y)| (x - y).abs())
             .fold(0.0, f64::max);
-        let steps = read_u64(&modified, "/solver/iterations").len() - 1;
-        let factorizations: u64 = read_u64(&modified, "/solver/factorizations").iter().sum();
-        let iterations: u64 = read_u64(&modified, "/solver/iterations").iter().sum();
-        let full_factorizations: u64 = read_u64(&full, "/solver/factorizations").iter().sum();
-        let full_iterations: u64 = read_u64(&full, "/solver/iterations").iter().sum();
+        let steps = read::<u64>(&modified, "/solver/iterations").len() - 1;
+        let factorizations: u64 = read::<u64>(&modified, "/solver/factorizations")
+            .iter()
+            .sum();
+        let iterations: u64 = read::<u64>(&modified, "/solver/iterations").iter().sum();
+        let full_factorizations: u64 = read::<u64>(&full, "/solver/factorizations").iter().sum();
+        let full_iterations: u64 = read::<u64>(&full, "/solver/iterations").iter().sum();
         eprintln!(
             "{integrator}: positions differ by {worst:.1e}; modified {factorizations} \
              factorisations / {iterations} iterations over {steps} steps, full \
@@ -97,18 +66,18 @@ fn the_free_chain_follows_full_newton_with_every_joint_kind() {
             "{integrator}: {factorizations} factorisations for {steps} steps"
         );
         for joint in ["revolute", "screw", "cam", "lobe"] {
-            let c = read(&modified, &format!("/joints/{joint}/constraint_error"));
+            let c = read::<f64>(&modified, &format!("/joints/{joint}/constraint_error"));
             assert!(c.iter().all(|&v| v <= 1e-12), "{integrator}, {joint}");
         }
         if integrator != "newmark" {
             let (dl, dh) = (
-                drift(&read(&modified, "/momentum/linear"), 3),
-                drift(&read(&modified, "/momentum/angular"), 3),
+                drift(&read::<f64>(&modified, "/momentum/linear"), 3),
+                drift(&read::<f64>(&modified, "/momentum/angular"), 3),
             );
             assert!(dl <= 1e-9 && dh <= 1e-9, "{integrator}: {dl:e} {dh:e}");
         }
         if integrator == "energy-momentum" {
-            let de = drift(&read(&modified, "/energy/total"), 1);
+            let de = drift(&read::<f64>(&modified, "/energy/total"), 1);
             assert!(de <= 1e-9, "energy drift {de:e}");
         }
     }
@@ -117,47 +86,34 @@ fn the_free_chain_follows_full_newton_with_every_joint_kind() {
 #[test]
 fn the_spinning_beam_keeps_its_energy_with_modified_newton() {
     let (file, _dir) = run("dynamics/spinning_beam.toml", "energy-momentum", "modified");
-    assert!((read(&file, "/time").last().unwrap() - 20.0).abs() < 1e-9);
-    let de = drift(&read(&file, "/energy/total"), 1);
+    assert!((read::<f64>(&file, "/time").last().unwrap() - 20.0).abs() < 1e-9);
+    let de = drift(&read::<f64>(&file, "/energy/total"), 1);
     assert!(de <= 1e-9, "energy drift {de:e}");
-    assert!(drift(&read(&file, "/momentum/angular"), 3) <= 1e-9);
+    assert!(drift(&read::<f64>(&file, "/momentum/angular"), 3) <= 1e-9);
 }
 
 #[test]
 fn modified_newton_is_refused_where_it_cannot_hold() {
+    // The model error of `text` names `solver.newton` and says `why`.
+    let refused = |text: &str, why: &str| {
+        let err = parse_model(text, Path::new("m.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("solver.newton") && err.contains(why), "{err}");
+    };
     let static_model = std::fs::read_to_string(data("statics/screw_driven.toml")).unwrap();
     assert!(static_model.contains("[solver]"));
-    let text = static_model.replace("[solver]", "[solver]\nnewton = \"modified\"");
-    let err = parse_model(&text, Path::new("m.toml"))
-        .unwrap_err()
-        .to_string();
-    assert!(
-        err.contains("solver.newton") && err.contains("dynamic"),
-        "{err}"
+    refused(
+        &static_model.replace("[solver]", "[solver]\nnewton = \"modified\""),
+        "dynamic",
     );
-
     let chain = std::fs::read_to_string(data("dynamics/free_chain.toml")).unwrap();
-    let paper = chain.replace(
-        "integrator = \"energy-momentum\"",
-        "integrator = \"energy-momentum-paper\"\nnewton = \"modified\"",
-    );
-    let err = parse_model(&paper, Path::new("m.toml"))
-        .unwrap_err()
-        .to_string();
-    assert!(
-        err.contains("solver.newton") && err.contains("bordered"),
-        "{err}"
-    );
-
-    let typo = chain.replace(
-        "integrator = \"energy-momentum\"",
-        "integrator = \"energy-momentum\"\nnewton = \"quasi\"",
-    );
-    let err = parse_model(&typo, Path::new("m.toml"))
-        .unwrap_err()
-        .to_string();
-    assert!(
-        err.contains("solver.newton") && err.contains("\"modified\""),
-        "{err}"
-    );
+    let with = |integrator: &str, newton: &str| {
+        chain.replace(
+            "integrator = \"energy-momentum\"",
+            &format!("integrator = \"{integrator}\"\nnewton = \"{newton}\""),
+        )
+    };
+    refused(&with("energy-momentum-paper", "modified"), "bordered");
+    refused(&with("energy-momentum", "quasi"), "\"modified\"");
 }

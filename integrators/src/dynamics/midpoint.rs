@@ -38,7 +38,7 @@ use crate::rotation_guard::{as_step_failure, RotationGuard};
 use crate::statics::strain_energy;
 use flexmech_core::conserving::{MidRotation, Pose, Pose3};
 use flexmech_core::rotation::{cayley_inverse, exp, log};
-use flexmech_core::{BeamElement, Configuration, Element, Inertia};
+use flexmech_core::{cst, BeamElement, Configuration, Element, Inertia, Scalar};
 use nalgebra::{Const, Matrix3, SVector, Vector3, U1};
 use num_dual::DualSVec64;
 
@@ -76,10 +76,7 @@ pub(super) fn seeded_poses(
 ) -> (Pose<f64>, Pose<Dual12>, Pose<Dual12>) {
     type D = Dual12;
     let n = e.nodes;
-    let s: Pose<f64> = (
-        [start.x[n[0]], start.x[n[1]]],
-        [start.rot[n[0]], start.rot[n[1]]],
-    );
+    let s = pose_of(e, start);
     let seed = |j: usize| D::from_re(0.0).derivative(j);
     let v = |j: usize| Vector3::new(seed(j), seed(j + 1), seed(j + 2));
     let sd: Pose<D> = (
@@ -151,10 +148,7 @@ fn element_kernel(
         Element::Linear(e) => e,
         Element::Quadratic(e) => return quadratic_kernel(e, start, end, r, k),
     };
-    let pose = |c: &Configuration| -> Pose<f64> {
-        let n = e.nodes;
-        ([c.x[n[0]], c.x[n[1]]], [c.rot[n[0]], c.rot[n[1]]])
-    };
+    let pose = |c: &Configuration| pose_of(e, c);
     let (q, jac) = match scheme {
         Scheme::Momentum => e.momentum_force_tangent(&pose(start), &pose(end)),
         Scheme::EnergyMomentum => e.energy_momentum_force_tangent(&pose(start), &pose(end)),
@@ -191,15 +185,8 @@ fn element_force(
 ) {
     let q = match (el, scheme) {
         (Element::Linear(e), Scheme::Momentum | Scheme::EnergyMomentum) => {
-            let n = e.nodes;
-            let s: Pose<f64> = (
-                [start.x[n[0]], start.x[n[1]]],
-                [start.rot[n[0]], start.rot[n[1]]],
-            );
-            let t: Pose<f64> = ([end.x[n[0]], end.x[n[1]]], [end.rot[n[0]], end.rot[n[1]]]);
-            let (n0, m0) = e.resultants(&s.0, &s.1);
-            let (n1, m1) = e.resultants(&t.0, &t.1);
-            let (nbar, mbar) = ((n0 + n1) * 0.5, (m0 + m1) * 0.5);
+            let (s, t) = (pose_of(e, start), pose_of(e, end));
+            let (nbar, mbar) = averaged_resultants(e, &s, &t);
             if scheme == Scheme::Momentum {
                 e.midpoint_force(&s, &t, &nbar, &mbar, MidRotation::Geodesic)
             } else {
@@ -255,21 +242,27 @@ fn quadratic_kernel(
     }
 }
 
-/// The step averages `(Nₙ₊½, Mₙ₊½)` of an element's material resultants,
-/// the end seeded (see [`seeded_poses`]).
-fn averaged_resultants(
+/// The step averages `(Nₙ₊½, Mₙ₊½)` of an element's material resultants
+/// between the start pose `s` and the end pose `ed` (plain, or seeded for
+/// AD: see [`seeded_poses`]).
+fn averaged_resultants<T: Scalar>(
     e: &BeamElement<2>,
     s: &Pose<f64>,
-    ed: &Pose<Dual12>,
-) -> (Vector3<Dual12>, Vector3<Dual12>) {
-    type D = Dual12;
+    ed: &Pose<T>,
+) -> (Vector3<T>, Vector3<T>) {
     let (n0, m0) = e.resultants(&s.0, &s.1);
     let (n1, m1) = e.resultants(&ed.0, &ed.1);
-    let half = D::from_re(0.5);
+    let half = cst::<T>(0.5);
     (
-        (n0.map(D::from_re) + n1) * half,
-        (m0.map(D::from_re) + m1) * half,
+        (n0.map(cst::<T>) + n1) * half,
+        (m0.map(cst::<T>) + m1) * half,
     )
+}
+
+/// A 2-node element's nodal positions and rotations in a configuration.
+fn pose_of(e: &BeamElement<2>, c: &Configuration) -> Pose<f64> {
+    let n = e.nodes;
+    ([c.x[n[0]], c.x[n[1]]], [c.rot[n[0]], c.rot[n[1]]])
 }
 
 /// The energy–momentum scheme's consistency measure of a converged step:
@@ -280,15 +273,9 @@ pub fn correction_size(mech: &Mechanism, start: &Configuration, end: &Configurat
     let (mut corr, mut size) = (0.0f64, 0.0f64);
     for el in &mech.mesh.elements {
         let Element::Linear(e) = el else { continue };
-        let n = e.nodes;
-        let s: Pose<f64> = (
-            [start.x[n[0]], start.x[n[1]]],
-            [start.rot[n[0]], start.rot[n[1]]],
-        );
-        let t: Pose<f64> = ([end.x[n[0]], end.x[n[1]]], [end.rot[n[0]], end.rot[n[1]]]);
-        let (n0, m0) = e.resultants(&s.0, &s.1);
-        let (n1, m1) = e.resultants(&t.0, &t.1);
-        let (q, c) = e.discrete_gradient_parts(&s, &t, &((n0 + n1) * 0.5), &((m0 + m1) * 0.5));
+        let (s, t) = (pose_of(e, start), pose_of(e, end));
+        let (nbar, mbar) = averaged_resultants(e, &s, &t);
+        let (q, c) = e.discrete_gradient_parts(&s, &t, &nbar, &mbar);
         corr = corr.max(c.norm());
         size = size.max(q.norm());
     }
@@ -380,8 +367,6 @@ pub struct MidpointStep<'a> {
     /// Magnitudes of the internal and inertial contributions (residual scale).
     pub inertia_abs: Vec<f64>,
     pub scratch: Vec<f64>,
-    /// The residual of a tangent update (the same values as the check's).
-    pub r_tangent: Vec<f64>,
     /// Tangent positions of the mass blocks.
     pub(crate) slots: &'a MassSlots,
     pub floor: f64,
@@ -490,11 +475,8 @@ impl NewtonSystem for MidpointStep<'_> {
         self.evaluate_with(r, false)
     }
 
-    fn update_tangent(&mut self) {
-        let mut r = std::mem::take(&mut self.r_tangent);
-        r.resize(self.scratch.len(), 0.0);
-        self.evaluate_with(&mut r, true);
-        self.r_tangent = r;
+    fn update_tangent(&mut self, scratch: &mut [f64]) {
+        self.evaluate_with(scratch, true);
     }
 
     fn tangent_key(&self) -> f64 {
@@ -632,7 +614,6 @@ pub fn solve(
             nodal: vec![0.0; 6 * nodes],
             inertia_abs: vec![0.0; 6 * nodes],
             scratch: vec![0.0; n_eq],
-            r_tangent: vec![0.0; n_eq],
             slots: &slots,
             floor: mech.round_off_floor_at(&state.config.x),
         };

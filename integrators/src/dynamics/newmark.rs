@@ -85,8 +85,6 @@ struct NewmarkStep<'a> {
     nodal: Vec<f64>,
     abs: Vec<f64>,
     scratch: Vec<f64>,
-    /// The residual of a tangent update (the same values as the check's).
-    r_tangent: Vec<f64>,
     /// Tangent positions of the mass blocks (see [`MassSlots`]).
     slots: &'a MassSlots,
     floor: f64,
@@ -187,10 +185,8 @@ impl NewtonSystem for NewmarkStep<'_> {
         self.evaluate_with(r, false)
     }
 
-    fn update_tangent(&mut self) {
-        let mut r = std::mem::take(&mut self.r_tangent);
-        self.evaluate_with(&mut r, true);
-        self.r_tangent = r;
+    fn update_tangent(&mut self, scratch: &mut [f64]) {
+        self.evaluate_with(scratch, true);
     }
 
     fn tangent_key(&self) -> f64 {
@@ -358,7 +354,6 @@ pub fn solve(
             nodal: vec![0.0; 6 * nodes],
             abs: vec![0.0; 6 * nodes],
             scratch: vec![0.0; n_eq],
-            r_tangent: vec![0.0; n_eq],
             slots: &slots,
             floor: mech.round_off_floor_at(&state.config.x),
         };
