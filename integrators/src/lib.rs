@@ -10,6 +10,7 @@ pub mod dynamics;
 pub mod error;
 pub mod free_motion;
 pub mod linsolve;
+pub mod measure;
 pub mod mechanism;
 pub mod newton;
 pub mod record;
@@ -17,6 +18,7 @@ pub mod rotation_guard;
 pub mod stability;
 pub mod statics;
 pub mod step_control;
+pub mod system;
 
 pub use constraints::{MechanismState, Topology};
 pub use error::{NewtonFailure, SolveError};

@@ -8,19 +8,19 @@
 //! exactly; halvings only insert levels between them.
 
 use crate::assembly::Assembler;
-use crate::constraints::{initial_state, joint_records, MechanismState, Topology};
+use crate::constraints::{initial_state, MechanismState, Topology};
+use crate::dofs::DofMap;
 use crate::error::{NewtonFailure, SolveError};
-use crate::free_motion::FreeMotion;
-use crate::linsolve::{SparseLu, TangentRef};
+use crate::linsolve::SparseLu;
+use crate::measure::static_record;
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonSettings, NewtonSystem};
-use crate::record::{Energies, StepRecord};
+use crate::record::StepRecord;
 use crate::rotation_guard::{as_step_failure, RotationGuard};
 use crate::stability::InertiaCount;
 use crate::step_control::StepControl;
+use crate::system::{ReducedSystem, Reduction, StepTerms};
 use flexmech_core::Configuration;
-use nalgebra::Vector3;
-use rayon::prelude::*;
 
 /// Settings of a static analysis.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,122 +44,29 @@ pub struct StaticOutcome {
     pub steps: usize,
 }
 
-/// The static problem at one load factor: the [`NewtonSystem`] Newton solves.
-struct StaticProblem<'a> {
-    mech: &'a Mechanism,
-    topo: Topology,
-    asm: Assembler,
-    state: MechanismState,
-    fext: Vec<f64>,
-    nodal_r: Vec<f64>,
-    scratch: Vec<f64>,
-    /// Round-off floor of the residual norm.
-    floor: f64,
-}
+/// The static terms: the beams' internal forces at the iterate; no inertia;
+/// joints through `N`.
+struct StaticTerms;
 
-impl NewtonSystem for StaticProblem<'_> {
-    fn evaluate(&mut self, r: &mut [f64]) -> f64 {
-        self.topo.refresh(self.mech, &self.state);
-        self.asm
-            .assemble(&self.mech.mesh, &self.topo.dofs, &self.state.config);
-        for ((g, fi), fe) in self.nodal_r.iter_mut().zip(&self.asm.nodal).zip(&self.fext) {
-            *g = fi - fe;
+impl StepTerms for StaticTerms {
+    fn reduction(&self) -> Reduction {
+        Reduction::Variation
+    }
+
+    fn elements(
+        &self,
+        mech: &Mechanism,
+        dofs: &DofMap,
+        asm: &mut Assembler,
+        _start: &Configuration,
+        end: &Configuration,
+        tangent: bool,
+    ) {
+        if tangent {
+            asm.assemble(&mech.mesh, dofs, end);
+        } else {
+            asm.assemble_residual(&mech.mesh, end);
         }
-        self.topo.dofs.reduce(&self.nodal_r, r);
-        for (b, block) in self
-            .topo
-            .geometric_blocks(self.mech, &self.state, &self.nodal_r)
-            .iter()
-            .enumerate()
-        {
-            self.asm.add_block(b, block);
-        }
-        let dofs = &self.topo.dofs;
-        let f_ext = dofs.reduced_norm(&self.fext, &mut self.scratch);
-        f_ext.max(dofs.reduced_norm(&self.asm.nodal_abs, &mut self.scratch))
-    }
-
-    fn tangent_values(&self) -> &[f64] {
-        &self.asm.values
-    }
-
-    fn apply(&mut self, dq: &[f64]) {
-        self.topo.apply(self.mech, &mut self.state, dq);
-    }
-
-    fn floor(&self) -> f64 {
-        self.floor
-    }
-
-    fn free_motion(&self, mode: &[f64], tangent: TangentRef) -> FreeMotion {
-        let topo = &self.topo;
-        FreeMotion::of(
-            self.mech,
-            &topo.dofs,
-            &topo.released_eqs,
-            &self.state.config.x,
-            mode,
-            tangent,
-        )
-    }
-}
-
-/// Strain energy of the whole mesh (element energies summed in element order).
-pub fn strain_energy(mech: &Mechanism, config: &Configuration) -> f64 {
-    let per: Vec<f64> = mech
-        .mesh
-        .elements
-        .par_iter()
-        .map(|e| e.energy(&config.x, &config.rot))
-        .collect();
-    per.iter().sum()
-}
-
-/// A record of the configuration with energies (statics: no kinetic energy,
-/// no momenta; the potential is that of the dead forces, `−Σ f·u`; moments,
-/// which are not conservative in 3D, are left out of it).
-fn record(
-    mech: &Mechanism,
-    state: &MechanismState,
-    fext: &[f64],
-    time: f64,
-    dt: f64,
-    report: &newton::NewtonReport,
-) -> StepRecord {
-    let config = &state.config;
-    let strain = strain_energy(mech, config);
-    let potential: f64 = -(0..config.x.len())
-        .map(|n| {
-            let u: Vector3<f64> = config.x[n] - mech.mesh.positions[n];
-            u.dot(&Vector3::new(fext[6 * n], fext[6 * n + 1], fext[6 * n + 2]))
-        })
-        .sum::<f64>();
-    StepRecord {
-        time,
-        dt,
-        iterations: report.iterations,
-        factorizations: report.factorizations,
-        residual: report.residual,
-        residual_history: report.history.clone(),
-        beta: f64::NAN,
-        energy: Energies {
-            kinetic: 0.0,
-            strain,
-            potential,
-            total: strain + potential,
-            driver_work: 0.0,
-        },
-        negative_pivots: None,
-        momentum_linear: [0.0; 3],
-        momentum_angular: [0.0; 3],
-        positions: config.x.iter().map(|x| [x.x, x.y, x.z]).collect(),
-        quaternions: (0..config.x.len())
-            .map(|i| {
-                let q = config.quaternion(i);
-                [q.x, q.y, q.z, q.w]
-            })
-            .collect(),
-        joints: joint_records(mech, state),
     }
 }
 
@@ -185,21 +92,11 @@ pub fn solve_static(
     let asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
     let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
     let mut inertia = InertiaCount::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
-    let nodes = mech.mesh.node_count();
-    let mut prob = StaticProblem {
-        mech,
-        topo,
-        asm,
-        state,
-        fext: vec![0.0; 6 * nodes],
-        nodal_r: vec![0.0; 6 * nodes],
-        scratch: vec![0.0; n],
-        floor: mech.round_off_floor(),
-    };
+    let mut prob = ReducedSystem::new(mech, topo, asm, state, StaticTerms);
     let (mut r, mut dq) = (vec![0.0; n], vec![0.0; n]);
     let nominal = 1.0 / settings.load_steps as f64;
     let mut control = StepControl::with(nominal, settings.max_halvings, GROW_AFTER);
-    let mut guard = RotationGuard::new(mech, &prob.state);
+    let mut guard = RotationGuard::new(mech, &prob.end);
     let (mut lambda, mut steps) = (0.0f64, 0usize);
     // Kinematically driven mechanisms start each step from the secant
     // prediction, which carries the rigid motion downstream of a driven joint;
@@ -219,36 +116,35 @@ pub fn solve_static(
         let next_planned = ((lambda / nominal + 1e-9).floor() + 1.0) * nominal;
         let target = (lambda + control.step()).min(next_planned);
         let target = if target > 1.0 - 1e-12 { 1.0 } else { target };
-        let saved = prob.state.clone();
-        prob.floor = mech.round_off_floor_at(&prob.state.config.x);
+        prob.start.clone_from(&prob.end);
+        prob.floor = mech.round_off_floor_at(&prob.end.config.x);
         if let (true, Some((before, before_step))) = (driven, &previous) {
-            prob.topo.extrapolate(
-                mech,
-                &mut prob.state,
-                before,
-                (target - lambda) / before_step,
-            );
+            prob.topo
+                .extrapolate(mech, &mut prob.end, before, (target - lambda) / before_step);
         }
-        prob.topo.impose(mech, &mut prob.state, target);
+        prob.topo.impose(mech, &mut prob.end, target);
         mech.external_forces(target, &mut prob.fext);
         match newton::solve(&mut prob, &mut lu, &settings.newton, &mut r, &mut dq) {
             Ok(report) => {
-                if let Err(objection) = guard.accept(mech, &prob.state, target) {
-                    prob.state = saved;
+                if let Err(objection) = guard.accept(mech, &prob.end, target) {
+                    prob.end.clone_from(&prob.start);
                     control.failed(target, as_step_failure(objection)?)?;
                     continue;
                 }
                 let dt = target - lambda;
-                previous = Some((saved, dt));
+                previous = Some((prob.start.clone(), dt));
                 lambda = target;
                 steps += 1;
-                let mut step = record(mech, &prob.state, &prob.fext, lambda, dt, &report);
+                let mut step =
+                    static_record(mech, &prob.end, &prob.fext, lambda, dt, Some(&report));
+                // The stability count is of the converged iterate's tangent.
+                prob.update_tangent(&mut r);
                 step.negative_pivots = inertia.negative_eigenvalues(&prob.asm.values);
                 on_step(&step);
                 control.succeeded();
             }
             Err(reason) => {
-                prob.state = saved;
+                prob.end.clone_from(&prob.start);
                 if let NewtonFailure::LinearSolve(msg) = &reason {
                     if lambda == 0.0 && control.level() == 0 {
                         // A singular tangent at the undeformed state will not be
@@ -264,8 +160,8 @@ pub fn solve_static(
         }
     }
     Ok(StaticOutcome {
-        config: prob.state.config.clone(),
-        state: prob.state,
+        config: prob.end.config.clone(),
+        state: prob.end,
         steps,
     })
 }

@@ -27,13 +27,10 @@
 //! reaction's moment is taken about the mid-step positions, as the beams'
 //! internal forces are: linear *and* angular momentum are conserved exactly.
 
-use crate::kinematics::{
-    Increments, JointKinematics, JointMap, ReleasedState, LOCAL, MAX_RELEASED,
-};
+use crate::kinematics::{released_at, JointKinematics, ReleasedState, LOCAL, MAX_RELEASED};
 use flexmech_core::rotation::{cayley_inverse, exp, skew};
 use flexmech_core::{cst, Scalar};
-use nalgebra::{Const, Matrix3, SMatrix, SVector, Vector3, Vector6, U1};
-use num_dual::HyperDualSVec64;
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector6};
 
 /// A node's pose: position and rotation.
 pub type NodePose<'a> = (&'a Vector3<f64>, &'a Matrix3<f64>);
@@ -51,18 +48,6 @@ pub struct JointStep<T: Scalar = f64> {
     pub a: Matrix3<T>,
     /// `B`: released increments `τ` → `(u_R, θ_R)`.
     pub b: SMatrix<T, 6, MAX_RELEASED>,
-}
-
-impl JointStep<f64> {
-    /// `Ñ` of joint `map` for the master's poses at both ends of the step and
-    /// the released states at both ends.
-    pub fn new(
-        map: &dyn JointMap,
-        master: [NodePose<'_>; 2],
-        released: [&ReleasedState; 2],
-    ) -> Self {
-        map.incremental_step(master, released)
-    }
 }
 
 impl<T: Scalar> JointStep<T> {
@@ -140,81 +125,4 @@ impl<T: Scalar> JointStep<T> {
             .copy_from(&(self.b.transpose() * h));
         out
     }
-}
-
-/// Below this size a coordinate increment's column of `B` comes from a
-/// second-order Taylor expansion instead of the difference quotient: the
-/// quotient's cancellation error is then ≤ eps/1e-6 ≈ 2e-10 relative, and the
-/// expansion's `f‴τ³/6` misses the increment by < 2e-19·f‴, below round-off.
-const TAYLOR_BELOW: f64 = 1e-6;
-
-/// `B` for kinds with additive coordinates (the default of
-/// [`JointKinematics::step_map`]): along the path that changes one coordinate
-/// after the other, `F(q) = (r_R(q) − r_R(qₙ), cay⁻¹(Λ_R(q) Λ_R(qₙ)ᵀ))`,
-/// column `k` is the divided difference `(F(Pₖ) − F(Pₖ₋₁))/τₖ` with
-/// `τₖ = qₖ,ₙ₊₁ − qₖ,ₙ` (the end state is `end ⊕ inc`). The columns
-/// telescope, so `B τ = F(qₙ₊₁)` exactly; increments below `1e-6` use
-/// `F′(Pₖ₋₁) + ½F″(Pₖ₋₁)τₖ` (hyper-dual numbers) so the column stays accurate
-/// as `τₖ → 0` and tends to `N`'s column. The Taylor column follows `τₖ`
-/// exactly under automatic differentiation; for `k ≥ 1` its dependence on the
-/// earlier coordinates' end values (through `Pₖ₋₁`) is not followed.
-pub fn additive_step_map<J: JointKinematics + ?Sized, T: Scalar>(
-    joint: &J,
-    start: &ReleasedState,
-    end: &ReleasedState,
-    inc: &[T; MAX_RELEASED],
-) -> SMatrix<T, 6, MAX_RELEASED> {
-    type H = HyperDualSVec64<1, 1>;
-    let (r_n, l_n) = released_at(joint, start, &[0.0; MAX_RELEASED]);
-    let tau: [T; MAX_RELEASED] = std::array::from_fn(|k| cst::<T>(end.q[k] - start.q[k]) + inc[k]);
-    // F at the path point with the first `upto` coordinates at their end values.
-    let f = |upto: usize| -> Vector6<T> {
-        let d: [T; MAX_RELEASED] =
-            std::array::from_fn(|i| if i < upto { tau[i] } else { T::zero() });
-        let (r, l) = released_at(joint, start, &d);
-        stack(
-            &(r - r_n.map(cst::<T>)),
-            &cayley_inverse(&(l * l_n.map(cst::<T>).transpose())),
-        )
-    };
-    let mut b = SMatrix::<T, 6, MAX_RELEASED>::zeros();
-    for k in 0..J::RELEASED {
-        let column: Vector6<T> = if tau[k].value().abs() >= TAYLOR_BELOW {
-            (f(k + 1) - f(k)) / tau[k]
-        } else {
-            let mut d = [H::from_re(0.0); MAX_RELEASED];
-            for (i, di) in d.iter_mut().enumerate().take(k) {
-                *di = H::from_re(tau[i].value());
-            }
-            d[k] = H::from_re(0.0).derivative1(0).derivative2(0);
-            let (r, l) = released_at(joint, start, &d);
-            let dr = r - r_n.map(H::from_re);
-            let th = cayley_inverse(&(l * l_n.map(H::from_re).transpose()));
-            let d1 = |v: H| v.eps1.unwrap_generic(Const::<1>, U1)[0];
-            let d2 = |v: H| v.eps1eps2.unwrap_generic(Const::<1>, Const::<1>)[0];
-            let taylor = |v: H| cst::<T>(d1(v)) + tau[k] * cst::<T>(0.5 * d2(v));
-            stack(&dr.map(taylor), &th.map(taylor))
-        };
-        b.set_column(k, &column);
-    }
-    b
-}
-
-fn released_at<J: JointKinematics + ?Sized, T: Scalar>(
-    joint: &J,
-    state: &ReleasedState,
-    first: &[T; MAX_RELEASED],
-) -> (Vector3<T>, Matrix3<T>) {
-    let zero = [T::zero(); MAX_RELEASED];
-    joint.released(
-        state,
-        Increments {
-            first,
-            second: &zero,
-        },
-    )
-}
-
-fn stack<T: Scalar>(a: &Vector3<T>, b: &Vector3<T>) -> Vector6<T> {
-    Vector6::new(a.x, a.y, a.z, b.x, b.y, b.z)
 }

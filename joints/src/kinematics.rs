@@ -18,11 +18,10 @@
 //! variational map `N` of paper eqs 5–6 (`p_s = N p_Rm`) and the derivative of
 //! `Nᵀ g` that Newton's tangent needs. No kind writes a derivative by hand.
 
-use crate::incremental::{JointStep, NodePose};
-use flexmech_core::rotation::{exp, skew};
+use flexmech_core::rotation::{cayley_inverse, exp, skew};
 use flexmech_core::{cst, Scalar};
-use nalgebra::{Const, Matrix3, SMatrix, SVector, Vector3, Vector6, U1};
-use num_dual::{DualSVec64, HyperDualSVec64};
+use nalgebra::{Const, Matrix3, SMatrix, Vector3, Vector6, U1};
+use num_dual::HyperDualSVec64;
 use std::fmt::Debug;
 
 /// Largest number of released coordinates of a joint (cylindrical: 2,
@@ -102,7 +101,7 @@ pub trait JointKinematics: Send + Sync + Debug {
     /// coordinates' increments `τ`: `(u_R, θ_R) = B τ` exactly, with
     /// `u_R = r_R,ₙ₊₁ − r_R,ₙ` and `θ_R = cay⁻¹(Λ_R,ₙ₊₁ Λ_R,ₙᵀ)` (paper eq. 22;
     /// see [`crate::incremental`]). The default, for additive coordinates
-    /// (`τ = qₙ₊₁ − qₙ`), is [`crate::incremental::additive_step_map`]; a kind
+    /// (`τ = qₙ₊₁ − qₙ`), is [`additive_step_map`]; a kind
     /// with a multiplicative rotation overrides it. The end state is
     /// `end ⊕ inc` (`inc` as in [`JointKinematics::released`]), so that
     /// automatic differentiation can follow `B` as the end state moves.
@@ -112,7 +111,7 @@ pub trait JointKinematics: Send + Sync + Debug {
         end: &ReleasedState,
         inc: &[T; MAX_RELEASED],
     ) -> SMatrix<T, 6, MAX_RELEASED> {
-        crate::incremental::additive_step_map(self, start, end, inc)
+        additive_step_map(self, start, end, inc)
     }
 
     /// The released rotation angle reported as `/joints/<name>/angle`.
@@ -125,237 +124,6 @@ pub trait JointKinematics: Send + Sync + Debug {
     }
 }
 
-/// The joint operations the solvers use: object-safe, blanket-implemented for
-/// every [`JointKinematics`] by automatic differentiation.
-pub trait JointMap: Send + Sync + Debug {
-    /// Number of released coordinates.
-    fn released_count(&self) -> usize;
-    /// Names of the released coordinates.
-    fn coordinate_names(&self) -> &'static [&'static str];
-    /// `(r_R, Λ_R)` of a state.
-    fn released_placement(&self, state: &ReleasedState) -> (Vector3<f64>, Matrix3<f64>);
-    /// Slave position and rotation from the master's, relation (1) — exact.
-    fn slave(
-        &self,
-        x_m: &Vector3<f64>,
-        r_m: &Matrix3<f64>,
-        state: &ReleasedState,
-    ) -> (Vector3<f64>, Matrix3<f64>);
-    /// The variational map `N` (6 × (6 + released), paper eqs 5–6): slave
-    /// increment `(δx_s, δφ_s)` from master `(δx_m, δφ_m)` and released `δq`.
-    /// Columns past `6 + released` are zero.
-    fn variation(
-        &self,
-        x_m: &Vector3<f64>,
-        r_m: &Matrix3<f64>,
-        state: &ReleasedState,
-    ) -> SMatrix<f64, 6, LOCAL>;
-    /// `Nᵀ g` for the slave's nodal residual `g`, and its derivative with
-    /// respect to the local increments at fixed `g` (the configuration-dependent
-    /// part of the reduced tangent, paper §2: "the linearisation must include
-    /// the derivative of N").
-    fn transfer(
-        &self,
-        x_m: &Vector3<f64>,
-        r_m: &Matrix3<f64>,
-        state: &ReleasedState,
-        g: &Vector6<f64>,
-    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>);
-    /// The incremental map `Ñ` over a step (paper eqs 21–23, [`JointStep`]),
-    /// for the master's poses and the released states at both ends.
-    fn incremental_step(
-        &self,
-        master: [NodePose<'_>; 2],
-        released: [&ReleasedState; 2],
-    ) -> JointStep;
-
-    /// `Ñᵀ g` for a slave residual `g` held fixed, and its exact derivative
-    /// with respect to the local increments of the step's end state —
-    /// the master's end pose (`x ← x + δx`, `R ← exp(δφ̂)R`) and the released
-    /// coordinates — by forward-mode AD through `Ñ` (the conserving schemes'
-    /// Newton tangent; unused released columns are zero).
-    fn incremental_transfer(
-        &self,
-        master: [NodePose<'_>; 2],
-        released: [&ReleasedState; 2],
-        g: &Vector6<f64>,
-    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>);
-
-    /// `B` with `(u_R, θ_R) = B τ` over a step (see [`JointKinematics::step_map`]).
-    fn step_map(&self, start: &ReleasedState, end: &ReleasedState)
-        -> SMatrix<f64, 6, MAX_RELEASED>;
-    /// Advances the released state by `delta` (length `released_count`).
-    fn advance(&self, state: &mut ReleasedState, delta: &[f64]);
-    /// The angle reported in results.
-    fn reported_angle(&self, state: &ReleasedState) -> f64;
-}
-
-/// Slave increment `(Δx, spin)` for the local increment `e` applied after `h`,
-/// relative to the pose after `h` alone. The spin is the axial vector of the
-/// skew part of `R_s(e,h) R_s(0,h)ᵀ`, exact to first order in `e` — all that
-/// the first derivative in `e` (and mixed derivatives in `e`, `h`) need.
-fn slave_increment<J: JointKinematics, T: Scalar>(
-    joint: &J,
-    x_m: &Vector3<f64>,
-    r_m: &Matrix3<f64>,
-    state: &ReleasedState,
-    e: &[T; LOCAL],
-    h: &[T; LOCAL],
-) -> (Vector3<T>, Vector3<T>) {
-    let zero = [T::zero(); LOCAL];
-    let pose = |a: &[T; LOCAL], b: &[T; LOCAL]| {
-        let xm = x_m.map(cst::<T>) + Vector3::new(a[0] + b[0], a[1] + b[1], a[2] + b[2]);
-        let rm = exp(&Vector3::new(a[3], a[4], a[5]))
-            * exp(&Vector3::new(b[3], b[4], b[5]))
-            * r_m.map(cst::<T>);
-        let (rr, lr) = joint.released(
-            state,
-            Increments {
-                first: &a[6..],
-                second: &b[6..],
-            },
-        );
-        (xm + rm * rr, rm * lr)
-    };
-    let (x1, r1) = pose(e, h);
-    let (x0, r0) = pose(&zero, h);
-    let a = r1 * r0.transpose();
-    let half = cst::<T>(0.5);
-    let spin = Vector3::new(
-        (a[(2, 1)] - a[(1, 2)]) * half,
-        (a[(0, 2)] - a[(2, 0)]) * half,
-        (a[(1, 0)] - a[(0, 1)]) * half,
-    );
-    (x1 - x0, spin)
-}
-
-impl<J: JointKinematics> JointMap for J {
-    fn released_count(&self) -> usize {
-        J::RELEASED
-    }
-
-    fn coordinate_names(&self) -> &'static [&'static str] {
-        JointKinematics::coordinate_names(self)
-    }
-
-    fn released_placement(&self, state: &ReleasedState) -> (Vector3<f64>, Matrix3<f64>) {
-        let z = [0.0; MAX_RELEASED];
-        self.released(
-            state,
-            Increments {
-                first: &z,
-                second: &z,
-            },
-        )
-    }
-
-    fn slave(
-        &self,
-        x_m: &Vector3<f64>,
-        r_m: &Matrix3<f64>,
-        state: &ReleasedState,
-    ) -> (Vector3<f64>, Matrix3<f64>) {
-        let (rr, lr) = self.released_placement(state);
-        (x_m + r_m * rr, r_m * lr)
-    }
-
-    fn variation(
-        &self,
-        x_m: &Vector3<f64>,
-        r_m: &Matrix3<f64>,
-        state: &ReleasedState,
-    ) -> SMatrix<f64, 6, LOCAL> {
-        type D = DualSVec64<LOCAL>;
-        let e: [D; LOCAL] = std::array::from_fn(|i| D::from_re(0.0).derivative(i));
-        let h = [D::from_re(0.0); LOCAL];
-        let (dx, spin) = slave_increment(self, x_m, r_m, state, &e, &h);
-        let mut n = SMatrix::<f64, 6, LOCAL>::zeros();
-        for r in 0..3 {
-            n.set_row(r, &dx[r].eps.unwrap_generic(Const::<LOCAL>, U1).transpose());
-            n.set_row(
-                3 + r,
-                &spin[r].eps.unwrap_generic(Const::<LOCAL>, U1).transpose(),
-            );
-        }
-        for c in 6 + J::RELEASED..LOCAL {
-            n.column_mut(c).fill(0.0);
-        }
-        n
-    }
-
-    fn transfer(
-        &self,
-        x_m: &Vector3<f64>,
-        r_m: &Matrix3<f64>,
-        state: &ReleasedState,
-        g: &Vector6<f64>,
-    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>) {
-        type H = HyperDualSVec64<LOCAL, LOCAL>;
-        let e: [H; LOCAL] = std::array::from_fn(|i| H::from_re(0.0).derivative1(i));
-        let h: [H; LOCAL] = std::array::from_fn(|i| H::from_re(0.0).derivative2(i));
-        let (dx, spin) = slave_increment(self, x_m, r_m, state, &e, &h);
-        let gh = g.map(H::from_re);
-        let w = dx.dot(&gh.fixed_rows::<3>(0)) + spin.dot(&gh.fixed_rows::<3>(3));
-        let mut ntg = w.eps1.unwrap_generic(Const::<LOCAL>, U1);
-        let mut k = w.eps1eps2.unwrap_generic(Const::<LOCAL>, Const::<LOCAL>);
-        for c in 6 + J::RELEASED..LOCAL {
-            ntg[c] = 0.0;
-            k.row_mut(c).fill(0.0);
-            k.column_mut(c).fill(0.0);
-        }
-        (ntg, k)
-    }
-
-    fn incremental_step(
-        &self,
-        master: [NodePose<'_>; 2],
-        released: [&ReleasedState; 2],
-    ) -> JointStep {
-        JointStep::of(self, master, released, &[0.0; 6], &[0.0; MAX_RELEASED])
-    }
-
-    fn incremental_transfer(
-        &self,
-        master: [NodePose<'_>; 2],
-        released: [&ReleasedState; 2],
-        g: &Vector6<f64>,
-    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>) {
-        type D = DualSVec64<LOCAL>;
-        let e: [D; LOCAL] = std::array::from_fn(|i| D::from_re(0.0).derivative(i));
-        let seed: [D; 6] = std::array::from_fn(|i| e[i]);
-        let inc: [D; MAX_RELEASED] = std::array::from_fn(|i| e[6 + i]);
-        let step = JointStep::of(self, master, released, &seed, &inc);
-        let t = step.transfer(&g.map(D::from_re));
-        let mut value = t.map(|v| v.re);
-        let mut k = SMatrix::<f64, LOCAL, LOCAL>::zeros();
-        for r in 0..LOCAL {
-            k.set_row(r, &t[r].eps.unwrap_generic(Const::<LOCAL>, U1).transpose());
-        }
-        for c in 6 + J::RELEASED..LOCAL {
-            value[c] = 0.0;
-            k.row_mut(c).fill(0.0);
-            k.column_mut(c).fill(0.0);
-        }
-        (value, k)
-    }
-
-    fn step_map(
-        &self,
-        start: &ReleasedState,
-        end: &ReleasedState,
-    ) -> SMatrix<f64, 6, MAX_RELEASED> {
-        JointKinematics::step_map(self, start, end, &[0.0; MAX_RELEASED])
-    }
-
-    fn advance(&self, state: &mut ReleasedState, delta: &[f64]) {
-        JointKinematics::advance(self, state, delta)
-    }
-
-    fn reported_angle(&self, state: &ReleasedState) -> f64 {
-        JointKinematics::reported_angle(self, state)
-    }
-}
-
 /// `exp(φ t̂)` for a unit axis `t` and an angle `φ` (one-axis released rotation).
 pub fn axis_rotation<T: Scalar>(axis: &Vector3<f64>, angle: T) -> Matrix3<T> {
     exp(&(axis.map(cst::<T>) * angle))
@@ -364,4 +132,81 @@ pub fn axis_rotation<T: Scalar>(axis: &Vector3<f64>, angle: T) -> Matrix3<T> {
 /// `â` for an `f64` vector (re-exported for the joint kinds' closed forms).
 pub fn hat(a: &Vector3<f64>) -> Matrix3<f64> {
     skew(a)
+}
+
+/// Below this size a coordinate increment's column of `B` comes from a
+/// second-order Taylor expansion instead of the difference quotient: the
+/// quotient's cancellation error is then ≤ eps/1e-6 ≈ 2e-10 relative, and the
+/// expansion's `f‴τ³/6` misses the increment by < 2e-19·f‴, below round-off.
+const TAYLOR_BELOW: f64 = 1e-6;
+
+/// `B` for kinds with additive coordinates (the default of
+/// [`JointKinematics::step_map`]): along the path that changes one coordinate
+/// after the other, `F(q) = (r_R(q) − r_R(qₙ), cay⁻¹(Λ_R(q) Λ_R(qₙ)ᵀ))`,
+/// column `k` is the divided difference `(F(Pₖ) − F(Pₖ₋₁))/τₖ` with
+/// `τₖ = qₖ,ₙ₊₁ − qₖ,ₙ` (the end state is `end ⊕ inc`). The columns
+/// telescope, so `B τ = F(qₙ₊₁)` exactly; increments below `1e-6` use
+/// `F′(Pₖ₋₁) + ½F″(Pₖ₋₁)τₖ` (hyper-dual numbers) so the column stays accurate
+/// as `τₖ → 0` and tends to `N`'s column. The Taylor column follows `τₖ`
+/// exactly under automatic differentiation; for `k ≥ 1` its dependence on the
+/// earlier coordinates' end values (through `Pₖ₋₁`) is not followed.
+pub fn additive_step_map<J: JointKinematics + ?Sized, T: Scalar>(
+    joint: &J,
+    start: &ReleasedState,
+    end: &ReleasedState,
+    inc: &[T; MAX_RELEASED],
+) -> SMatrix<T, 6, MAX_RELEASED> {
+    type H = HyperDualSVec64<1, 1>;
+    let (r_n, l_n) = released_at(joint, start, &[0.0; MAX_RELEASED]);
+    let tau: [T; MAX_RELEASED] = std::array::from_fn(|k| cst::<T>(end.q[k] - start.q[k]) + inc[k]);
+    // F at the path point with the first `upto` coordinates at their end values.
+    let f = |upto: usize| -> Vector6<T> {
+        let d: [T; MAX_RELEASED] =
+            std::array::from_fn(|i| if i < upto { tau[i] } else { T::zero() });
+        let (r, l) = released_at(joint, start, &d);
+        stack(
+            &(r - r_n.map(cst::<T>)),
+            &cayley_inverse(&(l * l_n.map(cst::<T>).transpose())),
+        )
+    };
+    let mut b = SMatrix::<T, 6, MAX_RELEASED>::zeros();
+    for k in 0..J::RELEASED {
+        let column: Vector6<T> = if tau[k].value().abs() >= TAYLOR_BELOW {
+            (f(k + 1) - f(k)) / tau[k]
+        } else {
+            let mut d = [H::from_re(0.0); MAX_RELEASED];
+            for (i, di) in d.iter_mut().enumerate().take(k) {
+                *di = H::from_re(tau[i].value());
+            }
+            d[k] = H::from_re(0.0).derivative1(0).derivative2(0);
+            let (r, l) = released_at(joint, start, &d);
+            let dr = r - r_n.map(H::from_re);
+            let th = cayley_inverse(&(l * l_n.map(H::from_re).transpose()));
+            let d1 = |v: H| v.eps1.unwrap_generic(Const::<1>, U1)[0];
+            let d2 = |v: H| v.eps1eps2.unwrap_generic(Const::<1>, Const::<1>)[0];
+            let taylor = |v: H| cst::<T>(d1(v)) + tau[k] * cst::<T>(0.5 * d2(v));
+            stack(&dr.map(taylor), &th.map(taylor))
+        };
+        b.set_column(k, &column);
+    }
+    b
+}
+
+pub(crate) fn released_at<J: JointKinematics + ?Sized, T: Scalar>(
+    joint: &J,
+    state: &ReleasedState,
+    first: &[T; MAX_RELEASED],
+) -> (Vector3<T>, Matrix3<T>) {
+    let zero = [T::zero(); MAX_RELEASED];
+    joint.released(
+        state,
+        Increments {
+            first,
+            second: &zero,
+        },
+    )
+}
+
+fn stack<T: Scalar>(a: &Vector3<T>, b: &Vector3<T>) -> Vector6<T> {
+    Vector6::new(a.x, a.y, a.z, b.x, b.y, b.z)
 }

@@ -12,7 +12,8 @@
 //! `Δt → 0`. The record's `beta` carries the relative size of the
 //! discrete gradient's rank-one corrections, `O(Δt²)`.
 
-use super::{midpoint, DynamicSettings, Motion, Scheme};
+use super::simulation::{self, Integrator};
+use super::{DynamicSettings, Motion};
 use crate::error::SolveError;
 use crate::mechanism::Mechanism;
 use crate::record::StepRecord;
@@ -25,5 +26,5 @@ pub fn solve(
     initial: &Motion,
     on_step: impl FnMut(&StepRecord),
 ) -> Result<Configuration, SolveError> {
-    midpoint::solve(mech, settings, initial, Scheme::EnergyMomentum, on_step)
+    simulation::solve(mech, Integrator::EnergyMomentum, settings, initial, on_step)
 }

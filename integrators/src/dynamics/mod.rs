@@ -1,6 +1,7 @@
 //! Time integration (FORMULATION §4). Every scheme solves, per step, for the
-//! configuration at `tₙ₊₁` by Newton with the exact tangent (AD through the
-//! generic kernels), halves the step on failure, and reports a
+//! configuration at `tₙ₊₁` by Newton with the exact tangent on the shared
+//! reduced system ([`crate::system`]); one driver ([`simulation`]) predicts,
+//! halves the step on failure, and reports a
 //! [`StepRecord`](crate::record::StepRecord) per converged step.
 //!
 //! * [`newmark`]: the trapezoidal rule on SO(3) (Simo & Vu-Quoc).
@@ -14,15 +15,21 @@
 //!   algebraic mid rotation and the scalar correction `β q_k(N_d, 0)`, kept
 //!   to reproduce the paper.
 
+mod bordered;
 pub mod energy_momentum;
 pub mod energy_momentum_paper;
 mod mass_slots;
 pub mod midpoint;
+pub mod midpoint_kernels;
 pub mod momentum;
 pub mod newmark;
+mod newmark_terms;
+pub mod simulation;
+mod time_scheme;
+
+pub use simulation::{Integrator, Simulation};
 
 use crate::constraints::{MechanismState, Topology};
-pub(crate) use crate::step_control::StepControl;
 
 /// Easy time steps in a row before a halved step doubles again.
 pub(crate) const GROW_AFTER: usize = 4;

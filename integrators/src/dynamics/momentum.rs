@@ -6,7 +6,8 @@
 //! Newton tolerance; energy is not conserved exactly (it is in the
 //! energy–momentum scheme).
 
-use super::{midpoint, DynamicSettings, Motion, Scheme};
+use super::simulation::{self, Integrator};
+use super::{DynamicSettings, Motion};
 use crate::error::SolveError;
 use crate::mechanism::Mechanism;
 use crate::record::StepRecord;
@@ -19,5 +20,5 @@ pub fn solve(
     initial: &Motion,
     on_step: impl FnMut(&StepRecord),
 ) -> Result<Configuration, SolveError> {
-    midpoint::solve(mech, settings, initial, Scheme::Momentum, on_step)
+    simulation::solve(mech, Integrator::Momentum, settings, initial, on_step)
 }

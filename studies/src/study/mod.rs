@@ -95,6 +95,7 @@ use std::path::{Path, PathBuf};
 pub mod charts;
 pub mod execute;
 pub mod figures;
+pub mod key_path;
 pub mod merge;
 pub mod shard;
 pub mod spec;

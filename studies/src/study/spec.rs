@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use toml::{Table, Value};
 
-use super::sweep::{base_dir, check_key, KeyPath};
+use super::key_path::{base_dir, check_key, KeyPath};
 use crate::model::{load_model, ModelError};
 
 /// A per-run scalar of the summary table (see the module docs of

@@ -1,0 +1,200 @@
+//! Newton on `(q, β)` for the paper's energy–momentum scheme
+//! ([`super::energy_momentum_paper`], eq. 18): the bordered tangent
+//! `[K b; cᵀ d]`, `b = ∂g/∂β`, `c = ∂e/∂q`, `d = ∂e/∂β`, solved by two
+//! solves with one factorisation, so that Newton stays quadratic.
+
+use super::midpoint_kernels::{midpoint_forces, seeded_poses, Dual12};
+use crate::error::NewtonFailure;
+use crate::linsolve::SparseLu;
+use crate::newton::{
+    at_floor, check_regular, diverged, NewtonReport, NewtonSettings, NewtonSystem,
+};
+use crate::system::{ReducedSystem, StepTerms};
+use flexmech_core::conserving::MidRotation;
+use flexmech_core::rotation::cayley_inverse;
+use flexmech_core::{Configuration, Element};
+use nalgebra::{Const, SVector, U1};
+use rayon::prelude::*;
+
+/// Terms whose element force carries the correction `β q_k(N_d, 0)`.
+pub(crate) trait Bordered: StepTerms {
+    /// Sets the correction's factor β for the next evaluation.
+    fn set_beta(&mut self, beta: f64);
+}
+
+/// Per element: the energy residual `e = p·q_k(N̄, M̄) − ΔΠ`, the correction's
+/// work `c = p·q_k(N_d, 0)` and `q_k(N_d, 0)` itself, with the gradients of
+/// `e` and `c` with respect to spatial increments of the end pose (AD).
+struct EnergyTerms {
+    e: f64,
+    de: SVector<f64, 12>,
+    c: f64,
+    dc: SVector<f64, 12>,
+    qd: SVector<f64, 12>,
+}
+
+fn energy_terms(el: &Element, start: &Configuration, end: &Configuration) -> EnergyTerms {
+    let Element::Linear(e) = el else {
+        unreachable!("the midpoint schemes are checked to run on 2-node elements")
+    };
+    type D = Dual12;
+    let (s, sd, ed) = seeded_poses(e, start, end);
+    let (qk, qd) = midpoint_forces(e, &s, &sd, &ed, MidRotation::Algebraic, true);
+    let qd = qd.expect("the correction was asked for");
+    // The step's increments: uᵢ and the tangent-scaled θᵢ with Rₙ₊₁ = cay(θᵢ)Rₙ.
+    let mut work_k = D::from_re(0.0);
+    let mut work_d = D::from_re(0.0);
+    for i in 0..2 {
+        let u = ed.0[i] - sd.0[i];
+        let th = cayley_inverse(&(ed.1[i] * sd.1[i].transpose()));
+        work_k += u.dot(&qk.fixed_rows::<3>(6 * i)) + th.dot(&qk.fixed_rows::<3>(6 * i + 3));
+        work_d += u.dot(&qd.fixed_rows::<3>(6 * i)) + th.dot(&qd.fixed_rows::<3>(6 * i + 3));
+    }
+    let de_pi = e.energy(&ed.0, &ed.1) - D::from_re(e.energy(&s.0, &s.1));
+    let ee = work_k - de_pi;
+    EnergyTerms {
+        e: ee.re,
+        de: ee.eps.unwrap_generic(Const::<12>, U1),
+        c: work_d.re,
+        dc: work_d.eps.unwrap_generic(Const::<12>, U1),
+        qd: qd.map(|x| x.re),
+    }
+}
+
+/// Newton on `(q, β)` with the bordered tangent. Returns the report and β
+/// (NaN when the correction had no effect on the energy).
+pub(super) fn solve_step<T: Bordered>(
+    sys: &mut ReducedSystem<'_, T>,
+    lu: &mut SparseLu,
+    settings: &NewtonSettings,
+) -> Result<(NewtonReport, f64), NewtonFailure> {
+    let n_eq = sys.topo.dofs.n_eq;
+    let nodes = sys.end.config.x.len();
+    let (mut r, mut b, mut ge, mut gc) = (
+        vec![0.0; n_eq],
+        vec![0.0; n_eq],
+        vec![0.0; n_eq],
+        vec![0.0; n_eq],
+    );
+    let (mut y1, mut y2) = (vec![0.0; n_eq], vec![0.0; n_eq]);
+    let mut history = Vec::with_capacity(settings.max_iterations + 1);
+    let mut beta = 0.0;
+    let mut determined = true;
+    let mut previous_norm = f64::INFINITY;
+    for it in 0..=settings.max_iterations {
+        sys.terms.set_beta(beta);
+        let scale = sys.evaluate(&mut r);
+        // Energy equation and its border, element by element (in order: deterministic).
+        let (mut e_tot, mut c_tot, mut e_scale) = (0.0, 0.0, 0.0);
+        let mut nodal = [
+            vec![0.0; 6 * nodes],
+            vec![0.0; 6 * nodes],
+            vec![0.0; 6 * nodes],
+        ];
+        // Element terms in parallel, summed in element order (deterministic).
+        let (start, end) = (&sys.start.config, &sys.end.config);
+        let terms: Vec<EnergyTerms> = sys
+            .mech
+            .mesh
+            .elements
+            .par_iter()
+            .map(|el| energy_terms(el, start, end))
+            .collect();
+        for (el, t) in sys.mech.mesh.elements.iter().zip(&terms) {
+            e_tot += t.e;
+            c_tot += t.c;
+            e_scale += t.e.abs() + t.c.abs();
+            for (a, &nd) in el.nodes().iter().enumerate() {
+                for d in 0..6 {
+                    nodal[0][6 * nd + d] += t.qd[6 * a + d];
+                    nodal[1][6 * nd + d] += t.de[6 * a + d];
+                    nodal[2][6 * nd + d] += t.dc[6 * a + d];
+                }
+            }
+        }
+        // b = ∂(Ñᵀg)/∂β is a residual (through Ñ); the gradients of the
+        // energy terms are derivatives (through the end-point maps).
+        sys.reduce(&nodal[0], &mut b);
+        sys.topo.dofs.reduce(&nodal[1], &mut ge);
+        sys.topo.dofs.reduce(&nodal[2], &mut gc);
+        let energy = e_tot + beta * c_tot;
+        let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let res_g = if norm == 0.0 {
+            0.0
+        } else {
+            norm / scale.max(f64::MIN_POSITIVE)
+        };
+        let res_e = energy.abs() / e_scale.max(f64::MIN_POSITIVE);
+        let res = if determined { res_g.max(res_e) } else { res_g };
+        history.push(res);
+        if !res.is_finite() {
+            return Err(NewtonFailure::NotFinite { iteration: it });
+        }
+        let g_ok = res_g <= settings.tolerance || at_floor(norm, &mut previous_norm, sys.floor());
+        // The energy residual's own round-off floor: forces rounded at the
+        // system's force floor, times the size of the step's increments.
+        let increments: f64 = (0..nodes)
+            .map(|i| {
+                let (s0, s1) = (&sys.start.config, &sys.end.config);
+                let u = s1.x[i] - s0.x[i];
+                let th = cayley_inverse(&(s1.rot[i] * s0.rot[i].transpose()));
+                u.norm_squared() + th.norm_squared()
+            })
+            .sum::<f64>()
+            .sqrt();
+        let e_ok = !determined
+            || res_e <= settings.tolerance
+            || energy.abs() <= 64.0 * f64::EPSILON * e_scale + sys.floor() * increments;
+        if g_ok && e_ok {
+            check_regular(sys, lu, it > 0, true)?;
+            let beta_out = if determined { beta } else { f64::NAN };
+            return Ok((
+                NewtonReport {
+                    iterations: it,
+                    factorizations: it,
+                    residual: res,
+                    history,
+                },
+                beta_out,
+            ));
+        }
+        if let Some(failure) = diverged(it, res, &history, settings) {
+            return Err(failure);
+        }
+        if it == settings.max_iterations {
+            break;
+        }
+        lu.factor(sys.tangent_values())
+            .map_err(NewtonFailure::LinearSolve)?;
+        for (y, v) in y1.iter_mut().zip(&r) {
+            *y = -v;
+        }
+        lu.solve(&mut y1).map_err(NewtonFailure::LinearSolve)?;
+        y2.copy_from_slice(&b);
+        lu.solve(&mut y2).map_err(NewtonFailure::LinearSolve)?;
+        // Border: c = ∂e/∂q = ∇E + β∇C, d = ∂e/∂β = C.
+        let c: Vec<f64> = ge.iter().zip(&gc).map(|(a, g)| a + beta * g).collect();
+        let cy1: f64 = c.iter().zip(&y1).map(|(a, b)| a * b).sum();
+        let cy2: f64 = c.iter().zip(&y2).map(|(a, b)| a * b).sum();
+        let pivot = c_tot - cy2;
+        let size = c_tot.abs()
+            + c.iter().map(|v| v * v).sum::<f64>().sqrt()
+                * y2.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let dbeta = if pivot.abs() > 1e-10 * size && pivot.is_finite() {
+            determined = true;
+            (-energy - cy1) / pivot
+        } else {
+            // β has no lever on the energy in this step: solve without it.
+            determined = false;
+            beta = 0.0;
+            0.0
+        };
+        beta += dbeta;
+        let dq: Vec<f64> = y1.iter().zip(&y2).map(|(a, b)| a - b * dbeta).collect();
+        sys.apply(&dq);
+    }
+    Err(NewtonFailure::MaxIterations {
+        iterations: settings.max_iterations,
+        residual: *history.last().unwrap_or(&f64::NAN),
+    })
+}

@@ -1,0 +1,316 @@
+//! One driver for every time integrator: a [`Simulation`] steps a mechanism
+//! through time with the scheme's terms over the shared reduced system
+//! ([`crate::system`]) — predictor, drivers imposed, Newton, the rotation
+//! guard, step control (shared with statics), the drivers' work and the
+//! records.
+//!
+//! ```no_run
+//! # use flexmech_integrators::dynamics::{DynamicSettings, Motion};
+//! # use flexmech_integrators::dynamics::simulation::{Integrator, Simulation};
+//! # fn demo(mech: &flexmech_integrators::Mechanism, settings: &DynamicSettings)
+//! #     -> Result<(), flexmech_integrators::SolveError> {
+//! let rest = Motion::rest(mech.mesh.node_count());
+//! let mut sim = Simulation::new(mech, Integrator::EnergyMomentum, settings, &rest)?;
+//! while let Some(step) = sim.step()? {
+//!     if step.energy.kinetic > 1e3 {
+//!         break; // the user's own stopping rule
+//!     }
+//! }
+//! let (v, w) = sim.velocities();
+//! # let _ = (v, w);
+//! # Ok(()) }
+//! ```
+
+use super::midpoint::MidpointTerms;
+use super::newmark_terms::NewmarkTerms;
+use super::time_scheme::TimeScheme;
+use super::{DynamicSettings, Motion, Scheme, GROW_AFTER};
+use crate::assembly::Assembler;
+use crate::constraints::{initial_state, MechanismState, Topology};
+use crate::error::SolveError;
+use crate::linsolve::SparseLu;
+use crate::measure::dynamic_record;
+use crate::mechanism::Mechanism;
+use crate::newton::NewtonReport;
+use crate::record::StepRecord;
+use crate::rotation_guard::{as_step_failure, RotationGuard};
+use crate::step_control::StepControl;
+use crate::system::ReducedSystem;
+use flexmech_core::{Configuration, Element, Inertia};
+use nalgebra::Vector3;
+
+/// Relative distance to `t_end` below which a run has reached it.
+const END_TOLERANCE: f64 = 1e-12;
+
+/// The time integrators.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Integrator {
+    /// Newmark's trapezoidal rule on SO(3) ([`super::newmark`]).
+    Newmark,
+    /// The momentum-conserving midpoint scheme ([`super::momentum`]).
+    Momentum,
+    /// The energy–momentum scheme ([`super::energy_momentum`]).
+    EnergyMomentum,
+    /// The paper's energy–momentum scheme ([`super::energy_momentum_paper`]).
+    EnergyMomentumPaper,
+}
+
+/// A mechanism in time: its state, velocities and time, advanced one
+/// converged step at a time.
+pub struct Simulation<'m> {
+    inner: Box<dyn Stepping + 'm>,
+}
+
+impl<'m> Simulation<'m> {
+    /// Sets up `mech` with `integrator` from `initial` at t = 0 (drivers
+    /// imposed, slave velocities through `N`).
+    pub fn new(
+        mech: &'m Mechanism,
+        integrator: Integrator,
+        settings: &DynamicSettings,
+        initial: &Motion,
+    ) -> Result<Self, SolveError> {
+        if !(settings.dt > 0.0 && settings.t_end > 0.0) {
+            return Err(SolveError::InvalidMechanism(
+                "dt and t_end must be positive".into(),
+            ));
+        }
+        let scheme = match integrator {
+            Integrator::Newmark => None,
+            Integrator::Momentum => Some(Scheme::Momentum),
+            Integrator::EnergyMomentum => Some(Scheme::EnergyMomentum),
+            Integrator::EnergyMomentumPaper => Some(Scheme::EnergyMomentumPaper),
+        };
+        if scheme == Some(Scheme::EnergyMomentumPaper)
+            && mech
+                .mesh
+                .elements
+                .iter()
+                .any(|e| !matches!(e, Element::Linear(_)))
+        {
+            return Err(SolveError::InvalidMechanism(
+                "the paper's energy-momentum scheme needs 2-node elements".into(),
+            ));
+        }
+        let mut state = initial_state(mech);
+        let topo = Topology::new(mech, &state)?;
+        topo.impose(mech, &mut state, 0.0);
+        let inertia = Inertia::new(&mech.mesh, settings.mass);
+        let mut asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
+        let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
+        let inner: Box<dyn Stepping + 'm> = match scheme {
+            None => {
+                let terms =
+                    NewmarkTerms::new(mech, &topo, &mut asm, &mut lu, &state, inertia, initial);
+                let sys = ReducedSystem::new(mech, topo, asm, state, terms);
+                Box::new(Stepper::new(sys, lu, settings))
+            }
+            Some(scheme) => {
+                let terms = MidpointTerms::new(mech, &topo, &asm, &state, inertia, initial, scheme);
+                let sys = ReducedSystem::new(mech, topo, asm, state, terms);
+                Box::new(Stepper::new(sys, lu, settings))
+            }
+        };
+        Ok(Self { inner })
+    }
+
+    /// Advances one converged step (halving and retrying as step control
+    /// allows) and returns its record; `None` once `t_end` is reached.
+    pub fn step(&mut self) -> Result<Option<StepRecord>, SolveError> {
+        self.inner.step()
+    }
+
+    /// Steps to `t_end`, calling `on_step` after every converged step.
+    pub fn run(&mut self, mut on_step: impl FnMut(&StepRecord)) -> Result<(), SolveError> {
+        while let Some(record) = self.step()? {
+            on_step(&record);
+        }
+        Ok(())
+    }
+
+    /// The record of the current state (the initial one before any step).
+    pub fn record(&self) -> StepRecord {
+        self.inner.record()
+    }
+
+    /// The current time.
+    pub fn time(&self) -> f64 {
+        self.inner.time()
+    }
+
+    /// The current state: positions, rotations, joint coordinates and
+    /// prescribed values.
+    pub fn state(&self) -> &MechanismState {
+        self.inner.state()
+    }
+
+    /// The current nodal velocities: spatial translational `v` and body
+    /// angular `W` (`Ṙ = R Ŵ`).
+    pub fn velocities(&self) -> (&[Vector3<f64>], &[Vector3<f64>]) {
+        self.inner.velocities()
+    }
+}
+
+/// Runs `integrator` from `initial` to `t_end`, reporting the record at
+/// t = 0 and after every converged step; returns the final configuration.
+pub fn solve(
+    mech: &Mechanism,
+    integrator: Integrator,
+    settings: &DynamicSettings,
+    initial: &Motion,
+    mut on_step: impl FnMut(&StepRecord),
+) -> Result<Configuration, SolveError> {
+    let mut sim = Simulation::new(mech, integrator, settings, initial)?;
+    on_step(&sim.record());
+    sim.run(on_step)?;
+    Ok(sim.state().config.clone())
+}
+
+/// A [`Stepper`] of any scheme, as [`Simulation`] holds it.
+trait Stepping {
+    fn step(&mut self) -> Result<Option<StepRecord>, SolveError>;
+    fn record(&self) -> StepRecord;
+    fn time(&self) -> f64;
+    fn state(&self) -> &MechanismState;
+    fn velocities(&self) -> (&[Vector3<f64>], &[Vector3<f64>]);
+}
+
+/// The driver of one scheme `S`. Between steps `sys.end` is the current
+/// state; during a step `sys.start` holds the state it started from.
+struct Stepper<'m, S> {
+    sys: ReducedSystem<'m, S>,
+    lu: SparseLu,
+    settings: DynamicSettings,
+    control: StepControl,
+    guard: RotationGuard,
+    t: f64,
+    /// Size of the last converged step (0 before the first).
+    last_dt: f64,
+    /// The drivers' work since t = 0.
+    driver_work: f64,
+    /// Newton's scratch.
+    r: Vec<f64>,
+    dq: Vec<f64>,
+    /// External forces at the current time (for the records' potential).
+    fext_now: Vec<f64>,
+}
+
+impl<'m, S: TimeScheme> Stepper<'m, S> {
+    fn new(sys: ReducedSystem<'m, S>, lu: SparseLu, settings: &DynamicSettings) -> Self {
+        let n_eq = sys.topo.dofs.n_eq;
+        let mut fext_now = vec![0.0; sys.fext.len()];
+        sys.mech.external_forces(0.0, &mut fext_now);
+        Self {
+            guard: RotationGuard::new(sys.mech, &sys.end),
+            sys,
+            lu,
+            settings: *settings,
+            control: StepControl::with(settings.dt, settings.max_halvings, GROW_AFTER),
+            t: 0.0,
+            last_dt: 0.0,
+            driver_work: 0.0,
+            r: vec![0.0; n_eq],
+            dq: vec![0.0; n_eq],
+            fext_now,
+        }
+    }
+
+    /// The predictor of the step `t → t + dt` into `sys.end`: constant
+    /// velocities of the free nodes and constant rates of the joints'
+    /// released coordinates, then the drivers at `t + dt`.
+    fn predict(&mut self, dt: f64) {
+        let sys = &mut self.sys;
+        let mech = sys.mech;
+        sys.start.clone_from(&sys.end);
+        let (v, w) = sys.terms.velocities();
+        for i in 0..mech.mesh.node_count() {
+            if !mech.fixed[i].iter().any(|&h| h) && sys.topo.slave_of[i].is_none() {
+                let spin = sys.start.config.rot[i] * w[i] * dt;
+                sys.end.config.increment(i, &(v[i] * dt), &spin);
+            }
+        }
+        for (j, rates) in sys.terms.joint_rates().iter().enumerate() {
+            let delta: Vec<f64> = rates.iter().map(|r| r * dt).collect();
+            if delta.iter().any(|&d| d != 0.0) {
+                mech.joints[j].map.advance(&mut sys.end.released[j], &delta);
+            }
+        }
+        sys.topo.impose(mech, &mut sys.end, self.t + dt);
+    }
+
+    fn record_with(&self, report: Option<&NewtonReport>) -> StepRecord {
+        let sys = &self.sys;
+        let mut rec = dynamic_record(
+            sys.mech,
+            sys.terms.mass(),
+            &sys.end,
+            sys.terms.velocities(),
+            &self.fext_now,
+            self.t,
+            self.last_dt,
+            report,
+        );
+        rec.energy.driver_work = self.driver_work;
+        rec
+    }
+}
+
+impl<S: TimeScheme> Stepping for Stepper<'_, S> {
+    fn step(&mut self) -> Result<Option<StepRecord>, SolveError> {
+        let t_end = self.settings.t_end;
+        while self.t < t_end * (1.0 - END_TOLERANCE) {
+            let (t, dt) = (self.t, self.control.next(self.t, t_end));
+            self.sys.terms.set_step(dt);
+            self.predict(dt);
+            let sys = &mut self.sys;
+            let mech = sys.mech;
+            mech.external_forces(sys.terms.load_time(t, dt), &mut sys.fext);
+            sys.floor = mech.round_off_floor_at(&sys.start.config.x);
+            let outcome = S::solve(
+                sys,
+                &mut self.lu,
+                &self.settings.newton,
+                &mut self.r,
+                &mut self.dq,
+            );
+            let (report, beta) = match outcome {
+                Ok(done) => done,
+                Err(reason) => {
+                    sys.end.clone_from(&sys.start);
+                    self.control.failed(t + dt, reason)?;
+                    continue;
+                }
+            };
+            if let Err(objection) = self.guard.accept(mech, &sys.end, t + dt) {
+                sys.end.clone_from(&sys.start);
+                self.control.failed(t + dt, as_step_failure(objection)?)?;
+                continue;
+            }
+            self.driver_work += S::finish(sys, dt);
+            self.t = self.control.advance(t, dt);
+            self.last_dt = dt;
+            mech.external_forces(self.t, &mut self.fext_now);
+            let mut rec = self.record_with(Some(&report));
+            rec.beta = beta;
+            self.control.succeeded();
+            return Ok(Some(rec));
+        }
+        Ok(None)
+    }
+
+    fn record(&self) -> StepRecord {
+        self.record_with(None)
+    }
+
+    fn time(&self) -> f64 {
+        self.t
+    }
+
+    fn state(&self) -> &MechanismState {
+        &self.sys.end
+    }
+
+    fn velocities(&self) -> (&[Vector3<f64>], &[Vector3<f64>]) {
+        self.sys.terms.velocities()
+    }
+}

@@ -1,0 +1,52 @@
+//! What a time-integration scheme adds to the reduced system
+//! ([`StepTerms`]) to be driven step by step by
+//! [`Simulation`](super::simulation::Simulation): its step size, when it
+//! takes the loads, the velocities its predictor uses, its Newton solve and
+//! what it updates when a step is accepted.
+
+use crate::error::NewtonFailure;
+use crate::linsolve::SparseLu;
+use crate::newton::{self, NewtonReport, NewtonSettings};
+use crate::system::{ReducedSystem, StepTerms};
+use flexmech_core::Inertia;
+use nalgebra::Vector3;
+
+/// A time-integration scheme over the shared reduced system.
+pub(crate) trait TimeScheme: StepTerms + Sized {
+    /// Sets the size of the coming step.
+    fn set_step(&mut self, dt: f64);
+
+    /// The time at which the step `t → t + dt` takes its external loads.
+    fn load_time(&self, t: f64, dt: f64) -> f64;
+
+    /// Nodal velocities at the start of the coming step: spatial
+    /// translational `v` and body angular `W`.
+    fn velocities(&self) -> (&[Vector3<f64>], &[Vector3<f64>]);
+
+    /// Rates of each joint's released coordinates, for the predictor
+    /// (empty: the joints' coordinates start from their last values).
+    fn joint_rates(&self) -> &[Vec<f64>] {
+        &[]
+    }
+
+    /// The mechanism's mass.
+    fn mass(&self) -> &Inertia;
+
+    /// Solves the step from the predicted iterate `sys.end`; returns the
+    /// Newton report and the record's `beta` (NaN: none). `r` and `dq` are
+    /// scratch of length `n_eq`.
+    fn solve(
+        sys: &mut ReducedSystem<'_, Self>,
+        lu: &mut SparseLu,
+        settings: &NewtonSettings,
+        r: &mut [f64],
+        dq: &mut [f64],
+    ) -> Result<(NewtonReport, f64), NewtonFailure> {
+        newton::solve(sys, lu, settings, r, dq).map(|report| (report, f64::NAN))
+    }
+
+    /// The step `sys.start → sys.end` of size `dt` converged and was
+    /// accepted: updates the velocities (and whatever else the scheme
+    /// carries) and returns the drivers' work over the step.
+    fn finish(sys: &mut ReducedSystem<'_, Self>, dt: f64) -> f64;
+}

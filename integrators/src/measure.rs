@@ -1,0 +1,102 @@
+//! The measures of a converged step — energies and momenta of the whole
+//! mechanism — and the [`StepRecord`]s built from them, for statics and
+//! for every time integrator alike.
+
+use crate::constraints::{joint_records, MechanismState};
+use crate::mechanism::Mechanism;
+use crate::newton::NewtonReport;
+use crate::record::{Energies, StepRecord};
+use flexmech_core::{Configuration, Inertia};
+use nalgebra::Vector3;
+use rayon::prelude::*;
+
+/// Strain energy of the whole mesh (element energies summed in element order).
+pub fn strain_energy(mech: &Mechanism, config: &Configuration) -> f64 {
+    let per: Vec<f64> = mech
+        .mesh
+        .elements
+        .par_iter()
+        .map(|e| e.energy(&config.x, &config.rot))
+        .collect();
+    per.iter().sum()
+}
+
+/// Potential of the external nodal forces `fext` (6 per node), taken as
+/// dead: `−Σ f·u` (gravity included; moments, which are not conservative
+/// for finite 3D rotations, are left out).
+pub fn load_potential(mech: &Mechanism, config: &Configuration, fext: &[f64]) -> f64 {
+    -(0..config.x.len())
+        .map(|n| {
+            let u: Vector3<f64> = config.x[n] - mech.mesh.positions[n];
+            u.dot(&Vector3::new(fext[6 * n], fext[6 * n + 1], fext[6 * n + 2]))
+        })
+        .sum::<f64>()
+}
+
+/// A record of `state` with its strain energy and load potential (no
+/// kinetic energy, no momenta: statics), after the Newton solve `report`
+/// (`None`: the initial state).
+pub fn static_record(
+    mech: &Mechanism,
+    state: &MechanismState,
+    fext: &[f64],
+    time: f64,
+    dt: f64,
+    report: Option<&NewtonReport>,
+) -> StepRecord {
+    let config = &state.config;
+    let strain = strain_energy(mech, config);
+    let potential = load_potential(mech, config, fext);
+    StepRecord {
+        time,
+        dt,
+        iterations: report.map_or(0, |r| r.iterations),
+        factorizations: report.map_or(0, |r| r.factorizations),
+        residual: report.map_or(0.0, |r| r.residual),
+        residual_history: report.map_or_else(Vec::new, |r| r.history.clone()),
+        beta: f64::NAN,
+        energy: Energies {
+            kinetic: 0.0,
+            strain,
+            potential,
+            total: strain + potential,
+            driver_work: 0.0,
+        },
+        negative_pivots: None,
+        momentum_linear: [0.0; 3],
+        momentum_angular: [0.0; 3],
+        positions: config.x.iter().map(|x| [x.x, x.y, x.z]).collect(),
+        quaternions: (0..config.x.len())
+            .map(|i| {
+                let q = config.quaternion(i);
+                [q.x, q.y, q.z, q.w]
+            })
+            .collect(),
+        joints: joint_records(mech, state),
+    }
+}
+
+/// [`static_record`] with the kinetic energy and the linear and angular
+/// momenta of nodal velocities `v` (spatial) and `w` (body angular).
+#[allow(clippy::too_many_arguments)]
+pub fn dynamic_record(
+    mech: &Mechanism,
+    inertia: &Inertia,
+    state: &MechanismState,
+    (v, w): (&[Vector3<f64>], &[Vector3<f64>]),
+    fext: &[f64],
+    time: f64,
+    dt: f64,
+    report: Option<&NewtonReport>,
+) -> StepRecord {
+    let mut rec = static_record(mech, state, fext, time, dt, report);
+    let config = &state.config;
+    let kinetic = inertia.kinetic_energy(v, w);
+    rec.energy.kinetic = kinetic;
+    rec.energy.total = kinetic + rec.energy.strain + rec.energy.potential;
+    let lin = inertia.linear_momentum(v);
+    let ang = inertia.angular_momentum(&config.x, &config.rot, v, w);
+    rec.momentum_linear = [lin.x, lin.y, lin.z];
+    rec.momentum_angular = [ang.x, ang.y, ang.z];
+    rec
+}

@@ -1,0 +1,227 @@
+//! The reduced system every solver hands to Newton (FORMULATION §3–4): one
+//! evaluation for statics, Newmark and the midpoint schemes.
+//!
+//! At the iterate `qₙ₊₁` (the end state, slaves placed exactly):
+//!
+//! 1. refresh the slaves' node maps `T_s = N [T_m; E]` (and, for the
+//!    conserving schemes, their rows through the incremental map `Ñ`);
+//! 2. the element forces of the scheme (and their tangents) — internal minus
+//!    external gives the nodal residual `g`;
+//! 3. the scheme's inertial forces (and their tangent blocks) are added to `g`;
+//! 4. the reduction through `N` (`Tᵀ g`, statics and Newmark) or `Ñ`
+//!    (`Ñᵀ g`, the conserving schemes, paper eqs 21–23);
+//! 5. the joints' configuration-dependent tangent blocks `∂(Nᵀ g)/∂q`
+//!    (or `∂(Ñᵀ g)/∂q`) with the slaves' full residuals;
+//! 6. the force scale: the larger of the reduced external loads and the
+//!    reduced magnitudes of the forces that cancel in `g`.
+//!
+//! A scheme supplies only steps 2 and 3 and the choice in step 4
+//! ([`StepTerms`]); the rest is here, once.
+
+use crate::assembly::Assembler;
+use crate::constraints::{MechanismState, Topology};
+use crate::dofs::DofMap;
+use crate::free_motion::FreeMotion;
+use crate::linsolve::TangentRef;
+use crate::mechanism::Mechanism;
+use crate::newton::NewtonSystem;
+use flexmech_core::Configuration;
+
+/// How the joints reduce the nodal residuals to the unknowns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reduction {
+    /// Through the variation map `N` at the iterate (paper eqs 5–8): statics
+    /// and Newmark.
+    Variation,
+    /// Through the exact incremental map `Ñ` of the step (paper eqs 21–23):
+    /// the conserving schemes.
+    Incremental,
+}
+
+/// What a scheme contributes to the reduced system at an iterate.
+pub trait StepTerms {
+    /// How the joints reduce this scheme's residual.
+    fn reduction(&self) -> Reduction;
+
+    /// Evaluates the scheme's element forces between `start` and `end` into
+    /// `asm` ([`Assembler::nodal`], [`Assembler::nodal_abs`]) and, if
+    /// `tangent`, their reduced tangents into [`Assembler::values`].
+    fn elements(
+        &self,
+        mech: &Mechanism,
+        dofs: &DofMap,
+        asm: &mut Assembler,
+        start: &Configuration,
+        end: &Configuration,
+        tangent: bool,
+    );
+
+    /// Adds the scheme's inertial forces at `end` to the nodal residual `g`
+    /// and their magnitudes to `abs`; with `tangent`, their tangent blocks
+    /// to the assembler. Default: none (statics).
+    fn inertia(
+        &self,
+        _start: &Configuration,
+        _end: &Configuration,
+        _g: &mut [f64],
+        _abs: &mut [f64],
+        _tangent: Option<(&mut Assembler, &DofMap)>,
+    ) {
+    }
+
+    /// What the tangent's form depends on besides the iterate (the step
+    /// size of a dynamic step; see [`NewtonSystem::tangent_key`]).
+    fn tangent_key(&self) -> f64 {
+        f64::NAN
+    }
+}
+
+/// The reduced system of one step: the mechanism's structure and the
+/// workspace of its evaluation (kept for the whole run: no allocation per
+/// step or iteration), the step's start state and the iterate at its end,
+/// and the scheme's terms.
+pub struct ReducedSystem<'m, T> {
+    /// The mechanism.
+    pub mech: &'m Mechanism,
+    /// Unknowns and node maps (refreshed at the iterate).
+    pub topo: Topology,
+    /// Element assembly and the tangent values.
+    pub asm: Assembler,
+    /// The state at the start of the step.
+    pub start: MechanismState,
+    /// The current iterate of the state at the end of the step.
+    pub end: MechanismState,
+    /// External nodal forces of the step (6 per node).
+    pub fext: Vec<f64>,
+    /// Nodal residuals `g` (internal + inertial − external) at the last
+    /// evaluation.
+    pub nodal: Vec<f64>,
+    abs: Vec<f64>,
+    scratch: Vec<f64>,
+    /// Absolute residual norm below which the residual is round-off.
+    pub floor: f64,
+    /// The scheme's terms.
+    pub terms: T,
+}
+
+impl<'m, T: StepTerms> ReducedSystem<'m, T> {
+    /// A system over `topo` and `asm` starting (and ending) at `state`.
+    pub fn new(
+        mech: &'m Mechanism,
+        topo: Topology,
+        asm: Assembler,
+        state: MechanismState,
+        terms: T,
+    ) -> Self {
+        let nodes = mech.mesh.node_count();
+        let n_eq = topo.dofs.n_eq;
+        Self {
+            mech,
+            topo,
+            asm,
+            start: state.clone(),
+            end: state,
+            fext: vec![0.0; 6 * nodes],
+            nodal: vec![0.0; 6 * nodes],
+            abs: vec![0.0; 6 * nodes],
+            scratch: vec![0.0; n_eq],
+            floor: mech.round_off_floor(),
+            terms,
+        }
+    }
+
+    /// The reduced residual of nodal residuals `g` into `out`, through the
+    /// scheme's [`Reduction`].
+    pub fn reduce(&self, g: &[f64], out: &mut [f64]) {
+        match self.terms.reduction() {
+            Reduction::Variation => self.topo.dofs.reduce(g, out),
+            Reduction::Incremental => {
+                self.topo
+                    .reduce_incremental(self.mech, &self.start, &self.end, g, out)
+            }
+        }
+    }
+
+    /// The residual into `r` (returns the force scale) and, if `tangent`,
+    /// the tangent values (see the module docs for the steps).
+    pub fn evaluate_with(&mut self, r: &mut [f64], tangent: bool) -> f64 {
+        let mech = self.mech;
+        let joints = !mech.joints.is_empty();
+        let reduction = self.terms.reduction();
+        self.topo.refresh(mech, &self.end);
+        if joints && reduction == Reduction::Incremental {
+            self.topo.refresh_rows(mech, &self.start, &self.end);
+        }
+        let (start, end) = (&self.start.config, &self.end.config);
+        self.terms
+            .elements(mech, &self.topo.dofs, &mut self.asm, start, end, tangent);
+        for (g, (fi, fe)) in self
+            .nodal
+            .iter_mut()
+            .zip(self.asm.nodal.iter().zip(&self.fext))
+        {
+            *g = fi - fe;
+        }
+        self.abs.copy_from_slice(&self.asm.nodal_abs);
+        let blocks = tangent.then_some((&mut self.asm, &self.topo.dofs));
+        self.terms
+            .inertia(start, end, &mut self.nodal, &mut self.abs, blocks);
+        self.reduce(&self.nodal, r);
+        if tangent && joints {
+            let blocks = match reduction {
+                Reduction::Variation => self.topo.geometric_blocks(mech, &self.end, &self.nodal),
+                Reduction::Incremental => {
+                    self.topo
+                        .incremental_blocks(mech, &self.start, &self.end, &self.nodal)
+                }
+            };
+            for (b, block) in blocks.iter().enumerate() {
+                self.asm.add_block(b, block);
+            }
+        }
+        let dofs = &self.topo.dofs;
+        let f_ext = dofs.reduced_norm(&self.fext, &mut self.scratch);
+        f_ext.max(dofs.reduced_norm(&self.abs, &mut self.scratch))
+    }
+}
+
+impl<T: StepTerms> NewtonSystem for ReducedSystem<'_, T> {
+    fn evaluate(&mut self, r: &mut [f64]) -> f64 {
+        self.evaluate_with(r, true)
+    }
+
+    fn residual(&mut self, r: &mut [f64]) -> f64 {
+        self.evaluate_with(r, false)
+    }
+
+    fn update_tangent(&mut self, scratch: &mut [f64]) {
+        self.evaluate_with(scratch, true);
+    }
+
+    fn tangent_key(&self) -> f64 {
+        self.terms.tangent_key()
+    }
+
+    fn tangent_values(&self) -> &[f64] {
+        &self.asm.values
+    }
+
+    fn apply(&mut self, dq: &[f64]) {
+        self.topo.apply(self.mech, &mut self.end, dq);
+    }
+
+    fn floor(&self) -> f64 {
+        self.floor
+    }
+
+    fn free_motion(&self, mode: &[f64], tangent: TangentRef) -> FreeMotion {
+        FreeMotion::of(
+            self.mech,
+            &self.topo.dofs,
+            &self.topo.released_eqs,
+            &self.end.config.x,
+            mode,
+            tangent,
+        )
+    }
+}
