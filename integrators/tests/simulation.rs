@@ -61,9 +61,12 @@ fn free_beam(v0: Vector3<f64>, om: Vector3<f64>) -> (Mechanism, Motion, DynamicS
     (mech, motion, settings)
 }
 
+/// Time, step, positions, quaternions, energies and angular momentum.
+type Fingerprint = (f64, f64, Vec<[f64; 3]>, Vec<[f64; 4]>, [f64; 4], [f64; 3]);
+
 /// The parts of a record a result file stores per step (β is NaN for most
 /// schemes, so records are compared through these).
-fn fingerprint(r: &StepRecord) -> (f64, f64, Vec<[f64; 3]>, Vec<[f64; 4]>, [f64; 4], [f64; 3]) {
+fn fingerprint(r: &StepRecord) -> Fingerprint {
     let e = r.energy;
     (
         r.time,
