@@ -19,6 +19,7 @@ pub mod stability;
 pub mod statics;
 pub mod step_control;
 pub mod system;
+pub mod tolerances;
 
 pub use constraints::{MechanismState, Topology};
 pub use error::{NewtonFailure, SolveError};

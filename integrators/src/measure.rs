@@ -73,6 +73,8 @@ pub fn static_record(
             })
             .collect(),
         joints: joint_records(mech, state),
+        velocities: Vec::new(),
+        angular_velocities: Vec::new(),
     }
 }
 
@@ -98,5 +100,14 @@ pub fn dynamic_record(
     let ang = inertia.angular_momentum(&config.x, &config.rot, v, w);
     rec.momentum_linear = [lin.x, lin.y, lin.z];
     rec.momentum_angular = [ang.x, ang.y, ang.z];
+    rec.velocities = v.iter().map(|v| [v.x, v.y, v.z]).collect();
+    rec.angular_velocities = w
+        .iter()
+        .zip(&config.rot)
+        .map(|(w, r)| {
+            let om = r * w;
+            [om.x, om.y, om.z]
+        })
+        .collect();
     rec
 }

@@ -12,6 +12,7 @@
 use crate::error::NewtonFailure;
 use crate::free_motion::FreeMotion;
 use crate::linsolve::{SparseLu, TangentRef};
+use crate::tolerances::TOLERANCES;
 
 /// Condition number (of the equilibrated tangent, see
 /// [`SparseLu::condition_estimate`]) above which a converged tangent is
@@ -19,7 +20,7 @@ use crate::linsolve::{SparseLu, TangentRef};
 /// well-posed model stays orders of magnitude below (a slender cantilever of
 /// a thousand elements with `EA/EI = 10⁵` has `κ ≈ 10¹⁰`), and one above
 /// it cannot be solved to more than two digits anyway.
-pub const SINGULAR_CONDITION: f64 = 1.0 / (100.0 * f64::EPSILON);
+pub const SINGULAR_CONDITION: f64 = TOLERANCES.singular_condition;
 
 /// Iteration limits.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,7 +41,7 @@ pub struct NewtonSettings {
 
 /// Largest ratio of successive residuals modified Newton accepts before it
 /// refactors the tangent at the current iterate.
-pub const MODIFIED_CONTRACTION: f64 = 0.5;
+pub const MODIFIED_CONTRACTION: f64 = TOLERANCES.modified_contraction;
 
 /// A nonlinear system `r(q) = 0` in the reduced unknowns.
 pub trait NewtonSystem {
@@ -225,7 +226,7 @@ pub(crate) fn check_regular<S: NewtonSystem>(
 /// `previous` is updated); while it still drops fast, one more iteration is
 /// cheap accuracy.
 pub(crate) fn at_floor(norm: f64, previous: &mut f64, floor: f64) -> bool {
-    let stalled = norm >= 0.5 * *previous;
+    let stalled = norm >= TOLERANCES.stall_ratio * *previous;
     *previous = norm;
     norm <= floor && (stalled || norm == 0.0)
 }
@@ -238,9 +239,11 @@ pub(crate) fn diverged(
     history: &[f64],
     settings: &NewtonSettings,
 ) -> Option<NewtonFailure> {
-    (it > 0 && res > 1e8 * history[0].max(settings.tolerance)).then(|| NewtonFailure::Diverged {
-        iteration: it,
-        residual: res,
-        initial: history[0],
+    (it > 0 && res > TOLERANCES.divergence_growth * history[0].max(settings.tolerance)).then(|| {
+        NewtonFailure::Diverged {
+            iteration: it,
+            residual: res,
+            initial: history[0],
+        }
     })
 }

@@ -61,6 +61,12 @@ pub struct StepRecord {
     pub quaternions: Vec<[f64; 4]>,
     /// One record per joint, in model order.
     pub joints: Vec<JointRecord>,
+    /// Dynamics: every node's translational velocity `v` (spatial); empty
+    /// in statics.
+    pub velocities: Vec<[f64; 3]>,
+    /// Dynamics: every node's angular velocity in spatial components,
+    /// `ω = R W` (`Ṙ = ω̂ R`); empty in statics.
+    pub angular_velocities: Vec<[f64; 3]>,
     /// Statics: the number of negative eigenvalues of the converged reduced
     /// tangent (see [`crate::stability`]); non-zero means the equilibrium
     /// is unstable (past a bifurcation or limit point). `None` in dynamics.

@@ -9,7 +9,6 @@
 
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, MechanismState, Topology};
-use crate::dofs::DofMap;
 use crate::error::{NewtonFailure, SolveError};
 use crate::linsolve::SparseLu;
 use crate::measure::static_record;
@@ -20,6 +19,7 @@ use crate::rotation_guard::{as_step_failure, RotationGuard};
 use crate::stability::InertiaCount;
 use crate::step_control::StepControl;
 use crate::system::{ReducedSystem, Reduction, StepTerms};
+use crate::tolerances::TOLERANCES;
 use flexmech_core::Configuration;
 
 /// Settings of a static analysis.
@@ -51,22 +51,6 @@ struct StaticTerms;
 impl StepTerms for StaticTerms {
     fn reduction(&self) -> Reduction {
         Reduction::Variation
-    }
-
-    fn elements(
-        &self,
-        mech: &Mechanism,
-        dofs: &DofMap,
-        asm: &mut Assembler,
-        _start: &Configuration,
-        end: &Configuration,
-        tangent: bool,
-    ) {
-        if tangent {
-            asm.assemble(&mech.mesh, dofs, end);
-        } else {
-            asm.assemble_residual(&mech.mesh, end);
-        }
     }
 }
 
@@ -110,12 +94,16 @@ pub fn solve_static(
             .any(|j| j.driven.iter().any(Option::is_some));
     // The state before the last converged step and that step's size.
     let mut previous: Option<(MechanismState, f64)> = None;
-    while lambda < 1.0 - 1e-12 {
+    while lambda < 1.0 - TOLERANCES.end_of_run {
         // Never step over a planned level k/load_steps: results are reported
         // at the load factors the user asked for; halvings only add levels.
-        let next_planned = ((lambda / nominal + 1e-9).floor() + 1.0) * nominal;
+        let next_planned = ((lambda / nominal + TOLERANCES.level_snap).floor() + 1.0) * nominal;
         let target = (lambda + control.step()).min(next_planned);
-        let target = if target > 1.0 - 1e-12 { 1.0 } else { target };
+        let target = if target > 1.0 - TOLERANCES.end_of_run {
+            1.0
+        } else {
+            target
+        };
         prob.start.clone_from(&prob.end);
         prob.floor = mech.round_off_floor_at(&prob.end.config.x);
         if let (true, Some((before, before_step))) = (driven, &previous) {

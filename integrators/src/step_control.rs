@@ -2,10 +2,7 @@
 //! steps).
 
 use crate::error::{NewtonFailure, SolveError};
-
-/// Relative distance to a multiple of the nominal step below which a time is
-/// that multiple (round-off of summed steps: far below any halved step).
-const TIME_SNAP: f64 = 1e-9;
+use crate::tolerances::TOLERANCES;
 
 /// Step-size control shared by statics and the integrators: halve on
 /// failure, grow back (doubling) towards the nominal step after a number of
@@ -62,7 +59,7 @@ impl StepControl {
     pub(crate) fn advance(&self, t: f64, dt: f64) -> f64 {
         let next = t + dt;
         let n = (next / self.nominal).round();
-        if (next - n * self.nominal).abs() <= TIME_SNAP * self.nominal {
+        if (next - n * self.nominal).abs() <= TOLERANCES.level_snap * self.nominal {
             n * self.nominal
         } else {
             next

@@ -46,15 +46,23 @@ pub trait StepTerms {
     /// Evaluates the scheme's element forces between `start` and `end` into
     /// `asm` ([`Assembler::nodal`], [`Assembler::nodal_abs`]) and, if
     /// `tangent`, their reduced tangents into [`Assembler::values`].
+    /// Default: the beams' internal forces at `end` (the exact gradient of
+    /// the strain energy, statics and Newmark).
     fn elements(
         &self,
         mech: &Mechanism,
         dofs: &DofMap,
         asm: &mut Assembler,
-        start: &Configuration,
+        _start: &Configuration,
         end: &Configuration,
         tangent: bool,
-    );
+    ) {
+        if tangent {
+            asm.assemble(&mech.mesh, dofs, end);
+        } else {
+            asm.assemble_residual(&mech.mesh, end);
+        }
+    }
 
     /// Adds the scheme's inertial forces at `end` to the nodal residual `g`
     /// and their magnitudes to `abs`; with `tangent`, their tangent blocks

@@ -375,6 +375,8 @@ fn record(step: usize) -> StepRecord {
         quaternions: vec![[1.0, 0.0, 0.0, 0.0]; 2],
         joints: vec![],
         negative_pivots: None,
+        velocities: Vec::new(),
+        angular_velocities: Vec::new(),
     }
 }
 

@@ -136,7 +136,15 @@ fn record(step: usize) -> StepRecord {
             constraint_error: 1e-12 * k,
         }],
         negative_pivots: None,
+        velocities: (0..N_NODES).map(|i| velocity(step, i, 1.0)).collect(),
+        angular_velocities: (0..N_NODES).map(|i| velocity(step, i, -2.0)).collect(),
     }
+}
+
+/// A made-up velocity of node `node` at `step`, distinct per node, step and `kind`.
+fn velocity(step: usize, node: usize, kind: f64) -> [f64; 3] {
+    let (k, n) = (step as f64, node as f64);
+    [kind * (k + 0.5), n - k, kind * n * 0.25 + k]
 }
 
 fn meta() -> RunMeta {
@@ -352,6 +360,25 @@ fn check_series(file: &hdf5::File, t: usize) {
         .flat_map(|s| s.quaternions.iter().flatten().copied())
         .collect();
     assert_same("configuration/quaternion", &data, &want);
+    for (name, field) in [
+        (layout::CONFIGURATION_VELOCITY, 0),
+        (layout::CONFIGURATION_ANGULAR_VELOCITY, 1),
+    ] {
+        let (shape, data) = read_f64(file, name);
+        assert_eq!(shape, [t, N_NODES, 3]);
+        let want: Vec<f64> = steps
+            .iter()
+            .flat_map(|s| {
+                let v = if field == 0 {
+                    &s.velocities
+                } else {
+                    &s.angular_velocities
+                };
+                v.iter().flatten().copied().collect::<Vec<_>>()
+            })
+            .collect();
+        assert_same(name, &data, &want);
+    }
 }
 
 #[test]
@@ -410,6 +437,11 @@ fn contract_names_are_literal() {
         (
             layout::CONFIGURATION_QUATERNION,
             "/configuration/quaternion",
+        ),
+        (layout::CONFIGURATION_VELOCITY, "/configuration/velocity"),
+        (
+            layout::CONFIGURATION_ANGULAR_VELOCITY,
+            "/configuration/angular_velocity",
         ),
     ];
     for (constant, literal) in expected {

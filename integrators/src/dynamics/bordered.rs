@@ -10,6 +10,7 @@ use crate::newton::{
     at_floor, check_regular, diverged, NewtonReport, NewtonSettings, NewtonSystem,
 };
 use crate::system::{ReducedSystem, StepTerms};
+use crate::tolerances::TOLERANCES;
 use flexmech_core::conserving::MidRotation;
 use flexmech_core::rotation::cayley_inverse;
 use flexmech_core::{Configuration, Element};
@@ -144,7 +145,7 @@ pub(super) fn solve_step<T: Bordered>(
             .sqrt();
         let e_ok = !determined
             || res_e <= settings.tolerance
-            || energy.abs() <= 64.0 * f64::EPSILON * e_scale + sys.floor() * increments;
+            || energy.abs() <= TOLERANCES.energy_round_off * e_scale + sys.floor() * increments;
         if g_ok && e_ok {
             check_regular(sys, lu, it > 0, true)?;
             let beta_out = if determined { beta } else { f64::NAN };
@@ -180,7 +181,7 @@ pub(super) fn solve_step<T: Bordered>(
         let size = c_tot.abs()
             + c.iter().map(|v| v * v).sum::<f64>().sqrt()
                 * y2.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let dbeta = if pivot.abs() > 1e-10 * size && pivot.is_finite() {
+        let dbeta = if pivot.abs() > TOLERANCES.border_pivot * size && pivot.is_finite() {
             determined = true;
             (-energy - cy1) / pivot
         } else {

@@ -5,7 +5,32 @@
 use crate::assembly::Assembler;
 use crate::dofs::DofMap;
 use flexmech_core::Inertia;
-use nalgebra::Matrix3;
+use nalgebra::{Const, Matrix3, Vector3, U1};
+use num_dual::DualSVec64;
+
+/// A nodal inertial moment `m(R)` at the end rotation `r_end` and its
+/// derivative with respect to a spatial spin of it (`R ← exp(η̂)R`), by
+/// three-lane forward AD; the value alone when `tangent` is false (the
+/// derivative is then zero).
+pub(crate) fn spin_derivative(
+    r_end: &Matrix3<f64>,
+    tangent: bool,
+    moment: impl Fn(&Matrix3<DualSVec64<3>>) -> Vector3<DualSVec64<3>>,
+    plain: impl Fn(&Matrix3<f64>) -> Vector3<f64>,
+) -> (Vector3<f64>, Matrix3<f64>) {
+    if !tangent {
+        return (plain(r_end), Matrix3::zeros());
+    }
+    type D = DualSVec64<3>;
+    let seed = |j: usize| D::from_re(0.0).derivative(j);
+    let eta = Vector3::new(seed(0), seed(1), seed(2));
+    let m = moment(&(flexmech_core::rotation::exp(&eta) * r_end.map(D::from_re)));
+    let mut k = Matrix3::zeros();
+    for c in 0..3 {
+        k.set_row(c, &m[c].eps.unwrap_generic(Const::<3>, U1).transpose());
+    }
+    (m.map(|v| v.re), k)
+}
 
 /// Tangent positions per translational mass entry `(i, j, m)` and per
 /// node's rotational inertia (`None` where a slave is involved: its maps

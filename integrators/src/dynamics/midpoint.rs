@@ -23,7 +23,7 @@
 //! quadratically with joints too.
 
 use super::bordered::{self, Bordered};
-use super::mass_slots::MassSlots;
+use super::mass_slots::{spin_derivative, MassSlots};
 use super::midpoint_kernels::{correction_size, element_force, element_kernel};
 use super::time_scheme::TimeScheme;
 pub use super::Scheme;
@@ -36,10 +36,9 @@ use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSettings};
 use crate::system::{ReducedSystem, Reduction, StepTerms};
-use flexmech_core::rotation::{cayley_inverse, exp, log};
+use flexmech_core::rotation::{cayley_inverse, log};
 use flexmech_core::{Configuration, Inertia};
-use nalgebra::{Const, Matrix3, Vector3, U1};
-use num_dual::DualSVec64;
+use nalgebra::{Matrix3, Vector3};
 
 /// Velocities at the end of a step from the configurations at both ends.
 pub fn end_motion(
@@ -72,27 +71,12 @@ fn inertial_moment(
     dt: f64,
     tangent: bool,
 ) -> (Vector3<f64>, Matrix3<f64>) {
-    if !tangent {
-        return (
-            inertial_moment_at(j0, r_n, r_end, w_n, dt),
-            Matrix3::zeros(),
-        );
-    }
-    type D = DualSVec64<3>;
-    let eta = Vector3::new(
-        D::from_re(0.0).derivative(0),
-        D::from_re(0.0).derivative(1),
-        D::from_re(0.0).derivative(2),
-    );
-    let r1 = exp(&eta) * r_end.map(D::from_re);
-    let m = inertial_moment_at(j0, r_n, &r1, w_n, dt);
-    let mut k = Matrix3::zeros();
-    let mut val = Vector3::zeros();
-    for i in 0..3 {
-        val[i] = m[i].re;
-        k.set_row(i, &m[i].eps.unwrap_generic(Const::<3>, U1).transpose());
-    }
-    (val, k)
+    spin_derivative(
+        r_end,
+        tangent,
+        |r1| inertial_moment_at(j0, r_n, r1, w_n, dt),
+        |r1| inertial_moment_at(j0, r_n, r1, w_n, dt),
+    )
 }
 
 /// `(πₙ₊₁ − πₙ)/Δt` for the end rotation `r1` (generic, for AD), with

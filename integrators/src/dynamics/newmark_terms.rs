@@ -1,7 +1,7 @@
 //! Newmark's trapezoidal rule (β = ¼, γ = ½) on SO(3) as terms of the
 //! shared reduced system (see [`super::newmark`] for the scheme).
 
-use super::mass_slots::MassSlots;
+use super::mass_slots::{spin_derivative, MassSlots};
 use super::slave_velocities;
 use super::time_scheme::TimeScheme;
 use super::Motion;
@@ -11,10 +11,9 @@ use crate::dofs::DofMap;
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::system::{ReducedSystem, Reduction, StepTerms};
-use flexmech_core::rotation::{exp, log};
+use flexmech_core::rotation::log;
 use flexmech_core::{Configuration, Inertia};
-use nalgebra::{Const, Matrix3, Vector3, U1};
-use num_dual::DualSVec64;
+use nalgebra::{Matrix3, Vector3};
 
 const BETA: f64 = 0.25;
 const GAMMA: f64 = 0.5;
@@ -108,22 +107,6 @@ impl StepTerms for NewmarkTerms {
         Reduction::Variation
     }
 
-    fn elements(
-        &self,
-        mech: &Mechanism,
-        dofs: &DofMap,
-        asm: &mut Assembler,
-        _start: &Configuration,
-        end: &Configuration,
-        tangent: bool,
-    ) {
-        if tangent {
-            asm.assemble(&mech.mesh, dofs, end);
-        } else {
-            asm.assemble_residual(&mech.mesh, end);
-        }
-    }
-
     fn inertia(
         &self,
         start: &Configuration,
@@ -152,31 +135,17 @@ impl StepTerms for NewmarkTerms {
             if *j0 == Matrix3::zeros() {
                 continue;
             }
-            let (m, k) = if tangent.is_some() {
-                type D = DualSVec64<3>;
-                let eta = Vector3::new(
-                    D::from_re(0.0).derivative(0),
-                    D::from_re(0.0).derivative(1),
-                    D::from_re(0.0).derivative(2),
-                );
-                let r1 = exp(&eta) * end.rot[i].map(D::from_re);
-                let m = inertial_moment(j0, &start.rot[i], &r1, prev, i, dt);
-                let mut k = Matrix3::zeros();
-                for c in 0..3 {
-                    k.set_row(c, &m[c].eps.unwrap_generic(Const::<3>, U1).transpose());
-                }
-                (m.map(|v| v.re), Some(k))
-            } else {
-                (
-                    inertial_moment(j0, &start.rot[i], &end.rot[i], prev, i, dt),
-                    None,
-                )
-            };
+            let (m, k) = spin_derivative(
+                &end.rot[i],
+                tangent.is_some(),
+                |r1| inertial_moment(j0, &start.rot[i], r1, prev, i, dt),
+                |r1| inertial_moment(j0, &start.rot[i], r1, prev, i, dt),
+            );
             for c in 0..3 {
                 g[6 * i + 3 + c] += m[c];
                 abs[6 * i + 3 + c] += m[c].abs();
             }
-            if let (Some((asm, dofs)), Some(k)) = (tangent.as_mut(), k) {
+            if let Some((asm, dofs)) = tangent.as_mut() {
                 self.slots.add_rotational(asm, dofs, i, &k);
             }
         }

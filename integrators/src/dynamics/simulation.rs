@@ -36,11 +36,9 @@ use crate::record::StepRecord;
 use crate::rotation_guard::{as_step_failure, RotationGuard};
 use crate::step_control::StepControl;
 use crate::system::ReducedSystem;
+use crate::tolerances::TOLERANCES;
 use flexmech_core::{Configuration, Element, Inertia};
 use nalgebra::Vector3;
-
-/// Relative distance to `t_end` below which a run has reached it.
-const END_TOLERANCE: f64 = 1e-12;
 
 /// The time integrators.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -258,7 +256,7 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
 impl<S: TimeScheme> Stepping for Stepper<'_, S> {
     fn step(&mut self) -> Result<Option<StepRecord>, SolveError> {
         let t_end = self.settings.t_end;
-        while self.t < t_end * (1.0 - END_TOLERANCE) {
+        while self.t < t_end * (1.0 - TOLERANCES.end_of_run) {
             let (t, dt) = (self.t, self.control.next(self.t, t_end));
             self.sys.terms.set_step(dt);
             self.predict(dt);

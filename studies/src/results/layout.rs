@@ -105,6 +105,11 @@ pub const CONFIGURATION: &str = "/configuration";
 pub const CONFIGURATION_POSITION: &str = "/configuration/position";
 /// T×nodes×4: every node's triad as a unit quaternion (w, x, y, z).
 pub const CONFIGURATION_QUATERNION: &str = "/configuration/quaternion";
+/// T×nodes×3, dynamics only: every node's translational velocity.
+pub const CONFIGURATION_VELOCITY: &str = "/configuration/velocity";
+/// T×nodes×3, dynamics only: every node's angular velocity `ω = R W`
+/// (spatial components).
+pub const CONFIGURATION_ANGULAR_VELOCITY: &str = "/configuration/angular_velocity";
 
 /// Path of the group of tracked node `label`: `/nodes/<label>`.
 pub fn node_group(label: &str) -> String {

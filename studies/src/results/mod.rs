@@ -36,6 +36,8 @@
 //! | `/joints/<name>/constraint_error` | T | ‖r_s − r_m − Λ_m f(ψ)‖ + ‖Λ_mᵀΛ_s − exp(ψ t̂)‖ |
 //! | `/configuration/position` | T×nodes×3 | every node's position |
 //! | `/configuration/quaternion` | T×nodes×4 | every node's triad as (w, x, y, z) |
+//! | `/configuration/velocity` | T×nodes×3 | dynamics: every node's translational velocity |
+//! | `/configuration/angular_velocity` | T×nodes×3 | dynamics: every node's angular velocity `ω = R W` (spatial) |
 //!
 //! `<label>` and `<name>` are the tracked-node labels and joint names of
 //! [`RunMeta`], used verbatim as group names (`arm.end`, `post.3`); they must

@@ -90,7 +90,8 @@ pub enum ResultError {
         path: PathBuf,
         /// Index of the rejected step (= steps written before it).
         step: usize,
-        /// `"positions"`, `"quaternions"` or `"joints"`.
+        /// `"positions"`, `"quaternions"`, `"joints"`, `"velocities"` or
+        /// `"angular_velocities"` (dynamics).
         field: &'static str,
         /// Length given by [`RunMeta`].
         expected: usize,
@@ -351,6 +352,8 @@ struct Datasets {
     joints: Vec<JointSets>,
     config_position: Series,
     config_quaternion: Series,
+    /// Dynamics only: translational and angular velocities of every node.
+    config_velocity: Option<[Series; 2]>,
 }
 
 impl Datasets {
@@ -373,6 +376,7 @@ impl Datasets {
             &self.config_quaternion,
         ]
         .into_iter()
+        .chain(self.config_velocity.iter().flatten())
         .chain(self.negative_pivots.iter())
         .chain(
             self.nodes
@@ -671,6 +675,24 @@ impl ResultWriter {
              quaternion (w, x, y, z) (T x nodes x 4)",
         )?;
 
+        let config_velocity = if meta.integrator == "static" {
+            None
+        } else {
+            Some([
+                config(
+                    names::CONFIGURATION_VELOCITY,
+                    3,
+                    "translational velocity of every node at every stored step (T x nodes x 3)",
+                )?,
+                config(
+                    names::CONFIGURATION_ANGULAR_VELOCITY,
+                    3,
+                    "angular velocity w = R W of every node's triad in spatial components \
+                     (T x nodes x 3)",
+                )?,
+            ])
+        };
+
         let sets = Datasets {
             time,
             kinetic,
@@ -692,6 +714,7 @@ impl ResultWriter {
             joints,
             config_position,
             config_quaternion,
+            config_velocity,
         };
         file.flush().ctx(path, || "flushing the file".to_owned())?;
         Ok(Self {
@@ -710,7 +733,8 @@ impl ResultWriter {
     /// by `residual_history.len()` entries), writes the step, and flushes the
     /// file so that the step survives a crash of the process.
     ///
-    /// A record whose `positions`, `quaternions` or `joints` length differs
+    /// A record whose `positions`, `quaternions`, `joints` or (dynamics)
+    /// velocities length differs
     /// from the [`RunMeta`] is rejected with [`ResultError::RecordLength`]
     /// before anything is written. If HDF5 fails part-way, the next `append`
     /// rewrites the same row and `finish` trims the file back to the steps
@@ -723,6 +747,15 @@ impl ResultWriter {
             ("quaternions", n_nodes, step.quaternions.len()),
             ("joints", self.sets.joints.len(), step.joints.len()),
         ];
+        let velocities = self.sets.config_velocity.as_ref().map_or(0, |_| n_nodes);
+        let lengths = lengths.into_iter().chain([
+            ("velocities", velocities, step.velocities.len()),
+            (
+                "angular_velocities",
+                velocities,
+                step.angular_velocities.len(),
+            ),
+        ]);
         for (field, expected, found) in lengths {
             if expected != found {
                 return Err(ResultError::RecordLength {
@@ -800,6 +833,10 @@ impl ResultWriter {
         }
         s.config_position.push_block(t, &step.positions, path)?;
         s.config_quaternion.push_block(t, &step.quaternions, path)?;
+        if let Some([v, w]) = &s.config_velocity {
+            v.push_block(t, &step.velocities, path)?;
+            w.push_block(t, &step.angular_velocities, path)?;
+        }
 
         self.file
             .flush()
