@@ -82,4 +82,48 @@ impl MassSlots {
             None => asm.add_node_block(dofs, (i, 3), (i, 3), block),
         }
     }
+
+    /// Adds a scheme's inertial forces to the nodal residual `g` (their
+    /// magnitudes to `abs`) and, with `tangent`, their tangent blocks:
+    /// `force(j, m)` is the force of mass entry `(i, j, m)` on node `i`,
+    /// whose derivative with respect to node `j`'s translation is
+    /// `coefficient(m)·I`; `moment(i, J₀, tangent)` is node `i`'s inertial
+    /// moment and its derivative under a spin of its end rotation (nodes
+    /// without rotary inertia are skipped).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn add_inertia(
+        &self,
+        inertia: &Inertia,
+        g: &mut [f64],
+        abs: &mut [f64],
+        mut tangent: Option<(&mut Assembler, &DofMap)>,
+        force: impl Fn(usize, f64) -> Vector3<f64>,
+        coefficient: impl Fn(f64) -> f64,
+        moment: impl Fn(usize, &Matrix3<f64>, bool) -> (Vector3<f64>, Matrix3<f64>),
+    ) {
+        for (k, &(i, j, m)) in inertia.mass.iter().enumerate() {
+            let f = force(j, m);
+            for c in 0..3 {
+                g[6 * i + c] += f[c];
+                abs[6 * i + c] += f[c].abs();
+            }
+            if let Some((asm, dofs)) = tangent.as_mut() {
+                let block = Matrix3::identity() * coefficient(m);
+                self.add_translational(asm, dofs, k, (i, j), &block);
+            }
+        }
+        for (i, j0) in inertia.rotational.iter().enumerate() {
+            if *j0 == Matrix3::zeros() {
+                continue;
+            }
+            let (m, k) = moment(i, j0, tangent.is_some());
+            for c in 0..3 {
+                g[6 * i + 3 + c] += m[c];
+                abs[6 * i + 3 + c] += m[c].abs();
+            }
+            if let Some((asm, dofs)) = tangent.as_mut() {
+                self.add_rotational(asm, dofs, i, &k);
+            }
+        }
+    }
 }

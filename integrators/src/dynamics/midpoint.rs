@@ -184,42 +184,25 @@ impl StepTerms for MidpointTerms {
         end: &Configuration,
         g: &mut [f64],
         abs: &mut [f64],
-        mut tangent: Option<(&mut Assembler, &DofMap)>,
+        tangent: Option<(&mut Assembler, &DofMap)>,
     ) {
         let dt = self.dt;
-        // Translational inertia: Σⱼ m_ij (vⱼ,ₙ₊₁ − vⱼ,ₙ)/Δt, vₙ₊₁ = 2(xₙ₊₁ − xₙ)/Δt − vₙ.
-        for (k, &(i, j, m)) in self.inertia.mass.iter().enumerate() {
-            let dv = (end.x[j] - start.x[j]) * (2.0 / dt) - self.v_n[j] * 2.0;
-            for c in 0..3 {
-                g[6 * i + c] += m * dv[c] / dt;
-                abs[6 * i + c] += (m * dv[c] / dt).abs();
-            }
-            if let Some((asm, dofs)) = tangent.as_mut() {
-                let block = Matrix3::identity() * (2.0 * m / (dt * dt));
-                self.slots.add_translational(asm, dofs, k, (i, j), &block);
-            }
-        }
-        // Rotational inertia, node by node.
-        for (i, j0) in self.inertia.rotational.iter().enumerate() {
-            if *j0 == Matrix3::zeros() {
-                continue;
-            }
-            let (m, k) = inertial_moment(
-                j0,
-                &start.rot[i],
-                &end.rot[i],
-                &self.w_n[i],
-                dt,
-                tangent.is_some(),
-            );
-            for c in 0..3 {
-                g[6 * i + 3 + c] += m[c];
-                abs[6 * i + 3 + c] += m[c].abs();
-            }
-            if let Some((asm, dofs)) = tangent.as_mut() {
-                self.slots.add_rotational(asm, dofs, i, &k);
-            }
-        }
+        // Translational inertia: Σⱼ m_ij (vⱼ,ₙ₊₁ − vⱼ,ₙ)/Δt, vₙ₊₁ = 2(xₙ₊₁ − xₙ)/Δt − vₙ;
+        // rotational (πₙ₊₁ − πₙ)/Δt, node by node.
+        self.slots.add_inertia(
+            &self.inertia,
+            g,
+            abs,
+            tangent,
+            |j, m| {
+                let dv = (end.x[j] - start.x[j]) * (2.0 / dt) - self.v_n[j] * 2.0;
+                dv.map(|d| m * d / dt)
+            },
+            |m| 2.0 * m / (dt * dt),
+            |i, j0, tangent| {
+                inertial_moment(j0, &start.rot[i], &end.rot[i], &self.w_n[i], dt, tangent)
+            },
+        );
     }
 
     fn tangent_key(&self) -> f64 {

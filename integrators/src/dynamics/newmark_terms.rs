@@ -113,42 +113,33 @@ impl StepTerms for NewmarkTerms {
         end: &Configuration,
         g: &mut [f64],
         abs: &mut [f64],
-        mut tangent: Option<(&mut Assembler, &DofMap)>,
+        tangent: Option<(&mut Assembler, &DofMap)>,
     ) {
         let (dt, prev) = (self.dt, &self.prev);
-        // Translational inertia M aₙ₊₁, aₙ₊₁ = (u − Δt vₙ − Δt²(½−β)aₙ)/(βΔt²).
-        for (k, &(i, j, m)) in self.inertia.mass.iter().enumerate() {
-            let u = end.x[j] - start.x[j];
-            let a1 = (u - prev.v[j] * dt - prev.a[j] * (dt * dt * (0.5 - BETA))) / (BETA * dt * dt);
-            for c in 0..3 {
-                g[6 * i + c] += m * a1[c];
-                abs[6 * i + c] += (m * a1[c]).abs();
-            }
-            if let Some((asm, dofs)) = tangent.as_mut() {
-                let block = Matrix3::identity() * (m / (BETA * dt * dt));
-                self.slots.add_translational(asm, dofs, k, (i, j), &block);
-            }
-        }
-        // Rotational inertia Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), and its tangent by
-        // AD in a spin of Rₙ₊₁.
-        for (i, j0) in self.inertia.rotational.iter().enumerate() {
-            if *j0 == Matrix3::zeros() {
-                continue;
-            }
-            let (m, k) = spin_derivative(
-                &end.rot[i],
-                tangent.is_some(),
-                |r1| inertial_moment(j0, &start.rot[i], r1, prev, i, dt),
-                |r1| inertial_moment(j0, &start.rot[i], r1, prev, i, dt),
-            );
-            for c in 0..3 {
-                g[6 * i + 3 + c] += m[c];
-                abs[6 * i + 3 + c] += m[c].abs();
-            }
-            if let Some((asm, dofs)) = tangent.as_mut() {
-                self.slots.add_rotational(asm, dofs, i, &k);
-            }
-        }
+        // Translational inertia M aₙ₊₁, aₙ₊₁ = (u − Δt vₙ − Δt²(½−β)aₙ)/(βΔt²);
+        // rotational Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), its tangent by AD in a
+        // spin of Rₙ₊₁.
+        self.slots.add_inertia(
+            &self.inertia,
+            g,
+            abs,
+            tangent,
+            |j, m| {
+                let u = end.x[j] - start.x[j];
+                let a1 =
+                    (u - prev.v[j] * dt - prev.a[j] * (dt * dt * (0.5 - BETA))) / (BETA * dt * dt);
+                a1.map(|a| m * a)
+            },
+            |m| m / (BETA * dt * dt),
+            |i, j0, tangent| {
+                spin_derivative(
+                    &end.rot[i],
+                    tangent,
+                    |r1| inertial_moment(j0, &start.rot[i], r1, prev, i, dt),
+                    |r1| inertial_moment(j0, &start.rot[i], r1, prev, i, dt),
+                )
+            },
+        );
     }
 
     fn tangent_key(&self) -> f64 {
