@@ -2,6 +2,8 @@
 //! (Reissner–Simo) beam element kernels, generic over the scalar so that
 //! automatic differentiation (num-dual) runs through every kernel.
 
+#![warn(missing_docs)]
+
 pub mod rotation;
 pub mod rotation_derivatives;
 pub mod scalar;

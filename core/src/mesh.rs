@@ -12,17 +12,24 @@ use thiserror::Error;
 /// the mesh still refuses them so that no library path can panic).
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum MeshError {
+    /// Start and end coincide.
     #[error("beam has zero length")]
     ZeroLength,
+    /// The section's `e2` has no component normal to the beam axis.
     #[error("the section axis e2 is parallel to the beam axis")]
     ParallelE2,
+    /// An arc of zero radius.
     #[error("arc radius is zero")]
     ZeroRadius,
+    /// An arc normal that is zero or not normal to the radius.
     #[error("arc normal must be non-zero and perpendicular to start − center")]
     BadNormal,
+    /// No elements, or elements of other than 2 or 3 nodes.
     #[error("a beam needs at least one element with 2 or 3 nodes, got {elements} elements of {nodes_per_element} nodes")]
     BadElementCount {
+        /// Elements asked for.
         elements: usize,
+        /// Nodes per element asked for.
         nodes_per_element: usize,
     },
 }

@@ -10,8 +10,11 @@ use num_dual::{DualSVec64, HyperDualSVec64};
 /// A 3 × 3 matrix function of `p` with its derivatives: value,
 /// `∂M/∂pᵢ` and `∂²M/∂pᵢ∂pⱼ`.
 pub struct MatrixDerivatives {
+    /// `M(p)`.
     pub value: Matrix3<f64>,
+    /// `∂M/∂pᵢ`, `i = 0..3`.
     pub d1: [Matrix3<f64>; 3],
+    /// `∂²M/∂pᵢ∂pⱼ`.
     pub d2: [[Matrix3<f64>; 3]; 3],
 }
 

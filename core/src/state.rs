@@ -6,7 +6,9 @@ use nalgebra::{Matrix3, Vector3, Vector4};
 /// Positions `xᵢ` and rotations `Rᵢ` (from the initial configuration) of every node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Configuration {
+    /// Nodal positions.
     pub x: Vec<Vector3<f64>>,
+    /// Nodal rotations from the initial triads (`Λᵢ = Rᵢ Λᵢ,₀`).
     pub rot: Vec<Matrix3<f64>>,
 }
 

@@ -20,8 +20,9 @@ use std::collections::VecDeque;
 pub struct BandStructure {
     /// `perm[i]`: the new index of unknown `i`.
     pub perm: Vec<usize>,
-    /// Lower and upper bandwidth of the permuted pattern.
+    /// Lower bandwidth of the permuted pattern.
     pub kl: usize,
+    /// Upper bandwidth of the permuted pattern.
     pub ku: usize,
 }
 

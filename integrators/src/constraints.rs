@@ -17,7 +17,9 @@ use nalgebra::{DMatrix, Matrix3, SMatrix, SVector, Vector3, Vector6};
 /// every joint: the complete state of a mechanism.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MechanismState {
+    /// Nodal positions and rotations.
     pub config: Configuration,
+    /// Every joint's released coordinates (model order).
     pub released: Vec<ReleasedState>,
     /// Current value of every prescribed nodal DOF (same order as
     /// [`Mechanism::prescribed`]).

@@ -9,8 +9,11 @@ pub enum SolveError {
     /// Newton did not reach the tolerance even after `halvings` step halvings.
     #[error("no convergence at t = {time} after {halvings} step halvings (last: {reason})")]
     NoConvergence {
+        /// Time (statics: load factor) the failed step aimed at.
         time: f64,
+        /// Halvings in force when it failed.
         halvings: usize,
+        /// The last Newton failure.
         reason: NewtonFailure,
     },
     /// The tangent could not be factorised (a mechanism or unsupported DOF).
@@ -28,10 +31,15 @@ pub enum SolveError {
         step_limit = flexmech_core::Element::ROTATION_STEP_LIMIT
     )]
     ElementRotation {
+        /// Index of the element in the mesh.
         element: usize,
+        /// ` of beam "name"` where known, else empty.
         beam: String,
+        /// Time (statics: load factor) of the rejected step.
         time: f64,
+        /// Relative rotation between the element's nodes, rad.
         angle: f64,
+        /// Its change in the step, rad.
         change: f64,
     },
     /// A prescribed nodal rotation changed by more than the step limit in one
@@ -44,8 +52,11 @@ pub enum SolveError {
         limit = flexmech_core::Element::ROTATION_STEP_LIMIT
     )]
     PrescribedRotationStep {
+        /// Index of the prescribed DOF.
         index: usize,
+        /// Time (statics: load factor) of the rejected step.
         time: f64,
+        /// The value's change in the step, rad.
         change: f64,
     },
     /// A converged state whose tangent is singular: the answer is not unique
@@ -55,8 +66,11 @@ pub enum SolveError {
          {condition:.1e}), so the solution is not unique — {motion}"
     )]
     Unrestrained {
+        /// Time (statics: load factor) of the state.
         time: f64,
+        /// Estimated condition number of the equilibrated tangent.
         condition: f64,
+        /// What is free, in the mechanism's terms.
         motion: Box<FreeMotion>,
     },
     /// The mechanism is inconsistent (for example a DOF that no element touches).
@@ -67,23 +81,41 @@ pub enum SolveError {
 /// Why one Newton solve failed.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum NewtonFailure {
+    /// The iteration limit was reached above the tolerance.
     #[error("residual {residual:.3e} above tolerance after {iterations} iterations")]
-    MaxIterations { iterations: usize, residual: f64 },
+    MaxIterations {
+        /// Linear solves performed.
+        iterations: usize,
+        /// The last scaled residual.
+        residual: f64,
+    },
+    /// The residual became NaN or infinite.
     #[error("residual is not finite at iteration {iteration}")]
-    NotFinite { iteration: usize },
+    NotFinite {
+        /// Iteration at which it was evaluated.
+        iteration: usize,
+    },
+    /// The residual grew by the divergence factor
+    /// ([`crate::tolerances::Tolerances::divergence_growth`]).
     #[error("residual grew to {residual:.3e} (from {initial:.3e}) at iteration {iteration}")]
     Diverged {
+        /// Iteration at which it was detected.
         iteration: usize,
+        /// The scaled residual then.
         residual: f64,
+        /// The first iterate's scaled residual.
         initial: f64,
     },
+    /// The sparse factorisation or solve failed.
     #[error("the linear solve failed: {0}")]
     LinearSolve(String),
     /// The tangent at the converged iterate is singular (see
     /// [`crate::newton::SINGULAR_CONDITION`]).
     #[error("singular tangent (condition number {condition:.1e}): {motion}")]
     Singular {
+        /// Estimated condition number of the equilibrated tangent.
         condition: f64,
+        /// What is free, in the mechanism's terms.
         motion: Box<FreeMotion>,
         /// At the converged iterate (the answer is not unique: no smaller
         /// step cures it), or at the start of the step (a smaller step may).

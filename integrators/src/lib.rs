@@ -2,6 +2,8 @@
 //! solves, Newton's method with step control, and the solvers (statics and
 //! the time integrators).
 
+#![warn(missing_docs)]
+
 pub mod assembly;
 pub mod band_lu;
 pub mod constraints;

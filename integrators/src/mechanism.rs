@@ -39,17 +39,25 @@ impl fmt::Debug for Schedule {
 /// A dead nodal force and a fixed-axis (spatial) moment, scaled by `scale(t)`.
 #[derive(Debug, Clone)]
 pub struct NodalLoad {
+    /// The loaded node.
     pub node: usize,
+    /// Force (global components).
     pub force: Vector3<f64>,
+    /// Moment about fixed global axes.
     pub moment: Vector3<f64>,
+    /// Time function scaling both (statics: of the load factor).
     pub scale: Schedule,
 }
 
 /// A joint of the mechanism: master–slave relation (1) between two nodes.
 #[derive(Debug, Clone)]
 pub struct JointInstance {
+    /// The joint's name (results, messages).
     pub name: String,
+    /// Master node: its pose carries the joint frame.
     pub master: usize,
+    /// Slave node: placed by relation (1) from the master and the released
+    /// coordinates; its DOFs are eliminated.
     pub slave: usize,
     /// The joint kind's kinematics and derived maps.
     pub map: Arc<dyn JointMap>,
@@ -63,17 +71,22 @@ pub struct JointInstance {
 /// displacement from the initial position, or rotation about the global axis.
 #[derive(Debug, Clone)]
 pub struct PrescribedDof {
+    /// The node.
     pub node: usize,
+    /// Which DOF: 0..3 translations, 3..6 rotations about global axes.
     pub dof: usize,
+    /// Its value over time (statics: over the load factor).
     pub value: Schedule,
 }
 
 /// Everything a solver needs about the mechanism.
 #[derive(Debug, Clone)]
 pub struct Mechanism {
+    /// Beams: nodes and elements.
     pub mesh: Mesh,
     /// Per node `[ux, uy, uz, rx, ry, rz]`: true where held at the initial value.
     pub fixed: Vec<[bool; 6]>,
+    /// Nodal loads.
     pub loads: Vec<NodalLoad>,
     /// Gravity acceleration (acts on `ρA`).
     pub gravity: Vector3<f64>,

@@ -97,7 +97,7 @@ pub struct NewtonReport {
 /// Runs Newton's method from the system's current iterate. `r` and `dq` are
 /// caller-owned scratch vectors of length `n_eq`. A singular tangent at the
 /// start of the solve or at the converged iterate ends it in
-/// [`NewtonFailure::Singular`] (see [`check_regular`]); one met on the way
+/// [`NewtonFailure::Singular`] (two triangular solves estimate its condition number); one met on the way
 /// (a wild iterate) is left to the failure it causes, which step control
 /// can cure.
 pub fn solve<S: NewtonSystem>(

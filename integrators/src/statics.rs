@@ -2,7 +2,7 @@
 //! factor λ runs from 0 to 1; each step (for driven mechanisms: from the
 //! secant prediction of the previous one) is solved by Newton with the exact
 //! tangent; a step that fails is retried with half the increment, never
-//! below `nominal/2^max_halvings` ([`StepControl`]: the halving level is kept
+//! below `nominal/2^max_halvings` (the shared step control: the halving level is kept
 //! across successes), and the increment grows back to nominal after three
 //! easy steps. Every planned level `k/load_steps` is reached
 //! exactly; halvings only insert levels between them.

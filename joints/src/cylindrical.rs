@@ -8,7 +8,9 @@ use nalgebra::{Matrix3, Vector3};
 /// The cylindrical joint.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cylindrical {
+    /// Unit axis of the released rotation (master frame).
     pub axis: Vector3<f64>,
+    /// Unit direction of the released translation (master frame).
     pub slide: Vector3<f64>,
 }
 

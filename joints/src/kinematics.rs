@@ -14,7 +14,7 @@
 //!
 //! A joint kind implements [`JointKinematics`] — the released translation and
 //! rotation as functions of the released coordinates, generic over the scalar.
-//! The blanket implementation of [`JointMap`] derives, with num-dual, the
+//! The blanket implementation of [`JointMap`](crate::JointMap) derives, with num-dual, the
 //! variational map `N` of paper eqs 5–6 (`p_s = N p_Rm`) and the derivative of
 //! `Nᵀ g` that Newton's tangent needs. No kind writes a derivative by hand.
 
@@ -62,7 +62,9 @@ impl ReleasedState {
 /// them separately to obtain mixed second derivatives.
 #[derive(Debug, Clone, Copy)]
 pub struct Increments<'a, T> {
+    /// The increment applied last (outermost).
     pub first: &'a [T],
+    /// The increment applied first.
     pub second: &'a [T],
 }
 

@@ -10,6 +10,8 @@
 //! the paper's incremental map `Ñ`; [`incremental`] gives every kind its exact
 //! step map for the conserving schemes.
 
+#![warn(missing_docs)]
+
 pub mod cam;
 pub mod cylindrical;
 pub mod dependent;

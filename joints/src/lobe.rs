@@ -33,29 +33,60 @@ use thiserror::Error;
 pub enum LobeError {
     /// A periodic spline needs at least three rows (two intervals).
     #[error("a lift table needs at least 3 rows (angle, lift), got {rows}")]
-    TooFewRows { rows: usize },
+    TooFewRows {
+        /// Rows given.
+        rows: usize,
+    },
     /// An angle or a lift is NaN or infinite.
     #[error("row {row} of the lift table is not finite: angle {angle}, lift {lift}")]
-    NonFiniteRow { row: usize, angle: f64, lift: f64 },
+    NonFiniteRow {
+        /// Row index, from 0.
+        row: usize,
+        /// Its angle.
+        angle: f64,
+        /// Its lift.
+        lift: f64,
+    },
     /// Angles must be strictly increasing.
     #[error("the angles of the lift table must be strictly increasing: row {row} has angle {angle} after {previous}")]
     NonIncreasing {
+        /// Row index, from 0.
         row: usize,
+        /// The previous row's angle.
         previous: f64,
+        /// This row's angle.
         angle: f64,
     },
     /// The lift of the last row must equal the lift of the first (one full period).
     #[error("the lift table is not periodic: the first row has lift {first}, the last {last} (they must be equal)")]
-    NotPeriodic { first: f64, last: f64 },
+    NotPeriodic {
+        /// Lift of the first row.
+        first: f64,
+        /// Lift of the last row.
+        last: f64,
+    },
     /// Fourier coefficients come as `[a0, a1, b1, a2, b2, …]`: an odd count.
     #[error("Fourier lift coefficients are [a0, a1, b1, a2, b2, ...]: expected an odd count, got {count}")]
-    FourierCount { count: usize },
+    FourierCount {
+        /// Coefficients given.
+        count: usize,
+    },
     /// A Fourier coefficient is NaN or infinite.
     #[error("Fourier lift coefficient {index} is not finite: {value}")]
-    NonFiniteCoefficient { index: usize, value: f64 },
+    NonFiniteCoefficient {
+        /// Coefficient index, from 0.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
     /// The axis and the slide direction must be finite unit vectors.
     #[error("the lobe's {name} must be a unit vector, its length is {norm}")]
-    NotUnit { name: &'static str, norm: f64 },
+    NotUnit {
+        /// `"axis"` or `"slide"`.
+        name: &'static str,
+        /// Its length.
+        norm: f64,
+    },
 }
 
 /// A periodic cubic spline through `(xᵢ, yᵢ)`, `i = 0..n`, with period

@@ -8,6 +8,7 @@ use nalgebra::{Matrix3, Vector3};
 /// The prismatic joint.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Prismatic {
+    /// Unit direction of the released translation (master frame).
     pub slide: Vector3<f64>,
 }
 

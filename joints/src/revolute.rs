@@ -8,6 +8,7 @@ use nalgebra::Vector3;
 /// The revolute joint about the unit `axis` (master body frame).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Revolute {
+    /// Unit axis of the released rotation (master frame).
     pub axis: Vector3<f64>,
 }
 

@@ -31,7 +31,7 @@ use crate::record::StepRecord;
 use flexmech_core::Configuration;
 
 /// Integrates `mech` from `initial` with the paper's energy–momentum scheme
-/// (bordered Newton: [`super::bordered`]).
+/// (bordered Newton on `(q, β)`).
 pub fn solve(
     mech: &Mechanism,
     settings: &DynamicSettings,

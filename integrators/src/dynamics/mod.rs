@@ -82,7 +82,9 @@ pub struct DynamicSettings {
 /// (`Ṙ = R Ŵ`, `R` the nodal rotation from the initial configuration).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Motion {
+    /// Translational velocity of every node (spatial).
     pub v: Vec<Vector3<f64>>,
+    /// Body angular velocity `W` of every node.
     pub w: Vec<Vector3<f64>>,
     /// Initial rate of each joint's first released coordinate (missing
     /// entries are zero). Slave velocities follow from their master's and
