@@ -3,8 +3,10 @@
 //! smallest and largest released displacements.
 
 use crate::dependent::DependentJoint;
+use crate::model_joint::{direction, perpendicular_slide, positive, ModelJoint, ParamError};
 use flexmech_core::{cst, Scalar};
 use nalgebra::Vector3;
+use serde::Deserialize;
 
 /// The eccentric cam.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -27,5 +29,34 @@ impl DependentJoint for Cam {
     fn translation<T: Scalar>(&self, psi: T) -> Vector3<T> {
         let r = cst::<T>(self.radius);
         self.slide.map(cst::<T>) * (r * psi.cos() - r - cst::<T>(self.offset))
+    }
+}
+
+/// Parameters of a `cam` joint in model files.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CamParams {
+    /// Cam axis `t` (normalised).
+    pub axis: [f64; 3],
+    /// Eccentricity `R` (> 0).
+    pub radius: f64,
+    /// Offset `a`.
+    pub offset: f64,
+    /// Follower direction `t_r`, perpendicular to `axis`.
+    pub slide: [f64; 3],
+}
+
+impl ModelJoint for Cam {
+    const NAME: &'static str = "cam";
+    type Params = CamParams;
+    fn from_params(p: CamParams) -> Result<Self, ParamError> {
+        let axis = direction("axis", p.axis)?;
+        let radius = positive("radius", p.radius)?;
+        Ok(Cam {
+            axis,
+            radius,
+            offset: p.offset,
+            slide: perpendicular_slide(Self::NAME, p.slide, &axis)?,
+        })
     }
 }

@@ -2,8 +2,10 @@
 //! released translation `s` along `slide`: `r_R = s t_r`, `Λ_R = exp((ψ−ψ₀) t̂)`.
 
 use crate::kinematics::{axis_rotation, Increments, JointKinematics, ReleasedState};
+use crate::model_joint::{direction, ModelJoint, ParamError};
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Matrix3, Vector3};
+use serde::Deserialize;
 
 /// The cylindrical joint.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,5 +33,26 @@ impl JointKinematics for Cylindrical {
 
     fn coordinate_names(&self) -> &'static [&'static str] {
         &["angle", "slide"]
+    }
+}
+
+/// Parameters of a `cylindrical` joint in model files.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CylindricalParams {
+    /// Axis of the released rotation.
+    pub axis: [f64; 3],
+    /// Direction of the released translation.
+    pub slide: [f64; 3],
+}
+
+impl ModelJoint for Cylindrical {
+    const NAME: &'static str = "cylindrical";
+    type Params = CylindricalParams;
+    fn from_params(p: CylindricalParams) -> Result<Self, ParamError> {
+        Ok(Cylindrical {
+            axis: direction("axis", p.axis)?,
+            slide: direction("slide", p.slide)?,
+        })
     }
 }

@@ -24,8 +24,10 @@
 //! quadrature is not exact there and falls back to the difference quotient).
 
 use crate::dependent::DependentJoint;
+use crate::model_joint::{common_key_help, direction, perpendicular_slide, ModelJoint, ParamError};
 use flexmech_core::{cst, Scalar};
 use nalgebra::Vector3;
+use serde::Deserialize;
 use thiserror::Error;
 
 /// Why a lobe (its lift table, Fourier coefficients or directions) was refused.
@@ -342,6 +344,133 @@ impl Lobe {
             }
         }
         Ok(Self { axis, slide, lift })
+    }
+}
+
+/// Parameters of a `lobe` joint in model files.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LobeParams {
+    /// Lobe axis `t` (normalised).
+    pub axis: [f64; 3],
+    /// Follower direction `t_r`, perpendicular to `axis`.
+    pub slide: [f64; 3],
+    /// The lift profile.
+    pub lift: LiftParams,
+}
+
+/// `lift = { table = [[angle, lift], ...] }` or `lift = { fourier = [a0, a1, b1, ...] }`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LiftParams {
+    /// Periodic table of `(angle, lift)` rows.
+    pub table: Option<Vec<[f64; 2]>>,
+    /// Fourier coefficients `[a0, a1, b1, a2, b2, …]`.
+    pub fourier: Option<Vec<f64>>,
+}
+
+impl LiftParams {
+    /// The lift, with the model-file checks: one of the two forms; a table of
+    /// at least 3 rows with strictly increasing angles whose last lift equals
+    /// the first (to `10⁻¹²` of the largest lift); an odd number of Fourier
+    /// coefficients.
+    pub fn lift(&self) -> Result<Lift, ParamError> {
+        match (&self.table, &self.fourier) {
+            (Some(_), Some(_)) => Err(ParamError::new(
+                "lift.fourier",
+                "give either `table` or `fourier`, not both",
+            )),
+            (None, None) => Err(ParamError::new(
+                "lift",
+                "expected lift = { table = [[angle, lift], ...] } or lift = { fourier = [a0, a1, b1, ...] }",
+            )),
+            (Some(rows), None) => {
+                let key = "lift.table";
+                if rows.len() < 3 {
+                    return Err(ParamError::new(
+                        key,
+                        format!(
+                            "a periodic lift table needs at least 3 rows [angle, lift], found {}",
+                            rows.len()
+                        ),
+                    ));
+                }
+                let pairs: Vec<(f64, f64)> = rows.iter().map(|r| (r[0], r[1])).collect();
+                for (r, w) in pairs.windows(2).enumerate() {
+                    if w[1].0 <= w[0].0 {
+                        return Err(ParamError::new(
+                            key,
+                            format!(
+                                "angles must be strictly increasing, but row {} has angle {:?} \
+                                 after {:?} in row {r}",
+                                r + 1,
+                                w[1].0,
+                                w[0].0
+                            ),
+                        )
+                        .at_item(r + 1));
+                    }
+                }
+                let (first, last) = (pairs[0], pairs[pairs.len() - 1]);
+                let scale = pairs.iter().fold(0.0_f64, |m, p| m.max(p.1.abs()));
+                if (last.1 - first.1).abs() > PERIODIC_LIFT_TOLERANCE * scale {
+                    return Err(ParamError::new(
+                        key,
+                        format!(
+                            "the lift profile is periodic (period = last angle − first angle = {:?}), \
+                             so the last lift must equal the first: found {:?} at angle {:?} and \
+                             {:?} at angle {:?}; end the table with [{:?}, {:?}]",
+                            last.0 - first.0,
+                            first.1,
+                            first.0,
+                            last.1,
+                            last.0,
+                            last.0,
+                            first.1
+                        ),
+                    )
+                    .at_item(pairs.len() - 1));
+                }
+                Lift::table(&pairs).map_err(|e| ParamError::new(key, e.to_string()))
+            }
+            (None, Some(c)) => {
+                if c.len() % 2 != 1 {
+                    return Err(ParamError::new(
+                        "lift.fourier",
+                        format!(
+                            "expected [a0, a1, b1, a2, b2, ...], an odd number of coefficients \
+                             (a0, then cos/sin pairs), found {}",
+                            c.len()
+                        ),
+                    ));
+                }
+                Lift::fourier(c).map_err(|e| ParamError::new("lift.fourier", e.to_string()))
+            }
+        }
+    }
+}
+
+/// Relative mismatch of a lift table's first and last lifts accepted as periodic.
+pub const PERIODIC_LIFT_TOLERANCE: f64 = 1e-12;
+
+impl ModelJoint for Lobe {
+    const NAME: &'static str = "lobe";
+    type Params = LobeParams;
+    fn from_params(p: LobeParams) -> Result<Self, ParamError> {
+        let axis = direction("axis", p.axis)?;
+        let slide = perpendicular_slide(Self::NAME, p.slide, &axis)?;
+        let lift = p.lift.lift()?;
+        Lobe::new(axis, slide, lift).map_err(|e| ParamError::new("lift", e.to_string()))
+    }
+
+    fn key_help(key: &str) -> Option<&'static str> {
+        match key {
+            "lift" => Some(
+                "its lift profile: lift = { table = [[angle, lift], ...] } or \
+                 lift = { fourier = [a0, a1, b1, ...] }",
+            ),
+            _ => common_key_help(key),
+        }
     }
 }
 

@@ -2,6 +2,7 @@
 //! `slide` direction, no released rotation: `r_R = s t_r`, `Λ_R = I`.
 
 use crate::kinematics::{Increments, JointKinematics, ReleasedState};
+use crate::model_joint::{direction, ModelJoint, ParamError, SlideParams};
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Matrix3, Vector3};
 
@@ -33,5 +34,15 @@ impl JointKinematics for Prismatic {
     /// No released rotation.
     fn reported_angle(&self, _: &ReleasedState) -> f64 {
         0.0
+    }
+}
+
+impl ModelJoint for Prismatic {
+    const NAME: &'static str = "prismatic";
+    type Params = SlideParams;
+    fn from_params(p: SlideParams) -> Result<Self, ParamError> {
+        Ok(Prismatic {
+            slide: direction("slide", p.slide)?,
+        })
     }
 }

@@ -4,8 +4,10 @@
 //! center at distance `b` from the rack.
 
 use crate::dependent::DependentJoint;
+use crate::model_joint::{direction, perpendicular_slide, positive, ModelJoint, ParamError};
 use flexmech_core::{cst, Scalar};
 use nalgebra::Vector3;
+use serde::Deserialize;
 
 /// The rack-and-pinion joint.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,5 +28,31 @@ impl DependentJoint for RackPinion {
     fn translation<T: Scalar>(&self, psi: T) -> Vector3<T> {
         let b = cst::<T>(self.radius);
         self.slide.cross(&self.axis).map(cst::<T>) * b + self.slide.map(cst::<T>) * (b * psi)
+    }
+}
+
+/// Parameters of a `rack_pinion` joint in model files.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RackPinionParams {
+    /// Pinion axis `t` (normalised).
+    pub axis: [f64; 3],
+    /// Pinion radius `b` (> 0).
+    pub radius: f64,
+    /// Rack direction `t_r`, perpendicular to `axis`.
+    pub slide: [f64; 3],
+}
+
+impl ModelJoint for RackPinion {
+    const NAME: &'static str = "rack_pinion";
+    type Params = RackPinionParams;
+    fn from_params(p: RackPinionParams) -> Result<Self, ParamError> {
+        let axis = direction("axis", p.axis)?;
+        let radius = positive("radius", p.radius)?;
+        Ok(RackPinion {
+            axis,
+            radius,
+            slide: perpendicular_slide(Self::NAME, p.slide, &axis)?,
+        })
     }
 }

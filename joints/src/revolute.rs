@@ -2,6 +2,7 @@
 //! released translation — the dependent joint with `f(ψ) = 0`.
 
 use crate::dependent::DependentJoint;
+use crate::model_joint::{direction, AxisParams, ModelJoint, ParamError};
 use flexmech_core::Scalar;
 use nalgebra::Vector3;
 
@@ -19,5 +20,15 @@ impl DependentJoint for Revolute {
 
     fn translation<T: Scalar>(&self, _psi: T) -> Vector3<T> {
         Vector3::zeros()
+    }
+}
+
+impl ModelJoint for Revolute {
+    const NAME: &'static str = "revolute";
+    type Params = AxisParams;
+    fn from_params(p: AxisParams) -> Result<Self, ParamError> {
+        Ok(Revolute {
+            axis: direction("axis", p.axis)?,
+        })
     }
 }

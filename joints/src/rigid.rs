@@ -2,6 +2,7 @@
 //! (`r_R = 0`, `Λ_R = I`), so two beams that meet at a point act as one.
 
 use crate::kinematics::{Increments, JointKinematics, ReleasedState};
+use crate::model_joint::{ModelJoint, NoParams, ParamError};
 use flexmech_core::Scalar;
 use nalgebra::{Matrix3, Vector3};
 
@@ -22,5 +23,13 @@ impl JointKinematics for Rigid {
 
     fn coordinate_names(&self) -> &'static [&'static str] {
         &[]
+    }
+}
+
+impl ModelJoint for Rigid {
+    const NAME: &'static str = "rigid";
+    type Params = NoParams;
+    fn from_params(_: NoParams) -> Result<Self, ParamError> {
+        Ok(Rigid)
     }
 }

@@ -2,8 +2,10 @@
 //! axis by the pitch times the angle, `f(ψ) = c ψ t` (`c`: advance per radian).
 
 use crate::dependent::DependentJoint;
+use crate::model_joint::{direction, ModelJoint, ParamError};
 use flexmech_core::{cst, Scalar};
 use nalgebra::Vector3;
+use serde::Deserialize;
 
 /// The screw joint.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,5 +23,26 @@ impl DependentJoint for Screw {
 
     fn translation<T: Scalar>(&self, psi: T) -> Vector3<T> {
         self.axis.map(cst::<T>) * (psi * cst::<T>(self.pitch))
+    }
+}
+
+/// Parameters of a `screw` joint in model files.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScrewParams {
+    /// Axis (normalised).
+    pub axis: [f64; 3],
+    /// Translation per radian along the axis.
+    pub pitch: f64,
+}
+
+impl ModelJoint for Screw {
+    const NAME: &'static str = "screw";
+    type Params = ScrewParams;
+    fn from_params(p: ScrewParams) -> Result<Self, ParamError> {
+        Ok(Screw {
+            axis: direction("axis", p.axis)?,
+            pitch: p.pitch,
+        })
     }
 }

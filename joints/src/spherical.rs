@@ -4,6 +4,7 @@
 //! is `δφ_s = δφ_m + Λ_m δω`.
 
 use crate::kinematics::{Increments, JointKinematics, ReleasedState, MAX_RELEASED};
+use crate::model_joint::{ModelJoint, NoParams, ParamError};
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -53,5 +54,13 @@ impl JointKinematics for Spherical {
     /// The magnitude of the released rotation.
     fn reported_angle(&self, state: &ReleasedState) -> f64 {
         log(&state.rot).norm()
+    }
+}
+
+impl ModelJoint for Spherical {
+    const NAME: &'static str = "spherical";
+    type Params = NoParams;
+    fn from_params(_: NoParams) -> Result<Self, ParamError> {
+        Ok(Spherical)
     }
 }

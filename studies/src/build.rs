@@ -2,17 +2,13 @@
 //! the beams, number the nodes, apply supports, loads and gravity.
 
 use crate::model::{
-    Analysis, BeamGeometry, IntegratorKind, JointKind, JointSpec, LiftSpec, Model, ModelError,
-    NodeRef, PrescribedSpec, TimeFunction,
+    Analysis, BeamGeometry, IntegratorKind, JointSpec, Model, ModelError, NodeRef, PrescribedSpec,
+    TimeFunction,
 };
 use flexmech_core::{Mesh, Section};
 use flexmech_integrators::dynamics::Motion;
 use flexmech_integrators::{JointInstance, Mechanism, NodalLoad, PrescribedDof, Schedule};
-use flexmech_joints::{
-    lobe::{Lift, Lobe},
-    Cam, Cylindrical, JointMap, Prismatic, RackPinion, ReleasedState, Revolute, Rigid, Screw,
-    Spherical, MAX_RELEASED,
-};
+use flexmech_joints::{JointMap, ReleasedState, MAX_RELEASED};
 use nalgebra::Vector3;
 use std::sync::Arc;
 
@@ -74,63 +70,14 @@ fn schedule_of(f: &TimeFunction) -> Schedule {
     Schedule::new(move |t| f.eval(t))
 }
 
-/// The kinematics of a joint kind and its initial released coordinates.
-fn joint_map(
-    model: &Model,
-    j: usize,
-    spec: &JointSpec,
-) -> Result<(Arc<dyn JointMap>, ReleasedState), ModelError> {
-    let v = |a: &[f64; 3]| Vector3::from(*a);
+/// The kinematics of a joint and its initial released coordinates: `angle`
+/// starts the first coordinate of kinds whose first coordinate is an angle.
+fn joint_map(spec: &JointSpec) -> (Arc<dyn JointMap>, ReleasedState) {
     let mut q0 = [0.0; MAX_RELEASED];
-    q0[0] = spec.angle;
-    let map: Arc<dyn JointMap> = match &spec.kind {
-        JointKind::Rigid => Arc::new(Rigid),
-        JointKind::Revolute { axis } => Arc::new(Revolute { axis: v(axis) }),
-        JointKind::Spherical => Arc::new(Spherical),
-        JointKind::Prismatic { slide } => Arc::new(Prismatic { slide: v(slide) }),
-        JointKind::Cylindrical { axis, slide } => Arc::new(Cylindrical {
-            axis: v(axis),
-            slide: v(slide),
-        }),
-        JointKind::Screw { axis, pitch } => Arc::new(Screw {
-            axis: v(axis),
-            pitch: *pitch,
-        }),
-        JointKind::RackPinion {
-            axis,
-            radius,
-            slide,
-        } => Arc::new(RackPinion {
-            axis: v(axis),
-            slide: v(slide),
-            radius: *radius,
-        }),
-        JointKind::Cam {
-            axis,
-            radius,
-            offset,
-            slide,
-        } => Arc::new(Cam {
-            axis: v(axis),
-            slide: v(slide),
-            radius: *radius,
-            offset: *offset,
-        }),
-        JointKind::Lobe { axis, slide, lift } => {
-            let lift = match lift {
-                LiftSpec::Table(rows) => Lift::table(rows),
-                LiftSpec::Fourier(c) => Lift::fourier(c),
-            };
-            let lobe = lift.and_then(|l| Lobe::new(v(axis), v(slide), l));
-            Arc::new(lobe.map_err(|e| {
-                ModelError::new(&model.path, format!("joint[{j}].lift"), None, e.to_string())
-            })?)
-        }
-    };
-    if let JointKind::Prismatic { .. } = spec.kind {
-        q0[0] = 0.0;
+    if spec.kind.has_angle() {
+        q0[0] = spec.angle;
     }
-    Ok((map, ReleasedState::new(q0)))
+    (spec.kind.map().clone(), ReleasedState::new(q0))
 }
 
 /// Builds the mechanism of `model`.
@@ -219,7 +166,7 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         .map(|x| x.norm())
         .fold(1.0, f64::max);
     for (j, spec) in model.joints.iter().enumerate() {
-        let (map, initial) = joint_map(model, j, spec)?;
+        let (map, initial) = joint_map(spec);
         let (master, slave) = (node(spec.master), node(spec.slave));
         // The slave must start where relation (1) puts it.
         let x0 = &mechanism.mesh.positions;

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod build;
 pub mod charts;
 mod checks;
+pub mod cli;
 pub mod fuzz;
 mod initial_check;
 pub mod model;

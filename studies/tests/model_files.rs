@@ -3,6 +3,9 @@
 
 use std::path::Path;
 
+use flexmech_joints::{
+    Cam, Cylindrical, Lift, Lobe, Prismatic, RackPinion, Revolute, Rigid, Screw, Spherical,
+};
 use flexmech_studies::model::*;
 
 /// A full model in the style of MODEL_FORMAT.md (with the `arm` beam it refers to).
@@ -292,17 +295,24 @@ fn full_file_parses_with_the_right_values() {
     assert_eq!(screw.name, "screw");
     assert_eq!(screw.master, NodeRef { beam: 0, node: 4 });
     assert_eq!(screw.slave, NodeRef { beam: 1, node: 0 });
-    match screw.kind {
-        JointKind::Screw { axis, pitch } => {
-            assert!(close(axis, [0.0, 0.0, 1.0]), "axis normalised: {axis:?}");
-            assert_eq!(pitch, 0.1);
+    match screw.kind.downcast_ref::<Screw>() {
+        Some(s) => {
+            assert!(
+                close(s.axis.into(), [0.0, 0.0, 1.0]),
+                "axis normalised: {s:?}"
+            );
+            assert_eq!(s.pitch, 0.1);
         }
-        ref k => panic!("wrong kind {k:?}"),
+        None => panic!("wrong kind {:?}", screw.kind),
     }
     assert_eq!((screw.angle, screw.rate), (0.25, 0.0));
     assert_eq!(screw.kind.type_name(), "screw");
     let weld = &m.joints[1];
-    assert_eq!(weld.kind, JointKind::Rigid);
+    assert!(
+        weld.kind.downcast_ref::<Rigid>().is_some(),
+        "{:?}",
+        weld.kind
+    );
     assert_eq!(weld.master, NodeRef { beam: 1, node: 6 });
     assert_eq!(weld.slave, NodeRef { beam: 2, node: 8 });
     assert_eq!((weld.angle, weld.rate), (0.0, 0.0));
@@ -451,46 +461,34 @@ lift = { fourier = [0.1, 0.02, 0.0] }
     let m = parse(&text).unwrap();
     let h = std::f64::consts::FRAC_1_SQRT_2;
     assert_eq!(m.joints.len(), 8);
-    match m.joints[0].kind {
-        JointKind::Revolute { axis } => assert!(close(axis, [0.0, 0.6, 0.8])),
-        ref k => panic!("{k:?}"),
-    }
-    assert_eq!(m.joints[1].kind, JointKind::Spherical);
-    match m.joints[2].kind {
-        JointKind::Prismatic { slide } => assert!(close(slide, [0.0, 0.0, -1.0])),
-        ref k => panic!("{k:?}"),
-    }
-    match m.joints[3].kind {
-        JointKind::Cylindrical { axis, slide } => {
-            assert!(close(axis, [1.0, 0.0, 0.0]) && close(slide, [1.0, 0.0, 0.0]))
-        }
-        ref k => panic!("{k:?}"),
-    }
-    match m.joints[4].kind {
-        JointKind::RackPinion { radius, slide, .. } => {
-            assert_eq!(radius, 0.5);
-            assert!(close(slide, [1.0, 0.0, 0.0]));
-        }
-        ref k => panic!("{k:?}"),
-    }
-    match m.joints[5].kind {
-        JointKind::Cam { radius, offset, .. } => assert_eq!((radius, offset), (0.2, -0.05)),
-        ref k => panic!("{k:?}"),
-    }
-    match &m.joints[6].kind {
-        JointKind::Lobe { slide, lift, .. } => {
-            assert!(close(*slide, [h, h, 0.0]));
-            assert_eq!(
-                *lift,
-                LiftSpec::Table(vec![(0.0, 0.1), (3.0, 0.3), (std::f64::consts::TAU, 0.1)])
-            );
-        }
-        k => panic!("{k:?}"),
-    }
-    match &m.joints[7].kind {
-        JointKind::Lobe { lift, .. } => assert_eq!(*lift, LiftSpec::Fourier(vec![0.1, 0.02, 0.0])),
-        k => panic!("{k:?}"),
-    }
+    let kind = |i: usize| &m.joints[i].kind;
+    let revolute = kind(0).downcast_ref::<Revolute>().expect("revolute");
+    assert!(close(revolute.axis.into(), [0.0, 0.6, 0.8]));
+    assert!(
+        kind(1).downcast_ref::<Spherical>().is_some(),
+        "{:?}",
+        kind(1)
+    );
+    let prismatic = kind(2).downcast_ref::<Prismatic>().expect("prismatic");
+    assert!(close(prismatic.slide.into(), [0.0, 0.0, -1.0]));
+    let cylindrical = kind(3).downcast_ref::<Cylindrical>().expect("cylindrical");
+    assert!(close(cylindrical.axis.into(), [1.0, 0.0, 0.0]));
+    assert!(close(cylindrical.slide.into(), [1.0, 0.0, 0.0]));
+    let rack = kind(4).downcast_ref::<RackPinion>().expect("rack_pinion");
+    assert_eq!(rack.radius, 0.5);
+    assert!(close(rack.slide.into(), [1.0, 0.0, 0.0]));
+    let cam = kind(5).downcast_ref::<Cam>().expect("cam");
+    assert_eq!((cam.radius, cam.offset), (0.2, -0.05));
+    let lobe = kind(6).downcast_ref::<Lobe>().expect("lobe");
+    assert!(close(lobe.slide.into(), [h, h, 0.0]));
+    // The table as written, and the spline through it.
+    assert_eq!(
+        kind(6).params()["lift"]["table"],
+        toml::Value::try_from(vec![[0.0, 0.1], [3.0, 0.3], [std::f64::consts::TAU, 0.1]]).unwrap()
+    );
+    assert!(matches!(&lobe.lift, Lift::Table(s) if s.knots() == [0.0, 3.0, std::f64::consts::TAU]));
+    let lobe = kind(7).downcast_ref::<Lobe>().expect("lobe");
+    assert_eq!(lobe.lift, Lift::Fourier(vec![0.1, 0.02, 0.0]));
 }
 
 #[test]

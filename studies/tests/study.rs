@@ -1,7 +1,7 @@
 //! `flexmech study`: parameter sweeps over a model file, run whole or in
 //! shards and merged, with their summary files and their errors.
 
-use flexmech_studies::model::JointKind;
+use flexmech_joints::Screw;
 use flexmech_studies::study::merge::MergeError;
 use flexmech_studies::study::{
     load_study, merge_study, parse_study, run_study, select_shard, Shard, ShardError, SlurmArray,
@@ -492,9 +492,9 @@ fn a_grid_key_missing_from_the_model_is_an_error_naming_it() {
     .unwrap();
     let screw = model.joints.iter().find(|j| j.name == "screw").unwrap();
     assert_eq!(screw.rate, 1.0);
-    match screw.kind {
-        JointKind::Screw { pitch, .. } => assert_eq!(pitch, 0.03),
-        ref other => panic!("{other:?}"),
+    match screw.kind.downcast_ref::<Screw>() {
+        Some(s) => assert_eq!(s.pitch, 0.03),
+        None => panic!("{:?}", screw.kind),
     }
 }
 

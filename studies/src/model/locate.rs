@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use std::ops::Range;
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
@@ -86,7 +87,7 @@ fn walk_value(value: &Spanned<DeValue<'_>>, offset: usize, path: &mut Vec<Seg>) 
 /// The key path (`beam[1].arc.sweep`) of the key or value at byte `offset`,
 /// found in the (possibly partial) parse of `text`; falls back to the enclosing
 /// `[table]` header found by reading the text.
-fn key_path_at(text: &str, offset: usize) -> String {
+pub(crate) fn key_path_at(text: &str, offset: usize) -> String {
     let (doc, _) = DeTable::parse_recoverable(text);
     let mut path = Vec::new();
     if walk_table(doc.get_ref(), offset, &mut path) {
@@ -250,4 +251,46 @@ pub(crate) fn deserialize_error(text: &str, file: &Path, err: &toml::de::Error) 
         }
     }
     ModelError::new(file, key, line, message)
+}
+
+/// The span of the key (or, for an array entry, the item) at the key path
+/// `path` (`joint[0].lift.table[2]`) in `text`, if it is there.
+pub(crate) fn span_at(text: &str, path: &str) -> Option<Range<usize>> {
+    let (doc, _) = DeTable::parse_recoverable(text);
+    let mut segs = Vec::new();
+    for part in path.split('.') {
+        let (key, mut rest) = part.split_once('[').map_or((part, ""), |(k, r)| (k, r));
+        segs.push(Seg::Key(key.to_string()));
+        while let Some((index, tail)) = rest.split_once(']') {
+            segs.push(Seg::Index(index.parse().ok()?));
+            rest = tail.strip_prefix('[').unwrap_or(tail);
+        }
+    }
+    let mut table = doc.get_ref();
+    let mut current: Option<&Spanned<DeValue<'_>>> = None;
+    let mut span = None;
+    for seg in &segs {
+        match seg {
+            Seg::Key(k) => {
+                if let Some(v) = current {
+                    match v.get_ref() {
+                        DeValue::Table(t) => table = t,
+                        _ => return None,
+                    }
+                }
+                let (key, value) = table.iter().find(|(key, _)| key.get_ref() == k)?;
+                span = Some(key.span());
+                current = Some(value);
+            }
+            Seg::Index(i) => match current?.get_ref() {
+                DeValue::Array(items) => {
+                    let item = items.get(*i)?;
+                    span = Some(item.span());
+                    current = Some(item);
+                }
+                _ => return None,
+            },
+        }
+    }
+    span
 }

@@ -22,28 +22,45 @@ pub mod error;
 mod labels;
 mod locate;
 mod raw;
+pub mod registry;
 pub mod time_function;
 pub mod types;
 mod validate;
 
 pub use error::ModelError;
+pub use registry::{JointKind, JointRegistry, RegistryError};
 pub use types::*;
 
 /// Reads and validates the model file at `path`. An unreadable file is a
 /// [`ModelError`] naming the file.
 pub fn load_model(path: &Path) -> Result<Model, ModelError> {
+    load_model_with(path, JointRegistry::global())
+}
+
+/// [`load_model`] with the joint kinds of `registry`.
+pub fn load_model_with(path: &Path, registry: &JointRegistry) -> Result<Model, ModelError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| ModelError::new(path, "", None, format!("cannot read the model file: {e}")))?;
-    parse_model(&text, path)
+    parse_model_with(&text, path, registry)
 }
 
 /// Parses and validates model-file `text`; `path` is used only in error
 /// messages and stored in [`Model::path`].
+/// Joint types are those of [`JointRegistry::global`].
 pub fn parse_model(text: &str, path: &Path) -> Result<Model, ModelError> {
+    parse_model_with(text, path, JointRegistry::global())
+}
+
+/// [`parse_model`] with the joint kinds of `registry`.
+pub fn parse_model_with(
+    text: &str,
+    path: &Path,
+    registry: &JointRegistry,
+) -> Result<Model, ModelError> {
     if let Err(e) = toml::de::DeTable::parse(text) {
         return Err(locate::syntax_error(text, path, &e));
     }
     let raw: raw::RawModel =
         toml::from_str(text).map_err(|e| locate::deserialize_error(text, path, &e))?;
-    validate::validate(raw, text, path)
+    validate::validate(raw, text, path, registry)
 }

@@ -124,32 +124,17 @@ pub(crate) struct RawSupport {
     pub fixed: Option<S<StrOrList>>,
 }
 
-/// `[[joint]]`: the union of every joint type's keys; the validator checks
-/// which belong to the given `type`.
+/// `[[joint]]`: the keys every joint has; the kind's own parameters are read
+/// from the same table by the joint registry (which refuses unknown keys).
 #[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub(crate) struct RawJoint {
     pub name: Option<S<String>>,
     #[serde(rename = "type")]
     pub kind: Option<S<String>>,
     pub master: Option<S<String>>,
     pub slave: Option<S<String>>,
-    pub axis: Option<S<Vec3>>,
-    pub slide: Option<S<Vec3>>,
-    pub pitch: Option<S<Num>>,
-    pub radius: Option<S<Num>>,
-    pub offset: Option<S<Num>>,
-    pub lift: Option<S<RawLift>>,
     pub angle: Option<S<Num>>,
     pub rate: Option<S<Num>>,
-}
-
-/// `lift = { table = [[angle, lift], ...] }` or `lift = { fourier = [...] }`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct RawLift {
-    pub table: Option<S<Vec<S<[Num; 2]>>>>,
-    pub fourier: Option<S<Vec<Num>>>,
 }
 
 /// `[[load]]`.

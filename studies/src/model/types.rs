@@ -92,58 +92,11 @@ pub struct SupportSpec {
     pub fixed: [bool; 6],
 }
 
-/// Lift profile of a `lobe` joint.
-#[derive(Debug, Clone, PartialEq)]
-pub enum LiftSpec {
-    /// Periodic table of `(angle, lift)` (period = last angle − first angle;
-    /// first and last lift equal); interpolated smoothly (periodic cubic spline).
-    Table(Vec<(f64, f64)>),
-    /// `a0 + Σ_k (a_k cos kψ + b_k sin kψ)` from `[a0, a1, b1, a2, b2, …]`.
-    Fourier(Vec<f64>),
-}
-
-/// The kind of a joint and its parameters. Directions are unit vectors (the
-/// loader normalises them), global at t = 0.
-#[derive(Debug, Clone, PartialEq)]
-pub enum JointKind {
-    Rigid,
-    Revolute {
-        axis: [f64; 3],
-    },
-    Spherical,
-    Prismatic {
-        slide: [f64; 3],
-    },
-    Cylindrical {
-        axis: [f64; 3],
-        slide: [f64; 3],
-    },
-    Screw {
-        axis: [f64; 3],
-        pitch: f64,
-    },
-    RackPinion {
-        axis: [f64; 3],
-        radius: f64,
-        slide: [f64; 3],
-    },
-    Cam {
-        axis: [f64; 3],
-        radius: f64,
-        offset: f64,
-        slide: [f64; 3],
-    },
-    Lobe {
-        axis: [f64; 3],
-        slide: [f64; 3],
-        lift: LiftSpec,
-    },
-}
-
 #[derive(Debug, Clone, PartialEq)]
 pub struct JointSpec {
     pub name: String,
-    pub kind: JointKind,
+    /// The registered kind and its parameters ([`super::JointRegistry`]).
+    pub kind: super::JointKind,
     pub master: NodeRef,
     pub slave: NodeRef,
     /// Initial released angle ψ₀ (default 0).

@@ -1,95 +1,39 @@
-//! Joints: types and their parameters, lift profiles, and the topology checks.
+//! Joints: the common keys, the kinds' parameters (through the joint
+//! registry), and the topology checks.
 
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::{dot, fmt_v, Ctx, Res, ANGLE_TOL};
-use crate::model::raw::{v3, RawJoint, RawLift, RawSupport, S};
+use super::{Ctx, Res};
+use crate::model::locate::span_at;
+use crate::model::raw::{RawJoint, RawSupport, S};
+use crate::model::registry::{JointKind, ParamsError};
 use crate::model::types::*;
-
-// ---------------------------------------------------------------------------
-// Joint types.
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum JointType {
-    Rigid,
-    Revolute,
-    Spherical,
-    Prismatic,
-    Cylindrical,
-    Screw,
-    RackPinion,
-    Cam,
-    Lobe,
-}
-
-const JOINT_TYPES: [(&str, JointType); 9] = [
-    ("rigid", JointType::Rigid),
-    ("revolute", JointType::Revolute),
-    ("spherical", JointType::Spherical),
-    ("prismatic", JointType::Prismatic),
-    ("cylindrical", JointType::Cylindrical),
-    ("screw", JointType::Screw),
-    ("rack_pinion", JointType::RackPinion),
-    ("cam", JointType::Cam),
-    ("lobe", JointType::Lobe),
-];
-
-impl JointType {
-    /// The type's parameter keys: required, then optional.
-    fn keys(self) -> (&'static [&'static str], &'static [&'static str]) {
-        const ANGLE: &[&str] = &["angle", "rate"];
-        match self {
-            JointType::Rigid | JointType::Spherical => (&[], &[]),
-            JointType::Revolute => (&["axis"], ANGLE),
-            JointType::Prismatic => (&["slide"], &[]),
-            JointType::Cylindrical => (&["axis", "slide"], ANGLE),
-            JointType::Screw => (&["axis", "pitch"], ANGLE),
-            JointType::RackPinion => (&["axis", "radius", "slide"], ANGLE),
-            JointType::Cam => (&["axis", "radius", "offset", "slide"], ANGLE),
-            JointType::Lobe => (&["axis", "slide", "lift"], ANGLE),
-        }
-    }
-}
-
-impl JointKind {
-    /// The joint's `type` as written in model files (`"rack_pinion"`, ...).
-    pub fn type_name(&self) -> &'static str {
-        match self {
-            JointKind::Rigid => "rigid",
-            JointKind::Revolute { .. } => "revolute",
-            JointKind::Spherical => "spherical",
-            JointKind::Prismatic { .. } => "prismatic",
-            JointKind::Cylindrical { .. } => "cylindrical",
-            JointKind::Screw { .. } => "screw",
-            JointKind::RackPinion { .. } => "rack_pinion",
-            JointKind::Cam { .. } => "cam",
-            JointKind::Lobe { .. } => "lobe",
-        }
-    }
-}
-
-/// What a missing joint parameter is, for messages.
-fn joint_key_help(key: &str) -> &'static str {
-    match key {
-        "axis" => "its released rotation axis, e.g. axis = [0.0, 0.0, 1.0]",
-        "slide" => "its slide direction t_r, e.g. slide = [1.0, 0.0, 0.0]",
-        "pitch" => "its pitch (translation per radian along the axis), e.g. pitch = 0.1",
-        "radius" => "its radius (> 0), e.g. radius = 0.05",
-        "offset" => "its offset a, e.g. offset = 0.0",
-        "lift" => {
-            "its lift profile: lift = { table = [[angle, lift], ...] } or \
-             lift = { fourier = [a0, a1, b1, ...] }"
-        }
-        _ => "this key",
-    }
-}
 
 // ---------------------------------------------------------------------------
 // The validator.
 
+/// The keys of a `[[joint]]` table that every kind has; the rest are the
+/// kind's parameters.
+const COMMON_KEYS: [&str; 6] = ["name", "type", "master", "slave", "angle", "rate"];
+
 impl Ctx<'_> {
     pub(super) fn joints(&self, raw: &[S<RawJoint>], beams: &[BeamSpec]) -> Res<Vec<JointSpec>> {
+        // The joint tables as plain TOML values: the kinds' parameters.
+        let tables: Vec<toml::Table> = toml::from_str::<toml::Table>(self.text)
+            .ok()
+            .and_then(|mut doc| doc.remove("joint"))
+            .and_then(|v| match v {
+                toml::Value::Array(items) => Some(items),
+                _ => None,
+            })
+            .unwrap_or_default()
+            .into_iter()
+            .map(|v| match v {
+                toml::Value::Table(t) => t,
+                _ => toml::Table::new(),
+            })
+            .collect();
         let mut out: Vec<JointSpec> = Vec::new();
         for (i, entry) in raw.iter().enumerate() {
             let tk = format!("joint[{i}]");
@@ -112,11 +56,7 @@ impl Ctx<'_> {
                     format!("duplicate joint name \"{name}\" (joint[{o}] has it too); joint names must be unique"),
                 ));
             }
-            let all_types = JOINT_TYPES
-                .iter()
-                .map(|(n, _)| *n)
-                .collect::<Vec<_>>()
-                .join("|");
+            let all_types = self.registry.names().collect::<Vec<_>>().join("|");
             let type_s = self.need(
                 &j.kind,
                 &k("type"),
@@ -124,56 +64,39 @@ impl Ctx<'_> {
                 &format!("the joint type, one of {all_types}"),
             )?;
             let type_name = type_s.get_ref().as_str();
-            let Some(&(_, jt)) = JOINT_TYPES.iter().find(|(n, _)| *n == type_name) else {
+            if !self.registry.contains(type_name) {
                 return Err(self.at(
                     k("type"),
                     type_s,
                     format!("unknown joint type \"{type_name}\"; expected one of {all_types}"),
                 ));
-            };
+            }
+            let mut params = tables.get(i).cloned().unwrap_or_default();
+            params.retain(|key, _| !COMMON_KEYS.contains(&key));
+            let kind = self.joint_kind(type_name, &params, i, &hs)?;
 
-            // Keys that do not belong to this type.
-            let present: [(&str, Option<Range<usize>>); 8] = [
-                ("axis", j.axis.as_ref().map(S::span)),
-                ("slide", j.slide.as_ref().map(S::span)),
-                ("pitch", j.pitch.as_ref().map(S::span)),
-                ("radius", j.radius.as_ref().map(S::span)),
-                ("offset", j.offset.as_ref().map(S::span)),
-                ("lift", j.lift.as_ref().map(S::span)),
-                ("angle", j.angle.as_ref().map(S::span)),
-                ("rate", j.rate.as_ref().map(S::span)),
-            ];
-            let (required, optional) = jt.keys();
-            for (key, span) in &present {
-                if span.is_some() && !required.contains(key) && !optional.contains(key) {
-                    let takes = if required.is_empty() && optional.is_empty() {
-                        "no keys besides name, type, master and slave".to_string()
+            // `angle` and `rate` belong to kinds whose first released
+            // coordinate is an angle.
+            for (key, value) in [("angle", &j.angle), ("rate", &j.rate)] {
+                if let (Some(v), false) = (value, kind.has_angle()) {
+                    let names = kind.map().coordinate_names();
+                    let why = if names.is_empty() {
+                        " (it has no released angle)".to_string()
+                    } else if names.len() == 3 {
+                        " (it releases three rotations, not one angle)".to_string()
                     } else {
-                        let mut parts: Vec<String> =
-                            required.iter().map(|r| format!("`{r}`")).collect();
-                        if !optional.is_empty() {
-                            parts.push(format!(
-                                "optionally {}",
-                                optional
-                                    .iter()
-                                    .map(|r| format!("`{r}`"))
-                                    .collect::<Vec<_>>()
-                                    .join(", ")
-                            ));
-                        }
-                        parts.join(", ")
+                        format!(
+                            " (its released coordinates are {}, not an angle)",
+                            names.join(", ")
+                        )
                     };
-                    let why = match (*key, jt) {
-                        ("angle" | "rate", JointType::Spherical) => {
-                            " (it releases three rotations, not one angle)"
-                        }
-                        ("angle" | "rate", _) => " (it has no released angle)",
-                        _ => "",
-                    };
-                    return Err(self.err(
+                    return Err(self.at(
                         k(key),
-                        span.clone(),
-                        format!("`{key}` does not belong to a {type_name} joint{why}; a {type_name} joint takes {takes}"),
+                        v,
+                        format!(
+                            "`{key}` does not belong to a {type_name} joint{why}; a {type_name} joint takes {}",
+                            self.takes(type_name)
+                        ),
                     ));
                 }
             }
@@ -216,87 +139,6 @@ impl Ctx<'_> {
                     ),
                 ));
             }
-
-            let need = |key: &str| format!("a {type_name} joint needs {}", joint_key_help(key));
-            let axis = || -> Res<[f64; 3]> {
-                let v = self.need(&j.axis, &k("axis"), &hs, &need("axis"))?;
-                self.direction(v, &k("axis"))
-            };
-            let slide = || -> Res<[f64; 3]> {
-                let v = self.need(&j.slide, &k("slide"), &hs, &need("slide"))?;
-                self.direction(v, &k("slide"))
-            };
-            let perpendicular_slide = |axis: [f64; 3]| -> Res<[f64; 3]> {
-                let v = self.need(&j.slide, &k("slide"), &hs, &need("slide"))?;
-                let s = self.direction(v, &k("slide"))?;
-                let cos = dot(s, axis);
-                if cos.abs() > ANGLE_TOL {
-                    return Err(self.at(
-                        k("slide"),
-                        v,
-                        format!(
-                            "must be perpendicular to `axis` for a {type_name} joint, found slide = {} \
-                             and axis = {} with |cos(angle)| = {:.3e}",
-                            fmt_v(v3(v.get_ref())),
-                            fmt_v(axis),
-                            cos.abs()
-                        ),
-                    ));
-                }
-                Ok(s)
-            };
-            let radius = || -> Res<f64> {
-                let v = self.need(&j.radius, &k("radius"), &hs, &need("radius"))?;
-                self.positive(v, &k("radius"))
-            };
-            let kind = match jt {
-                JointType::Rigid => JointKind::Rigid,
-                JointType::Spherical => JointKind::Spherical,
-                JointType::Revolute => JointKind::Revolute { axis: axis()? },
-                JointType::Prismatic => JointKind::Prismatic { slide: slide()? },
-                JointType::Cylindrical => JointKind::Cylindrical {
-                    axis: axis()?,
-                    slide: slide()?,
-                },
-                JointType::Screw => {
-                    let axis = axis()?;
-                    let pitch = self.need(&j.pitch, &k("pitch"), &hs, &need("pitch"))?;
-                    JointKind::Screw {
-                        axis,
-                        pitch: pitch.get_ref().0,
-                    }
-                }
-                JointType::RackPinion => {
-                    let axis = axis()?;
-                    let radius = radius()?;
-                    JointKind::RackPinion {
-                        axis,
-                        radius,
-                        slide: perpendicular_slide(axis)?,
-                    }
-                }
-                JointType::Cam => {
-                    let axis = axis()?;
-                    let radius = radius()?;
-                    let offset = self.need(&j.offset, &k("offset"), &hs, &need("offset"))?;
-                    JointKind::Cam {
-                        axis,
-                        radius,
-                        offset: offset.get_ref().0,
-                        slide: perpendicular_slide(axis)?,
-                    }
-                }
-                JointType::Lobe => {
-                    let axis = axis()?;
-                    let slide = perpendicular_slide(axis)?;
-                    let lift = self.need(&j.lift, &k("lift"), &hs, &need("lift"))?;
-                    JointKind::Lobe {
-                        axis,
-                        slide,
-                        lift: self.lift(lift, &k("lift"))?,
-                    }
-                }
-            };
             out.push(JointSpec {
                 name,
                 kind,
@@ -309,90 +151,82 @@ impl Ctx<'_> {
         Ok(out)
     }
 
-    fn lift(&self, l: &S<RawLift>, key: &str) -> Res<LiftSpec> {
-        let lift = l.get_ref();
-        match (&lift.table, &lift.fourier) {
-            (Some(_), Some(f)) => Err(self.at(
-                format!("{key}.fourier"),
-                f,
-                "give either `table` or `fourier`, not both",
-            )),
-            (None, None) => Err(self.at(
-                key,
-                l,
-                "expected lift = { table = [[angle, lift], ...] } or lift = { fourier = [a0, a1, b1, ...] }",
-            )),
-            (Some(t), None) => {
-                let key = format!("{key}.table");
-                let rows = t.get_ref();
-                if rows.len() < 3 {
-                    return Err(self.at(
-                        key,
-                        t,
-                        format!(
-                            "a periodic lift table needs at least 3 rows [angle, lift], found {}",
-                            rows.len()
-                        ),
-                    ));
-                }
-                let pairs: Vec<(f64, f64)> = rows
-                    .iter()
-                    .map(|r| (r.get_ref()[0].0, r.get_ref()[1].0))
-                    .collect();
-                for (r, w) in pairs.windows(2).enumerate() {
-                    if w[1].0 <= w[0].0 {
-                        return Err(self.at(
-                            key,
-                            &rows[r + 1],
-                            format!(
-                                "angles must be strictly increasing, but row {} has angle {:?} \
-                                 after {:?} in row {r}",
-                                r + 1,
-                                w[1].0,
-                                w[0].0
-                            ),
-                        ));
-                    }
-                }
-                let first = pairs[0];
-                let last = pairs[pairs.len() - 1];
-                let scale = pairs.iter().fold(0.0_f64, |m, p| m.max(p.1.abs()));
-                if (last.1 - first.1).abs() > 1e-12 * scale {
-                    return Err(self.at(
-                        key,
-                        &rows[rows.len() - 1],
-                        format!(
-                            "the lift profile is periodic (period = last angle − first angle = {:?}), \
-                             so the last lift must equal the first: found {:?} at angle {:?} and \
-                             {:?} at angle {:?}; end the table with [{:?}, {:?}]",
-                            last.0 - first.0,
-                            first.1,
-                            first.0,
-                            last.1,
-                            last.0,
-                            last.0,
-                            first.1
-                        ),
-                    ));
-                }
-                Ok(LiftSpec::Table(pairs))
-            }
-            (None, Some(f)) => {
-                let c: Vec<f64> = f.get_ref().iter().map(|n| n.0).collect();
-                if c.len() % 2 != 1 {
-                    return Err(self.at(
-                        format!("{key}.fourier"),
-                        f,
-                        format!(
-                            "expected [a0, a1, b1, a2, b2, ...], an odd number of coefficients \
-                             (a0, then cos/sin pairs), found {}",
-                            c.len()
-                        ),
-                    ));
-                }
-                Ok(LiftSpec::Fourier(c))
-            }
+    /// "`axis`, `pitch`": the parameter keys of a kind.
+    fn takes(&self, type_name: &str) -> String {
+        let parts: Vec<String> = self
+            .registry
+            .keys(type_name)
+            .unwrap_or(&[])
+            .iter()
+            .map(|r| format!("`{r}`"))
+            .collect();
+        if parts.is_empty() {
+            "no keys besides name, type, master and slave".to_string()
+        } else {
+            parts.join(", ")
         }
+    }
+
+    /// The joint of registered kind `type_name` from its parameter table
+    /// (`joint[i]`, spanning `table`): unknown, missing and refused keys
+    /// are errors at their line.
+    fn joint_kind(
+        &self,
+        type_name: &str,
+        params: &toml::Table,
+        i: usize,
+        table: &Range<usize>,
+    ) -> Res<JointKind> {
+        let tk = format!("joint[{i}]");
+        if let Some((key, value)) = non_finite(params) {
+            return Err(self.err(
+                format!("{tk}.{key}"),
+                span_at(self.text, &format!("{tk}.{key}")),
+                format!("must be a finite number, found {value:?}"),
+            ));
+        }
+        let Some(result) = self.registry.build(type_name, params) else {
+            return Err(self.err(
+                format!("{tk}.type"),
+                Some(table.clone()),
+                format!("unknown joint type \"{type_name}\""),
+            ));
+        };
+        result.map_err(|e| match e {
+            ParamsError::Unknown { key } => self.err(
+                format!("{tk}.{key}"),
+                span_at(self.text, &format!("{tk}.{key}")),
+                format!(
+                    "`{key}` does not belong to a {type_name} joint; a {type_name} joint takes {} \
+                     (besides name, type, master, slave, and angle and rate where it has a \
+                     released angle)",
+                    self.takes(type_name)
+                ),
+            ),
+            ParamsError::Missing { key, help } => self.err(
+                format!("{tk}.{key}"),
+                Some(table.clone()),
+                format!(
+                    "missing key `{key}`: a {type_name} joint needs {}",
+                    help.map_or_else(|| format!("`{key}`"), str::to_string)
+                ),
+            ),
+            ParamsError::Value(p) => {
+                let key = if p.key.is_empty() {
+                    tk.clone()
+                } else {
+                    format!("{tk}.{}", p.key)
+                };
+                let at = match p.item {
+                    Some(n) => format!("{key}[{n}]"),
+                    None => key.clone(),
+                };
+                let span = span_at(self.text, &at)
+                    .or_else(|| span_at(self.text, &key))
+                    .or(Some(table.clone()));
+                self.err(key, span, p.message)
+            }
+        })
     }
 
     /// Supports vs slaves, and cycles of joints.
@@ -455,4 +289,22 @@ impl Ctx<'_> {
         }
         Ok(())
     }
+}
+
+/// The first non-finite number in a parameter table (path relative to it).
+fn non_finite(table: &toml::Table) -> Option<(String, f64)> {
+    fn walk(v: &toml::Value, path: String) -> Option<(String, f64)> {
+        match v {
+            toml::Value::Float(x) if !x.is_finite() => Some((path, *x)),
+            toml::Value::Array(items) => items
+                .iter()
+                .enumerate()
+                .find_map(|(i, item)| walk(item, format!("{path}[{i}]"))),
+            toml::Value::Table(t) => t
+                .iter()
+                .find_map(|(k, item)| walk(item, format!("{path}.{k}"))),
+            _ => None,
+        }
+    }
+    table.iter().find_map(|(k, v)| walk(v, k.clone()))
 }

@@ -162,30 +162,24 @@ impl Ctx<'_> {
                         format!("unknown joint \"{jname}\"; {known}"),
                     ));
                 };
-                match joints[ji].kind {
-                    JointKind::Rigid | JointKind::Prismatic { .. } => {
-                        return Err(self.at(
-                            k("joint"),
-                            joint_s,
-                            format!(
-                                "joint \"{jname}\" is a {} joint: it has no released rotation, so \
-                                 there is no angle to prescribe",
-                                joints[ji].kind.type_name()
-                            ),
-                        ))
-                    }
-                    JointKind::Spherical => {
-                        return Err(self.at(
-                            k("joint"),
-                            joint_s,
-                            format!(
-                                "joint \"{jname}\" is spherical: it releases three rotations, and \
-                                 prescribing a spherical joint's rotation is not supported yet; use \
-                                 a revolute joint, or prescribe node DOFs (node + dof + value)"
-                            ),
-                        ))
-                    }
-                    _ => {}
+                let kind = &joints[ji].kind;
+                if !kind.has_angle() {
+                    let names = kind.map().coordinate_names();
+                    let message = if names.len() == 3 {
+                        format!(
+                            "joint \"{jname}\" is {}: it releases three rotations, and \
+                             prescribing its rotation is not supported yet; use a revolute \
+                             joint, or prescribe node DOFs (node + dof + value)",
+                            kind.type_name()
+                        )
+                    } else {
+                        format!(
+                            "joint \"{jname}\" is a {} joint: it has no released rotation, so \
+                             there is no angle to prescribe",
+                            kind.type_name()
+                        )
+                    };
+                    return Err(self.at(k("joint"), joint_s, message));
                 }
                 if let Some(o) = out.iter().position(
                     |q| matches!(q, PrescribedSpec::JointAngle { joint, .. } if *joint == ji),

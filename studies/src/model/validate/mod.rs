@@ -8,6 +8,7 @@ use super::error::ModelError;
 use super::labels::resolve_label;
 use super::locate::line_of;
 use super::raw::{v3, Num, RawModel, RawTimeFn, Vec3, S};
+use super::registry::JointRegistry;
 use super::types::*;
 
 mod geometry;
@@ -88,6 +89,8 @@ fn quoted_list<'a>(names: impl Iterator<Item = &'a str>) -> String {
 struct Ctx<'a> {
     file: &'a Path,
     text: &'a str,
+    /// The joint kinds the file may name.
+    registry: &'a JointRegistry,
 }
 
 impl Ctx<'_> {
@@ -294,8 +297,17 @@ impl Ctx<'_> {
 }
 
 /// Validates the raw file `raw` (parsed from `text`, read from `file`).
-pub(crate) fn validate(raw: RawModel, text: &str, file: &Path) -> Result<Model, ModelError> {
-    let cx = Ctx { file, text };
+pub(crate) fn validate(
+    raw: RawModel,
+    text: &str,
+    file: &Path,
+    registry: &JointRegistry,
+) -> Result<Model, ModelError> {
+    let cx = Ctx {
+        file,
+        text,
+        registry,
+    };
     let name = cx.model_name(&raw.name)?;
     let gravity = raw.gravity.as_ref().map_or([0.0; 3], |g| v3(g.get_ref()));
     let sections = cx.sections(&raw.section)?;

@@ -1,0 +1,383 @@
+//! The `flexmech` command line, as a library function so that a user's binary
+//! can run it with its own joint kinds. Thin: it parses arguments, calls the
+//! library and turns errors into messages that name the file, the key and
+//! the fix.
+//!
+//! A crate that defines joint kinds gets the whole command line (`run`,
+//! `check`, `study`, `reproduce`, `plot`, `bench`) for model files naming
+//! them with a three-line binary:
+//!
+//! ```no_run
+//! use flexmech_studies::model::JointRegistry;
+//!
+//! fn main() -> std::process::ExitCode {
+//!     let mut registry = JointRegistry::builtin();
+//!     // registry.register::<MyJoint>().expect("a new name");
+//!     flexmech_studies::cli::main_with(registry)
+//! }
+//! ```
+
+use crate::charts::plot_datasets;
+use crate::model::{load_model, JointRegistry};
+use crate::reproduce::{reproduce, ReproduceOptions};
+use crate::{build, run_model, RunError};
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "flexmech",
+    version,
+    about = "Dynamics of flexible mechanisms: geometrically exact beams joined by master-slave joints"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve model files and write `<out>/<name>.h5` for each.
+    Run {
+        /// Model files (TOML, see MODEL_FORMAT.md).
+        #[arg(required = true)]
+        models: Vec<PathBuf>,
+        /// Output directory for the result files.
+        #[arg(long, short, default_value = "results")]
+        out: PathBuf,
+    },
+    /// Check model files without solving them: parse, validate every key and
+    /// build the mechanism (every derived quantity at t = 0 must be finite).
+    ///
+    /// Prints `<file>: ok (…)` per valid model; errors name the file, line,
+    /// key and fix, as `run` does.
+    Check {
+        /// Model files (TOML, see MODEL_FORMAT.md).
+        #[arg(required = true)]
+        models: Vec<PathBuf>,
+    },
+    /// Reproduce the paper's examples (data/paper) with all three integrators.
+    ///
+    /// Writes `<out>/<model>/<integrator>.h5` for every run, the charts
+    /// (PNG and SVG) into `<out>/charts/`, and `<out>/summary.csv` and
+    /// `<out>/summary.md` with each run's outcome, energy drift and step
+    /// halvings. A run that fails (Newmark in `screw_free`) is a result, not
+    /// an error.
+    Reproduce {
+        /// Output directory.
+        #[arg(long, short, default_value = "results")]
+        out: PathBuf,
+        /// Only these models (screw_free, screw_driven, rack_pinion, cam, lobe).
+        #[arg(long = "model")]
+        models: Vec<String>,
+        /// Factor on every model's end time (e.g. 0.2 for a quick look).
+        #[arg(long, default_value_t = 1.0)]
+        time_scale: f64,
+    },
+    /// Draw line charts (PNG and SVG) of result datasets over /time.
+    ///
+    /// Writes `<out>/<dataset path with / as _>.png` (1600x1000 px) and `.svg`
+    /// per dataset, e.g. `plots/nodes_arm.end_displacement.png`.
+    Plot {
+        /// Result file written by `flexmech run`.
+        result: PathBuf,
+        /// Dataset paths, e.g. /energy/total or /nodes/<label>/displacement
+        /// (shape T: one curve; T x 3: x, y and z curves).
+        #[arg(required = true)]
+        datasets: Vec<String>,
+        /// Output directory for the charts.
+        #[arg(long, short, default_value = "plots")]
+        out: PathBuf,
+        /// Logarithmic y axis (non-positive values are left out).
+        #[arg(long)]
+        log: bool,
+    },
+    /// Time steps of the yardstick cantilever (2 m, tip force, dt = 1e-3)
+    /// at several mesh sizes with each integrator, modified Newton and
+    /// 3-node elements.
+    ///
+    /// Prints the machine, then µs per step, µs per element-step and the
+    /// ratio to Newmark with full Newton at the same size (ratios carry over
+    /// between machines; absolute times on a shared machine do not). Writes
+    /// `<out>/bench.md` and the runs' result files under `<out>/`. Set
+    /// RAYON_NUM_THREADS=1 for one-thread figures.
+    Bench {
+        /// Element counts (2-node; 3-node runs use half as many elements).
+        #[arg(long, value_delimiter = ',', default_values_t = [32, 128, 512, 2048, 8192])]
+        elements: Vec<usize>,
+        /// Time steps per run.
+        #[arg(long, default_value_t = 20)]
+        steps: usize,
+        /// Output directory.
+        #[arg(long, short, default_value = "bench")]
+        out: PathBuf,
+    },
+    /// Run a parameter study: a base model over a grid of key values.
+    ///
+    /// Writes `<out>/<name>/runs/<run id>.h5` per run, `summary.csv`,
+    /// `summary.h5` and `charts/<figure>.png/.svg` (see "Study files" in
+    /// MODEL_FORMAT.md). Without --shard, a Slurm array task runs the shard
+    /// SLURM_ARRAY_TASK_ID/_MIN/_COUNT select.
+    Study {
+        /// Study file (TOML).
+        study: PathBuf,
+        /// Output directory; the study writes to `<out>/<name>/`.
+        #[arg(long, short, default_value = "studies")]
+        out: PathBuf,
+        /// Run only shard K of N (runs with index % N == K-1) and write
+        /// summary-shard-K-of-N.csv/.h5.
+        #[arg(long, value_name = "K/N", conflicts_with = "merge")]
+        shard: Option<String>,
+        /// Merge the shard summaries into summary.csv/.h5 and the charts.
+        #[arg(long)]
+        merge: bool,
+    },
+}
+
+/// Runs the command line of this process's arguments with the joint kinds
+/// of `registry`.
+pub fn main_with(registry: JointRegistry) -> ExitCode {
+    run_with(registry, std::env::args_os())
+}
+
+/// Runs the command line `args` (the first is the program name) with the
+/// joint kinds of `registry`, which becomes the process's registry
+/// ([`JointRegistry::install`]); refused if another one is installed.
+pub fn run_with<I, T>(registry: JointRegistry, args: I) -> ExitCode
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let names: Vec<&str> = registry.names().collect();
+    if let Err(mine) = registry.install() {
+        let installed: Vec<&str> = JointRegistry::global().names().collect();
+        if installed != mine.names().collect::<Vec<_>>() {
+            eprintln!(
+                "error: this process already reads model files with the joint kinds {installed:?}, \
+                 not {names:?}; install one registry, once, before reading any model"
+            );
+            return ExitCode::FAILURE;
+        }
+    }
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
+    execute(cli)
+}
+
+fn execute(cli: Cli) -> ExitCode {
+    match cli.command {
+        Command::Run { models, out } => {
+            let mut failed = 0;
+            let mut names: Vec<(String, PathBuf)> = Vec::new();
+            for path in &models {
+                let outcome = load_model(path).map_err(Into::into).and_then(|m| {
+                    if let Some((_, first)) = names.iter().find(|(n, _)| *n == m.name) {
+                        return Err(RunError::DuplicateName {
+                            name: m.name.clone(),
+                            file: path.clone(),
+                            first: first.clone(),
+                        });
+                    }
+                    names.push((m.name.clone(), path.clone()));
+                    run_model(&m, &out)
+                });
+                match outcome {
+                    Ok(s) => {
+                        let warned = if s.warnings.is_empty() {
+                            ""
+                        } else {
+                            " with a warning"
+                        };
+                        println!(
+                            "{}: completed{warned}, {} steps ({} written, {} Newton iterations) in {:.2} s -> {}",
+                            path.display(),
+                            s.steps,
+                            s.written,
+                            s.iterations,
+                            s.wall_time_s,
+                            s.file.display()
+                        );
+                        for w in &s.warnings {
+                            eprintln!("warning: {}: {w}", path.display());
+                        }
+                    }
+                    Err(e) => {
+                        failed += 1;
+                        eprintln!("error: {e}");
+                    }
+                }
+            }
+            if failed > 0 {
+                eprintln!("{failed} of {} model(s) failed", models.len());
+                ExitCode::FAILURE
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+        Command::Check { models } => {
+            let mut failed = 0;
+            for path in &models {
+                match load_model(path).and_then(|m| build(&m).map(|b| (m, b))) {
+                    Ok((m, b)) => println!(
+                        "{}: ok (model \"{}\": {} beams, {} elements, {} joints, {} nodes)",
+                        path.display(),
+                        m.name,
+                        m.beams.len(),
+                        b.mechanism.mesh.elements.len(),
+                        m.joints.len(),
+                        b.mechanism.mesh.node_count()
+                    ),
+                    Err(e) => {
+                        failed += 1;
+                        eprintln!("error: {e}");
+                    }
+                }
+            }
+            if failed > 0 {
+                eprintln!("{failed} of {} model(s) refused", models.len());
+                ExitCode::FAILURE
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+        Command::Reproduce {
+            out,
+            models,
+            time_scale,
+        } => {
+            let options = ReproduceOptions {
+                out,
+                models,
+                time_scale,
+            };
+            match reproduce(&options) {
+                Ok(rep) => {
+                    for r in &rep.runs {
+                        let outcome = match r.failure_time {
+                            Some(t) => format!("failed at t = {t:.4} s"),
+                            None => "completed".to_string(),
+                        };
+                        println!(
+                            "{:13} {:21} {:28} energy drift {:.2e}, {} reduced steps -> {}",
+                            r.model,
+                            r.integrator,
+                            outcome,
+                            r.energy_drift(),
+                            r.reduced_steps(),
+                            r.file.display()
+                        );
+                    }
+                    println!(
+                        "{} charts in {}; summary in {} and {}",
+                        rep.charts.len(),
+                        options.out.join("charts").display(),
+                        rep.summary.0.display(),
+                        rep.summary.1.display()
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Command::Plot {
+            result,
+            datasets,
+            out,
+            log,
+        } => match plot_datasets(&result, &datasets, &out, log) {
+            Ok(files) => {
+                for f in files {
+                    println!("{}", f.display());
+                }
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::FAILURE
+            }
+        },
+        Command::Bench {
+            elements,
+            steps,
+            out,
+        } => {
+            use crate::bench;
+            println!("{}", bench::machine());
+            let outcome = bench::bench(&elements, steps, &out, |t| {
+                println!(
+                    "{:>6} elements  {:<26} {:>9.0} µs/step  {:>7.2} µs/(element·step)",
+                    t.elements,
+                    t.case.label,
+                    t.per_step_us(),
+                    t.per_element_step_us()
+                );
+            });
+            match outcome {
+                Ok(timings) => {
+                    let table = bench::table(&timings);
+                    println!("\n{table}");
+                    let file = out.join("bench.md");
+                    let text = format!("{}\n\n{table}", bench::machine());
+                    if let Err(e) = std::fs::write(&file, text) {
+                        eprintln!("error: cannot write {}: {e}", file.display());
+                        return ExitCode::FAILURE;
+                    }
+                    println!("table: {}", file.display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Command::Study {
+            study,
+            out,
+            shard,
+            merge,
+        } => {
+            let slurm = crate::study::SlurmArray::from_env();
+            let outcome =
+                crate::study::study_command(&study, &out, shard.as_deref(), merge, &slurm, true);
+            match outcome {
+                Ok(r) => {
+                    let what = match r.shard {
+                        Some(s) => format!("shard {s}"),
+                        None if merge => "merged".to_owned(),
+                        None => "all runs".to_owned(),
+                    };
+                    println!(
+                        "{}: {what}: {} run(s), {} failed -> {} and {}",
+                        study.display(),
+                        r.runs,
+                        r.failed,
+                        r.csv.display(),
+                        r.h5.display()
+                    );
+                    if !r.charts.is_empty() {
+                        println!("charts: {}", r.dir.join("charts").display());
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+    }
+}
