@@ -37,6 +37,25 @@ impl StepControl {
         }
     }
 
+    /// `(step, level, easy)`: what a restart needs to continue identically.
+    pub(crate) fn saved(&self) -> (f64, usize, usize) {
+        (self.step, self.level, self.easy)
+    }
+
+    /// Continues from a [`StepControl::saved`] triple; refused unless the step
+    /// is the nominal one halved `level` times, within the allowed halvings.
+    pub(crate) fn restore(&mut self, step: f64, level: usize, easy: usize) -> Result<(), String> {
+        if level > self.max_halvings || step != self.nominal / f64::powi(2.0, level as i32) {
+            return Err(format!(
+                "saved step {step:e} at halving level {level} is not the nominal step {:e} \
+                 halved at most {} times",
+                self.nominal, self.max_halvings
+            ));
+        }
+        (self.step, self.level, self.easy) = (step, level, easy);
+        Ok(())
+    }
+
     /// The step now in force (at most the nominal one).
     pub(crate) fn step(&self) -> f64 {
         self.step

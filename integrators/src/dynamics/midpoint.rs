@@ -23,6 +23,7 @@
 //! quadratically with joints too.
 
 use super::bordered::{self, Bordered};
+use super::checkpoint::{CheckpointMismatch, Tape};
 use super::mass_slots::{spin_derivative, MassSlots};
 use super::midpoint_kernels::{correction_size, element_force, element_kernel};
 use super::time_scheme::TimeScheme;
@@ -231,6 +232,31 @@ impl TimeScheme for MidpointTerms {
 
     fn joint_rates(&self) -> &[Vec<f64>] {
         &self.rates
+    }
+
+    /// β, the step size, `v`, `W` and every joint's released rates.
+    fn save(&self, tape: &mut Tape) {
+        tape.put(self.beta);
+        tape.put(self.dt);
+        tape.put_vectors(&self.v_n);
+        tape.put_vectors(&self.w_n);
+        tape.put(self.rates.len() as f64);
+        for r in &self.rates {
+            tape.put_list(r);
+        }
+    }
+
+    fn restore(&mut self, mech: &Mechanism, tape: &mut Tape) -> Result<(), CheckpointMismatch> {
+        let n = mech.mesh.node_count();
+        self.beta = tape.take()?;
+        self.dt = tape.take()?;
+        self.v_n = tape.take_vectors("velocities", n)?;
+        self.w_n = tape.take_vectors("angular velocities", n)?;
+        let joints = tape.take_count("joints", Some(mech.joints.len()))?;
+        self.rates = (0..joints)
+            .map(|j| tape.take_list("a joint's rates", Some(mech.joints[j].map.released_count())))
+            .collect::<Result<Vec<_>, _>>()?;
+        tape.done()
     }
 
     fn mass(&self) -> &Inertia {

@@ -16,6 +16,7 @@
 //!   to reproduce the paper.
 
 mod bordered;
+pub mod checkpoint;
 pub mod energy_momentum;
 pub mod energy_momentum_paper;
 mod mass_slots;
@@ -27,6 +28,7 @@ mod newmark_terms;
 pub mod simulation;
 mod time_scheme;
 
+pub use checkpoint::{Checkpoint, CheckpointMismatch};
 pub use simulation::{Integrator, Simulation};
 
 use crate::constraints::{MechanismState, Topology};

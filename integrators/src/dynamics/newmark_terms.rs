@@ -1,6 +1,7 @@
 //! Newmark's trapezoidal rule (β = ¼, γ = ½) on SO(3) as terms of the
 //! shared reduced system (see [`super::newmark`] for the scheme).
 
+use super::checkpoint::{CheckpointMismatch, Tape};
 use super::mass_slots::{spin_derivative, MassSlots};
 use super::slave_velocities;
 use super::time_scheme::TimeScheme;
@@ -162,6 +163,47 @@ impl TimeScheme for NewmarkTerms {
 
     fn mass(&self) -> &Inertia {
         &self.inertia
+    }
+
+    /// `v, a, W, A`, the step size, and the drivers' reactions at the last
+    /// accepted state (flag 1 and per joint then prescribed, or flag 0).
+    fn save(&self, tape: &mut Tape) {
+        for vs in [&self.prev.v, &self.prev.a, &self.prev.w, &self.prev.alpha] {
+            tape.put_vectors(vs);
+        }
+        tape.put(self.dt);
+        match &self.reactions {
+            None => tape.put(0.0),
+            Some((joints, prescribed)) => {
+                tape.put(1.0);
+                tape.put(joints.len() as f64);
+                for r in joints {
+                    tape.put_list(r);
+                }
+                tape.put_list(prescribed);
+            }
+        }
+    }
+
+    fn restore(&mut self, mech: &Mechanism, tape: &mut Tape) -> Result<(), CheckpointMismatch> {
+        let n = mech.mesh.node_count();
+        self.prev = Kinematics {
+            v: tape.take_vectors("velocities", n)?,
+            a: tape.take_vectors("accelerations", n)?,
+            w: tape.take_vectors("angular velocities", n)?,
+            alpha: tape.take_vectors("angular accelerations", n)?,
+        };
+        self.dt = tape.take()?;
+        self.reactions = if tape.take()? == 0.0 {
+            None
+        } else {
+            let joints = tape.take_count("joints with reactions", Some(mech.joints.len()))?;
+            let rs = (0..joints)
+                .map(|_| tape.take_list("a joint's reactions", None))
+                .collect::<Result<Vec<_>, _>>()?;
+            Some((rs, tape.take_list("prescribed DOFs' reactions", None)?))
+        };
+        tape.done()
     }
 
     /// Newmark's updates of velocities and accelerations; the drivers' work

@@ -21,6 +21,7 @@
 //! # Ok(()) }
 //! ```
 
+use super::checkpoint::{Checkpoint, CheckpointMismatch, Tape};
 use super::midpoint::MidpointTerms;
 use super::newmark_terms::NewmarkTerms;
 use super::time_scheme::TimeScheme;
@@ -53,10 +54,23 @@ pub enum Integrator {
     EnergyMomentumPaper,
 }
 
+impl Integrator {
+    /// The name used in model and result files (`"energy-momentum"`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Newmark => "newmark",
+            Integrator::Momentum => "momentum",
+            Integrator::EnergyMomentum => "energy-momentum",
+            Integrator::EnergyMomentumPaper => "energy-momentum-paper",
+        }
+    }
+}
+
 /// A mechanism in time: its state, velocities and time, advanced one
 /// converged step at a time.
 pub struct Simulation<'m> {
     inner: Box<dyn Stepping + 'm>,
+    integrator: Integrator,
 }
 
 impl<'m> Simulation<'m> {
@@ -109,7 +123,43 @@ impl<'m> Simulation<'m> {
                 Box::new(Stepper::new(sys, lu, settings))
             }
         };
-        Ok(Self { inner })
+        Ok(Self { inner, integrator })
+    }
+
+    /// Continues a run from a [`Checkpoint`] taken by
+    /// [`Simulation::checkpoint`] (possibly in another process) of the same
+    /// mechanism, integrator and settings (`t_end` may differ). With full
+    /// Newton the continued run is the uninterrupted one bit for bit; with
+    /// modified Newton its first step factorises a fresh tangent, so it agrees
+    /// to the Newton tolerance.
+    pub fn resume(
+        mech: &'m Mechanism,
+        integrator: Integrator,
+        settings: &DynamicSettings,
+        checkpoint: &Checkpoint,
+    ) -> Result<Self, SolveError> {
+        let refuse = |why: String| SolveError::InvalidMechanism(format!("restart: {why}"));
+        if checkpoint.integrator != integrator.name() {
+            return Err(refuse(format!(
+                "the saved run used integrator \"{}\", this one \"{}\"",
+                checkpoint.integrator,
+                integrator.name()
+            )));
+        }
+        let rest = Motion::rest(mech.mesh.node_count());
+        let mut sim = Self::new(mech, integrator, settings, &rest)?;
+        sim.inner
+            .restore(checkpoint)
+            .map_err(|e| refuse(e.to_string()))?;
+        Ok(sim)
+    }
+
+    /// Everything the simulation carries to its next step, for
+    /// [`Simulation::resume`].
+    pub fn checkpoint(&self) -> Checkpoint {
+        let mut c = self.inner.checkpoint();
+        c.integrator = self.integrator.name().to_string();
+        c
     }
 
     /// Advances one converged step (halving and retrying as step control
@@ -171,6 +221,8 @@ trait Stepping {
     fn time(&self) -> f64;
     fn state(&self) -> &MechanismState;
     fn velocities(&self) -> (&[Vector3<f64>], &[Vector3<f64>]);
+    fn checkpoint(&self) -> Checkpoint;
+    fn restore(&mut self, checkpoint: &Checkpoint) -> Result<(), CheckpointMismatch>;
 }
 
 /// The driver of one scheme `S`. Between steps `sys.end` is the current
@@ -310,5 +362,59 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
 
     fn velocities(&self) -> (&[Vector3<f64>], &[Vector3<f64>]) {
         self.sys.terms.velocities()
+    }
+
+    fn checkpoint(&self) -> Checkpoint {
+        let (step, level, easy) = self.control.saved();
+        let mut tape = Tape::default();
+        self.sys.terms.save(&mut tape);
+        let end = &self.sys.end;
+        Checkpoint {
+            integrator: String::new(),
+            time: self.t,
+            last_dt: self.last_dt,
+            driver_work: self.driver_work,
+            step,
+            level,
+            easy,
+            positions: end.config.x.clone(),
+            rotations: end.config.rot.clone(),
+            released: end.released.clone(),
+            prescribed: end.prescribed.clone(),
+            scheme: tape.into_data(),
+        }
+    }
+
+    fn restore(&mut self, c: &Checkpoint) -> Result<(), CheckpointMismatch> {
+        let mech = self.sys.mech;
+        let n = mech.mesh.node_count();
+        let counts = [
+            ("nodal positions", c.positions.len(), n),
+            ("nodal rotations", c.rotations.len(), n),
+            ("joints", c.released.len(), mech.joints.len()),
+            ("prescribed DOFs", c.prescribed.len(), mech.prescribed.len()),
+        ];
+        for (what, saved, here) in counts {
+            if saved != here {
+                return Err(CheckpointMismatch(format!(
+                    "{saved} {what} saved, the mechanism has {here}"
+                )));
+            }
+        }
+        if !(c.time.is_finite() && c.time >= 0.0) {
+            return Err(CheckpointMismatch(format!("saved time {}", c.time)));
+        }
+        self.control
+            .restore(c.step, c.level, c.easy)
+            .map_err(CheckpointMismatch)?;
+        self.sys.terms.restore(mech, &mut Tape::reading(&c.scheme))?;
+        self.sys.end = c.state();
+        self.sys.start.clone_from(&self.sys.end);
+        self.t = c.time;
+        self.last_dt = c.last_dt;
+        self.driver_work = c.driver_work;
+        self.guard = RotationGuard::new(mech, &self.sys.end);
+        mech.external_forces(self.t, &mut self.fext_now);
+        Ok(())
     }
 }

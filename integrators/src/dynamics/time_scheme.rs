@@ -4,7 +4,9 @@
 //! takes the loads, the velocities its predictor uses, its Newton solve and
 //! what it updates when a step is accepted.
 
+use super::checkpoint::{CheckpointMismatch, Tape};
 use crate::error::NewtonFailure;
+use crate::mechanism::Mechanism;
 use crate::linsolve::SparseLu;
 use crate::newton::{self, NewtonReport, NewtonSettings};
 use crate::system::{ReducedSystem, StepTerms};
@@ -49,4 +51,11 @@ pub(crate) trait TimeScheme: StepTerms + Sized {
     /// accepted: updates the velocities (and whatever else the scheme
     /// carries) and returns the drivers' work over the step.
     fn finish(sys: &mut ReducedSystem<'_, Self>, dt: f64) -> f64;
+
+    /// Writes what the scheme carries between steps (for a restart).
+    fn save(&self, tape: &mut Tape);
+
+    /// Reads back what [`TimeScheme::save`] wrote, checking its shapes
+    /// against `mech`.
+    fn restore(&mut self, mech: &Mechanism, tape: &mut Tape) -> Result<(), CheckpointMismatch>;
 }
