@@ -20,7 +20,7 @@
 use crate::charts::plot_datasets;
 use crate::model::{load_model, JointRegistry};
 use crate::reproduce::{reproduce, ReproduceOptions};
-use crate::{build, run_model, RunError};
+use crate::{build, restart_model, run_model, RunError};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -46,6 +46,11 @@ enum Command {
         /// Output directory for the result files.
         #[arg(long, short, default_value = "results")]
         out: PathBuf,
+        /// Continue the dynamic run stored in this result file from its last
+        /// stored step to the model's `t_end` (one model, describing the same
+        /// mechanism with the same integrator and `dt`).
+        #[arg(long, value_name = "RESULT.h5")]
+        restart: Option<PathBuf>,
     },
     /// Check model files without solving them: parse, validate every key and
     /// build the mechanism (every derived quantity at t = 0 must be finite).
@@ -176,7 +181,18 @@ where
 
 fn execute(cli: Cli) -> ExitCode {
     match cli.command {
-        Command::Run { models, out } => {
+        Command::Run {
+            models,
+            out,
+            restart,
+        } => {
+            if restart.is_some() && models.len() != 1 {
+                eprintln!(
+                    "error: --restart continues one run: give one model file, found {}",
+                    models.len()
+                );
+                return ExitCode::FAILURE;
+            }
             let mut failed = 0;
             let mut names: Vec<(String, PathBuf)> = Vec::new();
             for path in &models {
@@ -189,7 +205,10 @@ fn execute(cli: Cli) -> ExitCode {
                         });
                     }
                     names.push((m.name.clone(), path.clone()));
-                    run_model(&m, &out)
+                    match &restart {
+                        Some(result) => restart_model(&m, result, &out),
+                        None => run_model(&m, &out),
+                    }
                 });
                 match outcome {
                     Ok(s) => {

@@ -15,4 +15,4 @@ pub mod run;
 pub mod study;
 
 pub use build::{build, Built};
-pub use run::{run_model, run_model_to, RunError, RunSummary};
+pub use run::{restart_model, run_model, run_model_to, RunError, RunSummary};

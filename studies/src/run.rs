@@ -4,11 +4,9 @@
 
 use crate::build::{build, Built};
 use crate::checks::{Balance, Stability};
-use crate::model::{Analysis, IntegratorKind, MassKind, Model, ModelError};
-use crate::results::{layout, ResultError, ResultWriter, RunMeta};
-use flexmech_integrators::dynamics::{
-    energy_momentum, energy_momentum_paper, momentum, newmark, DynamicSettings,
-};
+use crate::model::{Analysis, MassKind, Model, ModelError};
+use crate::results::{layout, read_checkpoint, RestartError, ResultError, ResultWriter, RunMeta};
+use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
 use flexmech_integrators::{
     solve_static, Mechanism, NewtonSettings, SolveError, StaticSettings, StepRecord,
 };
@@ -43,6 +41,23 @@ pub enum RunError {
         name: String,
         file: PathBuf,
         first: PathBuf,
+    },
+    /// The result file to continue cannot be read.
+    #[error(transparent)]
+    Restart(#[from] RestartError),
+    /// The result file to continue is not a run of this model.
+    #[error(
+        "{}: cannot continue {} with this model: {why}",
+        model.display(),
+        result.display()
+    )]
+    RestartMismatch {
+        /// The model file.
+        model: PathBuf,
+        /// The result file.
+        result: PathBuf,
+        /// What differs, and what to do.
+        why: String,
     },
     /// The solver stopped; `file` holds the steps computed before.
     #[error(
@@ -95,7 +110,8 @@ struct Sink<'a> {
 }
 
 impl Sink<'_> {
-    fn push(&mut self, step: &StepRecord) {
+    /// Takes a step's record; returns whether it was written now.
+    fn push(&mut self, step: &StepRecord) -> bool {
         if let Some(b) = &mut self.balance {
             b.push(self.mech, step);
         }
@@ -105,21 +121,35 @@ impl Sink<'_> {
         self.count += 1;
         self.iterations += step.iterations;
         if self.error.is_some() {
-            return;
+            return false;
         }
         if self.count.is_multiple_of(self.every) {
             self.pending = None;
             if let Err(e) = self.writer.append(step) {
                 self.error = Some(e);
             }
+            self.error.is_none()
         } else {
             self.pending = Some(step.clone());
+            false
         }
     }
 
-    fn flush_last(&mut self) {
+    /// Writes the last record if it is still pending; returns whether it did.
+    fn flush_last(&mut self) -> bool {
         if let (Some(step), None) = (self.pending.take(), &self.error) {
             if let Err(e) = self.writer.append(&step) {
+                self.error = Some(e);
+            }
+            return self.error.is_none();
+        }
+        false
+    }
+
+    /// Rewrites the file's restart state with the simulation's.
+    fn checkpoint(&mut self, sim: &Simulation<'_>) {
+        if self.error.is_none() {
+            if let Err(e) = self.writer.checkpoint(&sim.checkpoint()) {
                 self.error = Some(e);
             }
         }
@@ -145,6 +175,83 @@ pub fn run_model(model: &Model, out_dir: &Path) -> Result<RunSummary, RunError> 
 /// Runs `model` and writes its results to `file` (parent directories are
 /// created).
 pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> {
+    run(model, file, None)
+}
+
+/// Relative distance between a node's initial position in the model and in
+/// the run to continue below which they are the same node (round-off of the
+/// mesh generator on coordinates of the model's size).
+const SAME_NODE: f64 = 1e-12;
+
+/// Continues the dynamic run stored in the result file `result` (its
+/// `/restart` state, the last stored step) to `model`'s `t_end`, writing
+/// `out_dir/<name>.h5` from the restart time on. `model` must describe the
+/// same mechanism (nodes, joints, prescribed DOFs) with the same integrator
+/// and `dt`; with full Newton the continuation equals the uninterrupted run
+/// bit for bit.
+pub fn restart_model(model: &Model, result: &Path, out_dir: &Path) -> Result<RunSummary, RunError> {
+    let file = out_dir.join(format!("{}.h5", model.name));
+    let mismatch = |why: String| RunError::RestartMismatch {
+        model: model.path.clone(),
+        result: result.to_path_buf(),
+        why,
+    };
+    let same_file = match (file.canonicalize(), result.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    if same_file {
+        return Err(mismatch(format!(
+            "the continuation would overwrite the file it continues ({}); give another --out",
+            file.display()
+        )));
+    }
+    let (checkpoint, initial) = read_checkpoint(result)?;
+    let Analysis::Dynamic { t_end, .. } = model.solver.analysis else {
+        return Err(mismatch(
+            "key `solver.analysis`: a static analysis cannot be continued; restarts continue \
+             dynamic runs"
+                .into(),
+        ));
+    };
+    if checkpoint.time >= t_end {
+        return Err(mismatch(format!(
+            "key `solver.t_end`: the stored run already reaches t = {} >= t_end = {t_end}; set a \
+             later t_end",
+            checkpoint.time
+        )));
+    }
+    let built = build(model)?;
+    let here = &built.mechanism.mesh.positions;
+    if here.len() != initial.len() {
+        return Err(mismatch(format!(
+            "the stored run has {} nodes, the model {}",
+            initial.len(),
+            here.len()
+        )));
+    }
+    let scale = here.iter().map(|x| x.norm()).fold(1.0, f64::max);
+    if let Some(i) = here
+        .iter()
+        .zip(&initial)
+        .position(|(a, b)| (a - nalgebra::Vector3::from(*b)).norm() > SAME_NODE * scale)
+    {
+        return Err(mismatch(format!(
+            "node {i} starts at {:?} in the stored run and at {:?} in the model: not the same \
+             mechanism",
+            initial[i],
+            [here[i].x, here[i].y, here[i].z]
+        )));
+    }
+    run(model, &file, Some((&checkpoint, result)))
+}
+
+fn run(
+    model: &Model,
+    file: &Path,
+    restart_from: Option<(&Checkpoint, &Path)>,
+) -> Result<RunSummary, RunError> {
+    let restart = restart_from.map(|(c, _)| c);
     let built: Built = build(model)?;
     let out_dir = file
         .parent()
@@ -176,7 +283,10 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
             .collect(),
         joint_names: model.joints.iter().map(|j| j.name.clone()).collect(),
     };
-    let writer = ResultWriter::create(&file, &meta)?;
+    let mut writer = ResultWriter::create(&file, &meta)?;
+    if let Some((c, from)) = restart_from {
+        writer.restarted_from(from, c.time)?;
+    }
     let dynamic = matches!(model.solver.analysis, Analysis::Dynamic { .. });
     let mut sink = Sink {
         writer,
@@ -201,7 +311,10 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
                 },
                 max_halvings: model.solver.max_halvings,
             };
-            solve_static(mech, &settings, |s| sink.push(s)).map(|_| ())
+            solve_static(mech, &settings, |s| {
+                sink.push(s);
+            })
+            .map(|_| ())
         }
         Analysis::Dynamic {
             integrator,
@@ -222,18 +335,31 @@ pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> 
                     MassKind::Lumped => flexmech_core::MassKind::Lumped,
                 },
             };
-            let push = |s: &StepRecord| sink.push(s);
-            match integrator {
-                IntegratorKind::Newmark => newmark::solve(mech, &settings, &built.motion, push),
-                IntegratorKind::Momentum => momentum::solve(mech, &settings, &built.motion, push),
-                IntegratorKind::EnergyMomentum => {
-                    energy_momentum::solve(mech, &settings, &built.motion, push)
+            let sim = match restart {
+                Some(c) => Simulation::resume(mech, integrator, &settings, c),
+                None => Simulation::new(mech, integrator, &settings, &built.motion),
+            };
+            sim.and_then(|mut sim| {
+                if sink.push(&sim.record()) {
+                    sink.checkpoint(&sim);
                 }
-                IntegratorKind::EnergyMomentumPaper => {
-                    energy_momentum_paper::solve(mech, &settings, &built.motion, push)
+                let outcome = loop {
+                    match sim.step() {
+                        Ok(Some(record)) => {
+                            if sink.push(&record) {
+                                sink.checkpoint(&sim);
+                            }
+                        }
+                        Ok(None) => break Ok(()),
+                        Err(e) => break Err(e),
+                    }
+                };
+                // The last converged state, also after a failure.
+                if sink.flush_last() {
+                    sink.checkpoint(&sim);
                 }
-            }
-            .map(|_| ())
+                outcome
+            })
         }
     };
     let wall = start.elapsed().as_secs_f64();

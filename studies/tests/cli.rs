@@ -244,3 +244,60 @@ fn a_completed_run_whose_energy_balance_is_off_says_so() {
     assert!(w.contains("energy balance"), "{w}");
     assert!(attr("screw-energy-momentum.h5").is_none());
 }
+
+#[test]
+fn run_restart_continues_a_stored_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper/cam.toml"),
+    )
+    .unwrap();
+    let short = dir.path().join("short.toml");
+    let long = dir.path().join("long.toml");
+    std::fs::write(&short, text.replace("t_end = 3.0", "t_end = 0.1")).unwrap();
+    std::fs::write(&long, text.replace("t_end = 3.0", "t_end = 0.2")).unwrap();
+    let first = dir.path().join("first");
+    let out = flexmech()
+        .args([
+            "run",
+            short.to_str().unwrap(),
+            "--out",
+            first.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stored = first.join("cam.h5");
+    let next = dir.path().join("next");
+    let out = flexmech()
+        .args(["run", long.to_str().unwrap(), "--restart"])
+        .arg(&stored)
+        .args(["--out", next.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // 0.1 s more at dt = 0.01: 10 steps (plus the restart state as the first row).
+    assert!(stdout.contains("completed, 11 steps"), "{stdout}");
+    // One model only.
+    let out = flexmech()
+        .args([
+            "run",
+            long.to_str().unwrap(),
+            short.to_str().unwrap(),
+            "--restart",
+        ])
+        .arg(&stored)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("one model file"));
+}

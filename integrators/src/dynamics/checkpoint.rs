@@ -210,7 +210,10 @@ mod tests {
         let mut r = Tape::reading(&data);
         assert_eq!(r.take().unwrap(), 0.5);
         assert_eq!(r.take_list("x", Some(2)).unwrap(), [1.0, 2.0]);
-        assert_eq!(r.take_vectors("v", 1).unwrap(), [Vector3::new(3.0, 4.0, 5.0)]);
+        assert_eq!(
+            r.take_vectors("v", 1).unwrap(),
+            [Vector3::new(3.0, 4.0, 5.0)]
+        );
         r.done().unwrap();
         let mut r = Tape::reading(&data);
         r.take().unwrap();

@@ -407,7 +407,9 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
         self.control
             .restore(c.step, c.level, c.easy)
             .map_err(CheckpointMismatch)?;
-        self.sys.terms.restore(mech, &mut Tape::reading(&c.scheme))?;
+        self.sys
+            .terms
+            .restore(mech, &mut Tape::reading(&c.scheme))?;
         self.sys.end = c.state();
         self.sys.start.clone_from(&self.sys.end);
         self.t = c.time;

@@ -6,8 +6,8 @@
 
 use super::checkpoint::{CheckpointMismatch, Tape};
 use crate::error::NewtonFailure;
-use crate::mechanism::Mechanism;
 use crate::linsolve::SparseLu;
+use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSettings};
 use crate::system::{ReducedSystem, StepTerms};
 use flexmech_core::Inertia;

@@ -135,26 +135,9 @@ pub struct InitialVelocitySpec {
     pub origin: [f64; 3],
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum IntegratorKind {
-    Newmark,
-    Momentum,
-    EnergyMomentum,
-    /// The paper's energy–momentum scheme (eqs 17–20, scalar β).
-    EnergyMomentumPaper,
-}
-
-impl IntegratorKind {
-    /// The name used in model files and result paths.
-    pub fn name(self) -> &'static str {
-        match self {
-            IntegratorKind::Newmark => "newmark",
-            IntegratorKind::Momentum => "momentum",
-            IntegratorKind::EnergyMomentum => "energy-momentum",
-            IntegratorKind::EnergyMomentumPaper => "energy-momentum-paper",
-        }
-    }
-}
+/// The time integrators: the solvers' own enum, one vocabulary for model
+/// files and Rust (`IntegratorKind::name` gives the model-file name).
+pub use flexmech_integrators::dynamics::Integrator as IntegratorKind;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MassKind {

@@ -18,6 +18,10 @@ pub const ATTR_STATUS: &str = "status";
 pub const ATTR_WALL_TIME: &str = "wall_time_s";
 /// Root attribute: warnings about a completed result (absent when none).
 pub const ATTR_WARNINGS: &str = "warnings";
+/// Root attribute of a continued run: the result file it continues.
+pub const ATTR_RESTARTED_FROM: &str = "restarted_from";
+/// Root attribute of a continued run: the time it continues from.
+pub const ATTR_RESTART_TIME: &str = "restart_time";
 /// Attribute on datasets and groups: a one-line human-readable meaning.
 pub const ATTR_DESCRIPTION: &str = "description";
 /// Attribute on `/nodes/<label>` (extension): the node index in the model.

@@ -81,6 +81,8 @@
 //! ```
 
 pub mod layout;
+pub mod restart;
 mod writer;
 
+pub use restart::{read_checkpoint, RestartError};
 pub use writer::{rotation_vector, ResultError, ResultWriter, RunMeta};

@@ -894,6 +894,39 @@ impl ResultWriter {
         })
     }
 
+    /// Rewrites `/restart` with the run's state at the step appended last
+    /// (see [`super::restart`]).
+    pub fn checkpoint(
+        &mut self,
+        checkpoint: &flexmech_integrators::dynamics::Checkpoint,
+    ) -> Result<(), ResultError> {
+        super::restart::write(&self.file, checkpoint, &self.initial_positions)
+            .ctx(&self.path, || {
+                "writing the restart state /restart".to_owned()
+            })
+    }
+
+    /// Sets the root attributes `restarted_from` (the result file this run
+    /// continues) and `restart_time` (the time it continues from).
+    pub fn restarted_from(&mut self, result: &Path, time: f64) -> Result<(), ResultError> {
+        set_str_attr(
+            &self.file,
+            names::ATTR_RESTARTED_FROM,
+            &result.display().to_string(),
+        )
+        .ctx(&self.path, || {
+            format!("writing root attribute {}", names::ATTR_RESTARTED_FROM)
+        })?;
+        self.file
+            .new_attr::<f64>()
+            .shape(())
+            .create(names::ATTR_RESTART_TIME)
+            .and_then(|a| a.as_writer().write_scalar(&time))
+            .ctx(&self.path, || {
+                format!("writing root attribute {}", names::ATTR_RESTART_TIME)
+            })
+    }
+
     /// Number of steps appended successfully (`T`).
     pub fn steps_written(&self) -> usize {
         self.steps
