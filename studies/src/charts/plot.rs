@@ -9,10 +9,8 @@
 
 use std::path::{Path, PathBuf};
 
-use hdf5::types::VarLenUnicode;
-
 use super::line::{ChartError, LineChart, Series};
-use crate::results::layout;
+use crate::results::{layout, ReadError, ResultReader};
 
 /// Why `plot_datasets` could not draw the charts; every variant names the
 /// result file (and the dataset where one is involved).
@@ -84,6 +82,36 @@ pub enum PlotError {
     },
 }
 
+impl From<ReadError> for PlotError {
+    fn from(e: ReadError) -> Self {
+        match e {
+            ReadError::Hdf5 { path, what, source } => PlotError::Hdf5 { path, what, source },
+            ReadError::UnknownDataset {
+                path,
+                dataset,
+                group,
+                available,
+            } => PlotError::UnknownDataset {
+                path,
+                dataset,
+                group,
+                available,
+            },
+            ReadError::Shape {
+                path,
+                dataset,
+                shape,
+                ..
+            } => PlotError::BadShape {
+                path,
+                dataset,
+                shape,
+                steps: 0,
+            },
+        }
+    }
+}
+
 fn shape_text(shape: &[usize]) -> String {
     if shape.is_empty() {
         return "scalar".to_owned();
@@ -104,26 +132,16 @@ pub fn plot_datasets(
     out_dir: &Path,
     log_y: bool,
 ) -> Result<Vec<PathBuf>, PlotError> {
-    let hdf5_err = |what: String| {
-        move |source| PlotError::Hdf5 {
-            path: file.to_path_buf(),
-            what,
-            source,
-        }
-    };
-    let h5 = hdf5::File::open(file).map_err(hdf5_err("opening the file".into()))?;
-    let time = open_dataset(&h5, file, layout::TIME)?
-        .read_raw::<f64>()
-        .map_err(hdf5_err(format!("reading {}", layout::TIME)))?;
+    let r = ResultReader::open(file)?;
+    let time = r.time()?;
     let steps = time.len();
 
-    let integrator = string_attr(&h5, layout::ATTR_INTEGRATOR);
-    let x_label = if integrator.as_deref() == Some("static") {
+    let x_label = if r.integrator().as_deref() == Some("static") {
         "time (load factor in statics)"
     } else {
         "time"
     };
-    let markers = stop_marker(string_attr(&h5, layout::ATTR_STATUS), &time);
+    let markers = stop_marker(r.string_attr(layout::ATTR_STATUS), &time);
     let file_name = file
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -132,8 +150,7 @@ pub fn plot_datasets(
     let mut charts = Vec::with_capacity(datasets.len());
     for requested in datasets {
         let name = format!("/{}", requested.trim_start_matches('/'));
-        let ds = open_dataset(&h5, file, &name)?;
-        let shape = ds.shape();
+        let shape = r.shape(&name)?;
         let bad_shape = || PlotError::BadShape {
             path: file.to_path_buf(),
             dataset: name.clone(),
@@ -141,9 +158,7 @@ pub fn plot_datasets(
             steps,
         };
         let values = match shape.as_slice() {
-            [n] | [n, 3] if *n == steps => ds
-                .read_raw::<f64>()
-                .map_err(hdf5_err(format!("reading {name}")))?,
+            [n] | [n, 3] if *n == steps => r.values(&name)?,
             _ => return Err(bad_shape()),
         };
         let series = if shape.len() == 1 {
@@ -159,7 +174,7 @@ pub fn plot_datasets(
                 })
                 .collect()
         };
-        let title = match string_attr(&ds, layout::ATTR_DESCRIPTION) {
+        let title = match r.description(&name) {
             Some(d) if !d.is_empty() => format!("{file_name}: {d}"),
             _ => file_name.clone(),
         };
@@ -214,55 +229,4 @@ fn stop_marker(status: Option<String>, time: &[f64]) -> Vec<(f64, String)> {
         return Vec::new();
     };
     vec![(last, label)]
-}
-
-fn string_attr(loc: &hdf5::Location, name: &str) -> Option<String> {
-    let attr = loc.attr(name).ok()?;
-    let value = attr.read_scalar::<VarLenUnicode>().ok()?;
-    Some(value.as_str().to_owned())
-}
-
-/// Opens a dataset by absolute path; if there is none, the error lists the
-/// datasets below the nearest existing group.
-fn open_dataset(h5: &hdf5::File, file: &Path, name: &str) -> Result<hdf5::Dataset, PlotError> {
-    let parts: Vec<&str> = name.split('/').filter(|p| !p.is_empty()).collect();
-    let mut group = h5.group("/").map_err(|source| PlotError::Hdf5 {
-        path: file.to_path_buf(),
-        what: "opening the root group".into(),
-        source,
-    })?;
-    for (i, part) in parts.iter().enumerate() {
-        if !group.link_exists(part) {
-            break;
-        }
-        if i + 1 == parts.len() {
-            if let Ok(ds) = group.dataset(part) {
-                return Ok(ds);
-            }
-        }
-        match group.group(part) {
-            Ok(g) => group = g,
-            Err(_) => break,
-        }
-    }
-    let mut available = Vec::new();
-    datasets_under(&group, &mut available);
-    available.sort();
-    Err(PlotError::UnknownDataset {
-        path: file.to_path_buf(),
-        dataset: name.to_owned(),
-        group: group.name(),
-        available,
-    })
-}
-
-fn datasets_under(group: &hdf5::Group, out: &mut Vec<String>) {
-    if let Ok(datasets) = group.datasets() {
-        out.extend(datasets.iter().map(|d| d.name()));
-    }
-    if let Ok(groups) = group.groups() {
-        for g in &groups {
-            datasets_under(g, out);
-        }
-    }
 }

@@ -16,6 +16,7 @@
 
 use super::{ReproduceError, RunRecord, CONSISTENCY_INTEGRATORS, CONSISTENCY_MODEL, INTEGRATORS};
 use crate::charts::{LineChart, Series};
+use crate::results::{ReadError, ResultReader};
 use std::path::{Path, PathBuf};
 
 /// Legend names of the integrators.
@@ -28,29 +29,33 @@ fn legend(integrator: &str) -> &'static str {
     }
 }
 
-/// Reads a dataset (flattened) from a result file.
+fn read_error(e: ReadError) -> ReproduceError {
+    ReproduceError::Read {
+        file: e.path().to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+/// A dataset (flattened) of a result file.
 fn read(file: &Path, name: &str) -> Result<Vec<f64>, ReproduceError> {
-    hdf5::File::open(file)
-        .and_then(|h| h.dataset(name)?.read_raw::<f64>())
-        .map_err(|e| ReproduceError::Read {
-            file: file.to_path_buf(),
-            message: format!("{name}: {e}"),
-        })
+    ResultReader::open(file)
+        .and_then(|r| r.values(name))
+        .map_err(read_error)
 }
 
 /// Component `c` of a T×3 dataset.
 fn column(file: &Path, name: &str, c: usize) -> Result<Vec<f64>, ReproduceError> {
-    Ok(read(file, name)?.chunks(3).map(|r| r[c]).collect())
+    let rows = ResultReader::open(file)
+        .and_then(|r| r.rows3(name))
+        .map_err(read_error)?;
+    Ok(rows.into_iter().map(|r| r[c]).collect())
 }
 
 /// The first joint's name in a result file.
 fn first_joint(file: &Path) -> Result<String, ReproduceError> {
-    let names = hdf5::File::open(file)
-        .and_then(|h| h.group("/joints")?.member_names())
-        .map_err(|e| ReproduceError::Read {
-            file: file.to_path_buf(),
-            message: format!("/joints: {e}"),
-        })?;
+    let names = ResultReader::open(file)
+        .and_then(|r| r.joint_names())
+        .map_err(read_error)?;
     names.into_iter().next().ok_or(ReproduceError::Read {
         file: file.to_path_buf(),
         message: "no joint in /joints".into(),

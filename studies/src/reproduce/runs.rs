@@ -3,6 +3,8 @@
 
 use super::{result_path, ReproduceError, CONSISTENCY_INTEGRATORS, CONSISTENCY_MODEL, INTEGRATORS};
 use crate::model::parse_model;
+use crate::results::reader::drift_of;
+use crate::results::{ReadError, ResultReader};
 use crate::run::{run_model_to, RunError};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -41,15 +43,9 @@ pub struct RunRecord {
 }
 
 impl RunRecord {
-    /// Largest `|B(t) − B(0)| / scale` of the balance `B = E − W_drivers`.
+    /// The run's energy drift ([`crate::results::reader::energy_drift`]).
     pub fn energy_drift(&self) -> f64 {
-        let b0 = self.balance.first().copied().unwrap_or(0.0);
-        let scale = self.energy_scale;
-        self.balance
-            .iter()
-            .map(|b| (b - b0).abs())
-            .fold(0.0, f64::max)
-            / scale
+        drift_of(&self.balance, self.energy_scale)
     }
 
     /// Steps taken with less than the nominal step (halvings in force); the
@@ -177,32 +173,17 @@ fn read_back(
     file: &Path,
     nominal_dt: f64,
 ) -> Result<RunRecord, ReproduceError> {
-    let err = |message: String| ReproduceError::Read {
+    let err = |e: ReadError| ReproduceError::Read {
         file: file.to_path_buf(),
-        message,
+        message: e.to_string(),
     };
-    let h5 = hdf5::File::open(file).map_err(|e| err(e.to_string()))?;
-    let read = |name: &str| -> Result<Vec<f64>, ReproduceError> {
-        h5.dataset(name)
-            .and_then(|d| d.read_raw::<f64>())
-            .map_err(|e| err(format!("{name}: {e}")))
-    };
-    let time = read("/time")?;
-    let total = read("/energy/total")?;
-    let work = read("/energy/driver_work")?;
-    let status: String = h5
-        .attr("status")
-        .and_then(|a| a.read_scalar::<hdf5::types::VarLenUnicode>())
-        .map(|s| s.as_str().to_string())
-        .map_err(|e| err(format!("status: {e}")))?;
-    let wall_time_s: f64 = h5
-        .attr("wall_time_s")
-        .and_then(|a| a.read_scalar::<f64>())
-        .unwrap_or(f64::NAN);
-    let failure_time = status
-        .starts_with("failed")
+    let r = ResultReader::open(file).map_err(err)?;
+    let time = r.time().map_err(err)?;
+    let status = r.status().map_err(err)?;
+    let failure_time = r
+        .failed()
+        .map_err(err)?
         .then(|| time.last().copied().unwrap_or(0.0));
-    let balance: Vec<f64> = total.iter().zip(&work).map(|(e, w)| e - w).collect();
     let record = RunRecord {
         model: model.to_string(),
         integrator: integrator.to_string(),
@@ -210,22 +191,18 @@ fn read_back(
         status,
         failure_time,
         nominal_dt,
-        dt: read("/solver/dt")?,
-        iterations: h5
-            .dataset("/solver/iterations")
-            .and_then(|d| d.read_raw::<u64>())
-            .map(|v| v.into_iter().map(|i| i as f64).collect())
-            .map_err(|e| err(format!("/solver/iterations: {e}")))?,
-        beta: read("/solver/beta")?,
+        dt: r.values("/solver/dt").map_err(err)?,
+        iterations: r
+            .counts("/solver/iterations")
+            .map_err(err)?
+            .into_iter()
+            .map(|i| i as f64)
+            .collect(),
+        beta: r.values("/solver/beta").map_err(err)?,
         time,
-        balance,
-        wall_time_s,
-        energy_scale: work
-            .iter()
-            .fold(total.first().map_or(0.0, |e| e.abs()), |m, v| {
-                m.max(v.abs())
-            })
-            .max(f64::MIN_POSITIVE),
+        balance: r.energy_balance().map_err(err)?,
+        wall_time_s: r.wall_time_s(),
+        energy_scale: r.energy_scale().map_err(err)?.max(f64::MIN_POSITIVE),
     };
     Ok(record)
 }

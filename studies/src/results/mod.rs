@@ -81,8 +81,10 @@
 //! ```
 
 pub mod layout;
+pub mod reader;
 pub mod restart;
 mod writer;
 
+pub use reader::{ReadError, ResultReader};
 pub use restart::{read_checkpoint, RestartError};
 pub use writer::{rotation_vector, ResultError, ResultWriter, RunMeta};

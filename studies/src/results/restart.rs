@@ -213,10 +213,7 @@ pub fn read_checkpoint(path: &Path) -> Result<(Checkpoint, Vec<[f64; 3]>), Resta
             .chunks_exact(3)
             .map(|c| Vector3::new(c[0], c[1], c[2]))
             .collect(),
-        rotations: r
-            .chunks_exact(9)
-            .map(Matrix3::from_row_slice)
-            .collect(),
+        rotations: r.chunks_exact(9).map(Matrix3::from_row_slice).collect(),
         released: Checkpoint::released_from_rows(&rows),
         prescribed,
         scheme,

@@ -18,7 +18,7 @@ use crate::model::{load_model, ModelError};
 /// [`crate::study`] for the definitions).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Figure {
-    /// `energy_drift`: max |E(t) − E(0)| / max(|E(0)|, max |E|).
+    /// `energy_drift`: [`crate::results::reader::energy_drift`].
     EnergyDrift,
     /// `max_displacement`: largest displacement of any tracked node.
     MaxDisplacement,
