@@ -520,7 +520,10 @@ pub fn joint_records(mech: &Mechanism, state: &MechanismState) -> Vec<JointRecor
             let pos = (c.x[s] - c.x[m] - c.rot[m] * rr).norm();
             let rot: Matrix3<f64> = c.rot[m].transpose() * c.rot[s] - lr;
             JointRecord {
-                angle: joint.map.reported_angle(&state.released[j]),
+                angle: joint
+                    .map
+                    .reported_angle(&state.released[j])
+                    .unwrap_or(f64::NAN),
                 released_translation: [rr.x, rr.y, rr.z],
                 constraint_error: pos + rot.norm(),
             }

@@ -22,7 +22,8 @@ pub struct Energies {
 /// State of one joint at the end of a step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointRecord {
-    /// Released angle ψ about the joint axis.
+    /// Released angle ψ about the joint axis (NaN for a kind without one,
+    /// e.g. prismatic or rigid; see `JointKinematics::reported_angle`).
     pub angle: f64,
     /// Released translation `r_R` in the master frame.
     pub released_translation: [f64; 3],

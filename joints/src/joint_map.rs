@@ -73,7 +73,7 @@ pub trait JointMap: Send + Sync + Debug {
     /// Advances the released state by `delta` (length `released_count`).
     fn advance(&self, state: &mut ReleasedState, delta: &[f64]);
     /// The angle reported in results.
-    fn reported_angle(&self, state: &ReleasedState) -> f64;
+    fn reported_angle(&self, state: &ReleasedState) -> Option<f64>;
 }
 
 /// Slave increment `(Δx, spin)` for the local increment `e` applied after `h`,
@@ -237,7 +237,7 @@ impl<J: JointKinematics> JointMap for J {
         JointKinematics::advance(self, state, delta)
     }
 
-    fn reported_angle(&self, state: &ReleasedState) -> f64 {
+    fn reported_angle(&self, state: &ReleasedState) -> Option<f64> {
         JointKinematics::reported_angle(self, state)
     }
 }

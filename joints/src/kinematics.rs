@@ -116,13 +116,11 @@ pub trait JointKinematics: Send + Sync + Debug {
         additive_step_map(self, start, end, inc)
     }
 
-    /// The released rotation angle reported as `/joints/<name>/angle`.
-    fn reported_angle(&self, state: &ReleasedState) -> f64 {
-        if Self::RELEASED > 0 {
-            state.q[0]
-        } else {
-            0.0
-        }
+    /// The released rotation angle reported as `/joints/<name>/angle`, or
+    /// `None` for a kind without one (the dataset is then absent). By
+    /// default the first coordinate when it is named `"angle"`.
+    fn reported_angle(&self, state: &ReleasedState) -> Option<f64> {
+        (self.coordinate_names().first() == Some(&"angle")).then_some(state.q[0])
     }
 }
 

@@ -30,11 +30,6 @@ impl JointKinematics for Prismatic {
     fn coordinate_names(&self) -> &'static [&'static str] {
         &["slide"]
     }
-
-    /// No released rotation.
-    fn reported_angle(&self, _: &ReleasedState) -> f64 {
-        0.0
-    }
 }
 
 impl ModelJoint for Prismatic {

@@ -52,8 +52,8 @@ impl JointKinematics for Spherical {
     }
 
     /// The magnitude of the released rotation.
-    fn reported_angle(&self, state: &ReleasedState) -> f64 {
-        log(&state.rot).norm()
+    fn reported_angle(&self, state: &ReleasedState) -> Option<f64> {
+        Some(log(&state.rot).norm())
     }
 }
 

@@ -5,7 +5,9 @@
 use crate::build::{build, Built};
 use crate::checks::{Balance, Stability};
 use crate::model::{Analysis, MassKind, Model, ModelError};
-use crate::results::{layout, read_checkpoint, RestartError, ResultError, ResultWriter, RunMeta};
+use crate::results::{
+    layout, read_checkpoint, MeshMeta, RestartError, ResultError, ResultWriter, RunMeta,
+};
 use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
 use flexmech_integrators::{
     solve_static, Mechanism, NewtonSettings, SolveError, StaticSettings, StepRecord,
@@ -282,6 +284,13 @@ fn run(
             .map(|(label, r)| (label.clone(), built.node(*r)))
             .collect(),
         joint_names: model.joints.iter().map(|j| j.name.clone()).collect(),
+        joint_angles: mech
+            .joints
+            .iter()
+            .map(|j| j.map.reported_angle(&j.initial).is_some())
+            .collect(),
+        command_line: command_line(),
+        mesh: Some(mesh_meta(model, &built)),
     };
     let mut writer = ResultWriter::create(&file, &meta)?;
     if let Some((c, from)) = restart_from {
@@ -406,6 +415,41 @@ fn run(
                 file,
             })
         }
+    }
+}
+
+/// This process's command line, arguments with spaces quoted.
+fn command_line() -> String {
+    std::env::args()
+        .map(|a| {
+            if a.contains(char::is_whitespace) {
+                format!("{a:?}")
+            } else {
+                a
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Labels, elements and beams of the built mechanism, for `/mesh`.
+fn mesh_meta(model: &Model, built: &Built) -> MeshMeta {
+    let mesh = &built.mechanism.mesh;
+    let mut node_labels = vec![String::new(); mesh.node_count()];
+    for (b, nodes) in built.beam_nodes.iter().enumerate() {
+        for (k, &n) in nodes.iter().enumerate() {
+            node_labels[n] = model.node_label(crate::model::NodeRef { beam: b, node: k });
+        }
+    }
+    MeshMeta {
+        node_labels,
+        elements: mesh.elements.iter().map(|e| e.nodes().to_vec()).collect(),
+        beams: model
+            .beams
+            .iter()
+            .zip(&built.beam_nodes)
+            .map(|(b, nodes)| (b.name.clone(), nodes.clone()))
+            .collect(),
     }
 }
 

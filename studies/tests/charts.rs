@@ -388,6 +388,7 @@ fn write_result(path: &Path, status: &str) {
         initial_positions: vec![[0.0; 3], [1.0, 0.0, 0.0]],
         tracked: vec![("bend.end".into(), 1)],
         joint_names: vec![],
+        ..Default::default()
     };
     let mut writer = ResultWriter::create(path, &meta).expect("create the result file");
     for k in 0..STEPS {

@@ -154,6 +154,7 @@ fn meta() -> RunMeta {
         initial_positions: (0..N_NODES).map(initial).collect(),
         tracked: vec![("arm.end".to_owned(), 3), ("post.1".to_owned(), 1)],
         joint_names: vec!["hinge.a".to_owned()],
+        ..Default::default()
     }
 }
 

@@ -18,6 +18,33 @@ pub const ATTR_STATUS: &str = "status";
 pub const ATTR_WALL_TIME: &str = "wall_time_s";
 /// Root attribute: warnings about a completed result (absent when none).
 pub const ATTR_WARNINGS: &str = "warnings";
+/// Root attribute: the git revision flexmech was built from (`+modified`
+/// when the working tree had uncommitted changes; `unknown` outside git).
+pub const ATTR_GIT_REVISION: &str = "git_revision";
+/// Root attribute: when the file was created, UTC, ISO 8601.
+pub const ATTR_CREATED: &str = "created";
+/// Root attribute: the units of the numbers in the file.
+pub const ATTR_UNITS: &str = "units";
+/// Root attribute: the command line that made the run (when known).
+pub const ATTR_COMMAND_LINE: &str = "command_line";
+/// The text of [`ATTR_UNITS`].
+pub const UNITS_NOTE: &str = "the model file's consistent units (e.g. m, kg, s, N, J); angles and \
+                              rotation vectors in radians";
+/// `/mesh`: the mesh, written once.
+pub const MESH: &str = "/mesh";
+/// nodes (strings): every node's label, in `/configuration` order.
+pub const MESH_NODE_LABELS: &str = "/mesh/node_labels";
+/// Σ nodes per element (u64): the elements' nodes, element after element.
+pub const MESH_ELEMENT_NODES: &str = "/mesh/element_nodes";
+/// elements + 1 (u64): element `e` has nodes `element_nodes[offsets[e]..offsets[e+1]]`.
+pub const MESH_ELEMENT_OFFSETS: &str = "/mesh/element_offsets";
+/// beams (strings): the beams' names, in model order.
+pub const MESH_BEAM_NAMES: &str = "/mesh/beam_names";
+/// Σ nodes per beam (u64): the beams' nodes in order along each beam.
+pub const MESH_BEAM_NODES: &str = "/mesh/beam_nodes";
+/// beams + 1 (u64): beam `b` has nodes `beam_nodes[offsets[b]..offsets[b+1]]`.
+pub const MESH_BEAM_OFFSETS: &str = "/mesh/beam_offsets";
+
 /// Root attribute of a continued run: the result file it continues.
 pub const ATTR_RESTARTED_FROM: &str = "restarted_from";
 /// Root attribute of a continued run: the time it continues from.

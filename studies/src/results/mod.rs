@@ -70,6 +70,7 @@
 //!     initial_positions: vec![[0.0; 3], [1.0, 0.0, 0.0]],
 //!     tracked: vec![("arm.end".into(), 1)],
 //!     joint_names: vec![],
+//!     ..Default::default()
 //! };
 //! let mut writer = ResultWriter::create("run.h5".as_ref(), &meta)?;
 //! for step in steps() {
@@ -81,10 +82,11 @@
 //! ```
 
 pub mod layout;
+mod mesh;
 pub mod reader;
 pub mod restart;
 mod writer;
 
 pub use reader::{ReadError, ResultReader};
 pub use restart::{read_checkpoint, RestartError};
-pub use writer::{rotation_vector, ResultError, ResultWriter, RunMeta};
+pub use writer::{rotation_vector, MeshMeta, ResultError, ResultWriter, RunMeta};

@@ -40,6 +40,26 @@ pub struct RunMeta {
     /// `released_translation` and `constraint_error`. Every [`StepRecord`]
     /// must carry exactly this many joint records.
     pub joint_names: Vec<String>,
+    /// Per joint, whether it has a released angle (`/joints/<name>/angle`
+    /// is written only then); joints past the end of the list have one.
+    pub joint_angles: Vec<bool>,
+    /// The command line that made the run; root attribute `command_line`
+    /// (omitted when empty).
+    pub command_line: String,
+    /// The mesh: `/mesh` (omitted when `None`).
+    pub mesh: Option<MeshMeta>,
+}
+
+/// The mesh as the result file records it under `/mesh`, enough to draw the
+/// mechanism without the model text.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MeshMeta {
+    /// Every node's label, in `/configuration` order (`arm.0`, `arm.end`, ...).
+    pub node_labels: Vec<String>,
+    /// Every element's nodes (2 or 3), in element order.
+    pub elements: Vec<Vec<usize>>,
+    /// Every beam's name and its nodes in order along it.
+    pub beams: Vec<(String, Vec<usize>)>,
 }
 
 /// Everything that can go wrong while writing a result file.
@@ -324,7 +344,8 @@ struct NodeSets {
 }
 
 struct JointSets {
-    angle: Series,
+    /// Absent for a joint without a released angle.
+    angle: Option<Series>,
     released_translation: Series,
     constraint_error: Series,
 }
@@ -383,11 +404,11 @@ impl Datasets {
                 .iter()
                 .flat_map(|n| [&n.position, &n.displacement, &n.rotation]),
         )
-        .chain(
-            self.joints
+        .chain(self.joints.iter().flat_map(|j| {
+            j.angle
                 .iter()
-                .flat_map(|j| [&j.angle, &j.released_translation, &j.constraint_error]),
-        )
+                .chain([&j.released_translation, &j.constraint_error])
+        }))
     }
 }
 
@@ -477,15 +498,25 @@ impl ResultWriter {
         // and leaves the first one's result intact.
         let lock = lock_result(path)?;
         let file = File::create(path).ctx(path, || "creating the file".to_owned())?;
-        let attrs = [
+        let created = super::mesh::utc_now();
+        let mut attrs = vec![
             (names::ATTR_MODEL, meta.model_text.as_str()),
             (names::ATTR_INTEGRATOR, meta.integrator.as_str()),
             (names::ATTR_VERSION, env!("CARGO_PKG_VERSION")),
+            (names::ATTR_GIT_REVISION, env!("FLEXMECH_GIT_REVISION")),
+            (names::ATTR_CREATED, created.as_str()),
+            (names::ATTR_UNITS, names::UNITS_NOTE),
             (names::ATTR_STATUS, names::STATUS_RUNNING),
         ];
+        if !meta.command_line.is_empty() {
+            attrs.push((names::ATTR_COMMAND_LINE, meta.command_line.as_str()));
+        }
         for (name, value) in attrs {
             create_str_attr(&file, name, value)
                 .ctx(path, || format!("writing root attribute {name}"))?;
+        }
+        if let Some(mesh) = &meta.mesh {
+            super::mesh::write(&file, mesh).ctx(path, || "writing /mesh".to_owned())?;
         }
 
         let groups = [
@@ -638,12 +669,17 @@ impl ResultWriter {
                 .ctx(path, || {
                     format!("writing {group} attribute {}", names::ATTR_JOINT_INDEX)
                 })?;
+            let has_angle = meta.joint_angles.get(index).copied().unwrap_or(true);
             joints.push(JointSets {
-                angle: f64s(
-                    &names::joint_path(name, names::JOINT_ANGLE),
-                    &[],
-                    "released angle psi",
-                )?,
+                angle: if has_angle {
+                    Some(f64s(
+                        &names::joint_path(name, names::JOINT_ANGLE),
+                        &[],
+                        "released angle psi",
+                    )?)
+                } else {
+                    None
+                },
                 released_translation: f64s(
                     &names::joint_path(name, names::JOINT_RELEASED_TRANSLATION),
                     &[3],
@@ -823,7 +859,9 @@ impl ResultWriter {
                 .push_row(t, rotation_vector(step.quaternions[node.index]), path)?;
         }
         for (joint, record) in s.joints.iter().zip(&step.joints) {
-            joint.angle.push_scalar(t, record.angle, path)?;
+            if let Some(angle) = &joint.angle {
+                angle.push_scalar(t, record.angle, path)?;
+            }
             joint
                 .released_translation
                 .push_row(t, record.released_translation, path)?;
