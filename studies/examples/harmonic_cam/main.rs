@@ -179,10 +179,30 @@ mod tests {
             csv.lines().skip(1).all(|l| l.contains("completed")),
             "{csv}"
         );
-        for figure in ["max_displacement", "energy_drift", "newton_iterations"] {
+        for figure in [
+            "max_displacement",
+            "energy_drift",
+            "newton_iterations",
+            "follower_x",
+        ] {
             assert!(
                 dir.join(format!("charts/{figure}.png")).is_file(),
                 "{figure}"
+            );
+        }
+        // The study's own figure: the drive table reaches ψ = π/2 − 1 at
+        // t = 0.5 s, ψ grows all the way and nψ < π, so the deepest follower
+        // position is the last, −(a + rise (1 − cos nψ)/2).
+        let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+        let col = header.iter().position(|h| *h == "follower_x").unwrap();
+        let psi = std::f64::consts::FRAC_PI_2 - 1.0;
+        let params = [(0.05, 1.0), (0.05, 2.0), (0.1, 1.0), (0.1, 2.0)];
+        for (line, (rise, lobes)) in csv.lines().skip(1).zip(params) {
+            let value: f64 = line.split(',').nth(col).unwrap().parse().unwrap();
+            let expected = -(0.02 + 0.5 * rise * (1.0 - (lobes * psi).cos()));
+            assert!(
+                (value - expected).abs() <= 1e-12,
+                "{line}: {value} vs {expected}"
             );
         }
         // Every run obeys the joint relation (1) of its own parameters,

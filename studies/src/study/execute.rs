@@ -78,7 +78,7 @@ fn run_one(
         }
     }
     match run_model_to(model, &file) {
-        Ok(_) | Err(RunError::Solve { .. }) => Ok(read_figures(&file)?),
+        Ok(_) | Err(RunError::Solve { .. }) => Ok(read_figures(&file, &spec.figures)?),
         Err(RunError::Model(e)) => Ok(RunFigures::without_file(layout::failed_status(
             &e.to_string(),
         ))),

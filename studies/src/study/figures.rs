@@ -20,6 +20,8 @@ pub struct RunFigures {
     pub wall_time: f64,
     /// See [`Figure::NewtonIterations`].
     pub newton_iterations: f64,
+    /// The values of the study's [`Figure::Dataset`] figures, by name.
+    pub datasets: Vec<(String, f64)>,
 }
 
 impl RunFigures {
@@ -33,12 +35,18 @@ impl RunFigures {
             failure_time: f64::NAN,
             wall_time: f64::NAN,
             newton_iterations: f64::NAN,
+            datasets: Vec::new(),
         }
     }
 
     /// The value of `figure`.
-    pub fn get(&self, figure: Figure) -> f64 {
+    pub fn get(&self, figure: &Figure) -> f64 {
         match figure {
+            Figure::Dataset(d) => self
+                .datasets
+                .iter()
+                .find(|(n, _)| *n == d.name)
+                .map_or(f64::NAN, |(_, v)| *v),
             Figure::EnergyDrift => self.energy_drift,
             Figure::MaxDisplacement => self.max_displacement,
             Figure::FailureTime => self.failure_time,
@@ -72,8 +80,9 @@ pub struct FigureError(#[from] pub ReadError);
 /// - `failure_time`: last value of `/time` when the status starts with
 ///   `failed`, else NaN;
 /// - `wall_time`: root attribute `wall_time_s` (NaN if absent);
-/// - `newton_iterations`: sum of `/solver/iterations`.
-pub fn read_figures(file: &Path) -> Result<RunFigures, FigureError> {
+/// - `newton_iterations`: sum of `/solver/iterations`;
+/// - every [`Figure::Dataset`] of `figures`: its reduction of its dataset.
+pub fn read_figures(file: &Path, figures: &[Figure]) -> Result<RunFigures, FigureError> {
     let r = ResultReader::open(file)?;
     let status = r.status()?;
     let mut max_displacement = f64::NAN;
@@ -95,6 +104,13 @@ pub fn read_figures(file: &Path) -> Result<RunFigures, FigureError> {
         failure_time,
         wall_time: r.wall_time_s(),
         newton_iterations: r.counts(layout::SOLVER_ITERATIONS)?.iter().sum::<u64>() as f64,
+        datasets: figures
+            .iter()
+            .filter_map(|f| match f {
+                Figure::Dataset(d) => Some(d.value(&r).map(|v| (d.name.clone(), v))),
+                _ => None,
+            })
+            .collect::<Result<_, _>>()?,
         status,
     })
 }

@@ -93,6 +93,7 @@
 use std::path::{Path, PathBuf};
 
 pub mod charts;
+pub mod dataset_figure;
 pub mod execute;
 pub mod figures;
 pub mod key_path;
@@ -102,6 +103,7 @@ pub mod spec;
 pub mod summary;
 pub mod sweep;
 
+pub use dataset_figure::{Component, DatasetFigure, Reduce};
 pub use execute::{run_study, StudyOptions};
 pub use merge::{merge_study, MergeError};
 pub use shard::{select_shard, Shard, ShardError, SlurmArray};

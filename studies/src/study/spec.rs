@@ -11,12 +11,13 @@ use std::path::{Path, PathBuf};
 
 use toml::{Table, Value};
 
+use super::dataset_figure::DatasetFigure;
 use super::key_path::{base_dir, check_key, KeyPath};
 use crate::model::{load_model, ModelError};
 
 /// A per-run scalar of the summary table (see the module docs of
 /// [`crate::study`] for the definitions).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub enum Figure {
     /// `energy_drift`: [`crate::results::reader::energy_drift`].
     EnergyDrift,
@@ -28,6 +29,8 @@ pub enum Figure {
     WallTime,
     /// `newton_iterations`: total Newton iterations.
     NewtonIterations,
+    /// A researcher's own: a dataset reduced to one number per run.
+    Dataset(DatasetFigure),
 }
 
 impl Figure {
@@ -41,8 +44,9 @@ impl Figure {
     ];
 
     /// The name used in study files, summary columns and chart files.
-    pub fn name(self) -> &'static str {
+    pub fn name(&self) -> &str {
         match self {
+            Figure::Dataset(d) => &d.name,
             Figure::EnergyDrift => "energy_drift",
             Figure::MaxDisplacement => "max_displacement",
             Figure::FailureTime => "failure_time",
@@ -57,25 +61,31 @@ impl Figure {
     }
 
     /// The label of a summary chart's y axis.
-    pub fn axis_label(self) -> &'static str {
-        match self {
+    pub fn axis_label(&self) -> String {
+        let label = match self {
+            Figure::Dataset(d) => return d.description(),
             Figure::EnergyDrift => "relative energy drift",
             Figure::MaxDisplacement => "largest displacement",
             Figure::FailureTime => "failure time",
             Figure::WallTime => "wall time (s)",
             Figure::NewtonIterations => "Newton iterations",
-        }
+        };
+        label.to_string()
     }
 
     /// A one-line meaning, for HDF5 descriptions.
-    pub fn description(self) -> &'static str {
-        match self {
-            Figure::EnergyDrift => "relative energy drift max|E-E0|/max(|E0|,max|E|)",
+    pub fn description(&self) -> String {
+        let text = match self {
+            Figure::Dataset(d) => return d.description(),
+            Figure::EnergyDrift => {
+                "relative energy drift max|B-B0|/max(|E0|,max|W|,K0+U0), B = E - W (drivers' work)"
+            }
             Figure::MaxDisplacement => "largest tracked-node displacement",
             Figure::FailureTime => "time of the last stored step of a failed run",
             Figure::WallTime => "wall time of the solve (s)",
             Figure::NewtonIterations => "total Newton iterations",
-        }
+        };
+        text.to_string()
     }
 }
 
@@ -262,6 +272,16 @@ pub enum SpecError {
         /// The name given.
         name: String,
     },
+    /// A dataset figure that does not parse.
+    #[error("{}{}: key `output.figures`: {why}", .file.display(), at(.line))]
+    BadFigure {
+        /// The study file.
+        file: PathBuf,
+        /// 1-based line, where known.
+        line: Option<usize>,
+        /// What is wrong.
+        why: String,
+    },
     /// A figure listed twice in `output.figures`.
     #[error(
         "{}{}: key `output.figures`: \"{name}\" is listed twice; list each figure once",
@@ -291,7 +311,11 @@ fn at(line: &Option<usize>) -> String {
 }
 
 fn known_figures() -> String {
-    Figure::ALL.map(Figure::name).join(", ")
+    let names: Vec<&str> = Figure::ALL.iter().map(Figure::name).collect();
+    format!(
+        "{}, or a table {{ name, dataset, reduce, component }} reducing a result dataset",
+        names.join(", ")
+    )
 }
 
 /// Short description of a TOML value's type and value, for messages.
@@ -541,23 +565,27 @@ pub fn parse_study(text: &str, path: &Path) -> Result<StudySpec, SpecError> {
                 };
                 figures.clear();
                 for n in names {
-                    let Value::String(s) = n else {
-                        return Err(wrong_type(
-                            "output.figures",
-                            "a list of figure names (strings)",
-                            n,
-                        ));
+                    let figure = match n {
+                        Value::String(s) => {
+                            Figure::from_name(s).ok_or_else(|| SpecError::UnknownFigure {
+                                file: file.clone(),
+                                line,
+                                name: s.clone(),
+                            })?
+                        }
+                        other => Figure::Dataset(DatasetFigure::parse(other).map_err(|why| {
+                            SpecError::BadFigure {
+                                file: file.clone(),
+                                line,
+                                why,
+                            }
+                        })?),
                     };
-                    let figure = Figure::from_name(s).ok_or_else(|| SpecError::UnknownFigure {
-                        file: file.clone(),
-                        line,
-                        name: s.clone(),
-                    })?;
-                    if figures.contains(&figure) {
+                    if figures.iter().any(|f| f.name() == figure.name()) {
                         return Err(SpecError::DuplicateFigure {
                             file,
                             line,
-                            name: s.clone(),
+                            name: figure.name().to_string(),
                         });
                     }
                     figures.push(figure);

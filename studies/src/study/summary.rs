@@ -118,7 +118,7 @@ pub fn columns(spec: &StudySpec) -> Vec<Column> {
         cols.push(Column {
             name: f.name().into(),
             kind: ColumnKind::Number,
-            description: f.description().into(),
+            description: f.description(),
         });
     }
     cols
@@ -142,7 +142,7 @@ pub fn row(spec: &StudySpec, cols: &[Column], plan: &RunPlan, figures: &RunFigur
     }
     cells.push(Cell::Text(figures.status.clone()));
     for f in &spec.figures {
-        cells.push(Cell::Number(figures.get(*f)));
+        cells.push(Cell::Number(figures.get(f)));
     }
     cells
 }
