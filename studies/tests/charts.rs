@@ -8,7 +8,7 @@ use std::sync::{Mutex, MutexGuard};
 
 use flexmech_integrators::record::{Energies, StepRecord};
 use flexmech_studies::charts::{plot_datasets, ChartError, LineChart, PlotError, Series};
-use flexmech_studies::results::{layout, ResultWriter, RunMeta};
+use flexmech_studies::results::{layout, ReadError, ResultWriter, RunMeta};
 
 /// HDF5 opens files without close-on-exec and locks them: the CLI test's child
 /// process must not inherit a file another test is writing. Serialise the
@@ -470,7 +470,10 @@ fn plot_errors_name_the_dataset_and_what_exists() {
     let err =
         plot_datasets(&file, &["/nodes/bend.end/displacment".into()], &out, false).unwrap_err();
     let message = err.to_string();
-    assert!(matches!(err, PlotError::UnknownDataset { .. }), "{message}");
+    assert!(
+        matches!(err, PlotError::Read(ReadError::UnknownDataset { .. })),
+        "{message}"
+    );
     assert!(message.contains("bend.h5"), "{message}");
     assert!(message.contains("/nodes/bend.end/displacment"), "{message}");
     assert!(
@@ -490,7 +493,10 @@ fn plot_errors_name_the_dataset_and_what_exists() {
 
     // A group is not a dataset.
     let err = plot_datasets(&file, &["/energy".into()], &out, false).unwrap_err();
-    assert!(matches!(err, PlotError::UnknownDataset { .. }), "{err}");
+    assert!(
+        matches!(err, PlotError::Read(ReadError::UnknownDataset { .. })),
+        "{err}"
+    );
 
     // T × nodes × 3 and Σ iterations are not chartable shapes.
     let err = plot_datasets(&file, &["/configuration/position".into()], &out, false).unwrap_err();
@@ -512,7 +518,10 @@ fn plot_errors_name_the_dataset_and_what_exists() {
         false,
     )
     .unwrap_err();
-    assert!(matches!(err, PlotError::UnknownDataset { .. }), "{err}");
+    assert!(
+        matches!(err, PlotError::Read(ReadError::UnknownDataset { .. })),
+        "{err}"
+    );
     assert!(!out.join("energy_strain.png").exists());
 }
 

@@ -16,33 +16,10 @@ use crate::results::{layout, ReadError, ResultReader};
 /// result file (and the dataset where one is involved).
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
-    /// The HDF5 library reported an error.
-    #[error("{}: HDF5 error while {what}: {source}", .path.display())]
-    Hdf5 {
-        /// The result file.
-        path: PathBuf,
-        /// What was being done, naming the dataset or attribute.
-        what: String,
-        /// The library's error.
-        #[source]
-        source: hdf5::Error,
-    },
-    /// The dataset does not exist (or is a group).
-    #[error(
-        "{}: no dataset {dataset}; datasets under {group}: {}",
-        .path.display(),
-        if .available.is_empty() { "(none)".to_owned() } else { .available.join(", ") }
-    )]
-    UnknownDataset {
-        /// The result file.
-        path: PathBuf,
-        /// The dataset asked for.
-        dataset: String,
-        /// The nearest existing group above it.
-        group: String,
-        /// Every dataset below that group.
-        available: Vec<String>,
-    },
+    /// The result file could not be read (an HDF5 error, or no such dataset:
+    /// the message lists the datasets under the nearest existing group).
+    #[error(transparent)]
+    Read(#[from] ReadError),
     /// The dataset is neither T nor T×3 (T = length of `/time`).
     #[error(
         "{}: dataset {dataset} has shape {}, but a chart needs {steps} (one value per step) \
@@ -80,36 +57,6 @@ pub enum PlotError {
         #[source]
         source: ChartError,
     },
-}
-
-impl From<ReadError> for PlotError {
-    fn from(e: ReadError) -> Self {
-        match e {
-            ReadError::Hdf5 { path, what, source } => PlotError::Hdf5 { path, what, source },
-            ReadError::UnknownDataset {
-                path,
-                dataset,
-                group,
-                available,
-            } => PlotError::UnknownDataset {
-                path,
-                dataset,
-                group,
-                available,
-            },
-            ReadError::Shape {
-                path,
-                dataset,
-                shape,
-                ..
-            } => PlotError::BadShape {
-                path,
-                dataset,
-                shape,
-                steps: 0,
-            },
-        }
-    }
 }
 
 fn shape_text(shape: &[usize]) -> String {

@@ -5,7 +5,18 @@ use hdf5::types::VarLenUnicode;
 use hdf5::File;
 
 use super::layout as names;
-use super::writer::MeshMeta;
+
+/// The mesh as the result file records it under `/mesh`, enough to draw the
+/// mechanism without the model text.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MeshMeta {
+    /// Every node's label, in `/configuration` order (`arm.0`, `arm.end`, ...).
+    pub node_labels: Vec<String>,
+    /// Every element's nodes (2 or 3), in element order.
+    pub elements: Vec<Vec<usize>>,
+    /// Every beam's name and its nodes in order along it.
+    pub beams: Vec<(String, Vec<usize>)>,
+}
 
 /// Writes `/mesh`: labels, and elements and beams as flattened lists with
 /// offsets (the compressed-row layout VTK and ParaView use).

@@ -87,6 +87,7 @@ pub mod reader;
 pub mod restart;
 mod writer;
 
+pub use mesh::MeshMeta;
 pub use reader::{ReadError, ResultReader};
 pub use restart::{read_checkpoint, RestartError};
-pub use writer::{rotation_vector, MeshMeta, ResultError, ResultWriter, RunMeta};
+pub use writer::{rotation_vector, ResultError, ResultWriter, RunMeta};

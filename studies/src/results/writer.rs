@@ -47,19 +47,7 @@ pub struct RunMeta {
     /// (omitted when empty).
     pub command_line: String,
     /// The mesh: `/mesh` (omitted when `None`).
-    pub mesh: Option<MeshMeta>,
-}
-
-/// The mesh as the result file records it under `/mesh`, enough to draw the
-/// mechanism without the model text.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct MeshMeta {
-    /// Every node's label, in `/configuration` order (`arm.0`, `arm.end`, ...).
-    pub node_labels: Vec<String>,
-    /// Every element's nodes (2 or 3), in element order.
-    pub elements: Vec<Vec<usize>>,
-    /// Every beam's name and its nodes in order along it.
-    pub beams: Vec<(String, Vec<usize>)>,
+    pub mesh: Option<super::mesh::MeshMeta>,
 }
 
 /// Everything that can go wrong while writing a result file.
