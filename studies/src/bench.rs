@@ -15,7 +15,9 @@ use std::path::{Path, PathBuf};
 pub struct Case {
     /// Short label, e.g. `newmark/modified`.
     pub label: &'static str,
+    /// The integrator's model-file name.
     pub integrator: &'static str,
+    /// `"full"` or `"modified"` Newton.
     pub newton: &'static str,
     /// Nodes per element (3-node elements run with half as many elements,
     /// so the unknowns are the same).
@@ -65,10 +67,13 @@ pub const CASES: [Case; 6] = [
 /// One timed run.
 #[derive(Debug, Clone)]
 pub struct Timing {
+    /// What ran.
     pub case: Case,
     /// Elements of 2 nodes (or the 3-node mesh with the same unknowns).
     pub elements: usize,
+    /// Time steps taken.
     pub steps: usize,
+    /// Newton iterations in all.
     pub iterations: usize,
     /// Wall time of the solve, seconds.
     pub seconds: f64,

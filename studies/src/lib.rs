@@ -1,6 +1,8 @@
 //! flexmech-studies: model files, the mechanism builder, runs that stream
 //! results into HDF5 files, and the `flexmech` command line.
 
+#![warn(missing_docs)]
+
 pub mod bench;
 pub mod build;
 pub mod charts;

@@ -4,7 +4,7 @@
 
 use crate::build::{build, Built};
 use crate::checks::{Balance, Stability};
-use crate::model::{Analysis, MassKind, Model, ModelError};
+use crate::model::{Analysis, Model, ModelError};
 use crate::results::{
     layout, read_checkpoint, MeshMeta, RestartError, ResultError, ResultWriter, RunMeta,
 };
@@ -25,7 +25,9 @@ pub enum RunError {
     /// The output directory could not be created.
     #[error("cannot create the output directory {dir}: {source}")]
     OutputDir {
+        /// The directory.
         dir: PathBuf,
+        /// The system's error.
         source: std::io::Error,
     },
     /// Writing the result file failed.
@@ -40,8 +42,11 @@ pub enum RunError {
         first.display()
     )]
     DuplicateName {
+        /// The shared name.
         name: String,
+        /// The second model file.
         file: PathBuf,
+        /// The first model file with that name.
         first: PathBuf,
     },
     /// The result file to continue cannot be read.
@@ -68,10 +73,13 @@ pub enum RunError {
         file.display()
     )]
     Solve {
+        /// The model's name.
         model: String,
         /// The model file.
         path: PathBuf,
+        /// The solver's error.
         error: Box<SolveError>,
+        /// The result file holding the steps computed before.
         file: PathBuf,
     },
 }
@@ -339,10 +347,7 @@ fn run(
                     modified: model.solver.modified_newton,
                 },
                 max_halvings: model.solver.max_halvings,
-                mass: match model.solver.mass {
-                    MassKind::Consistent => flexmech_core::MassKind::Consistent,
-                    MassKind::Lumped => flexmech_core::MassKind::Lumped,
-                },
+                mass: model.solver.mass,
             };
             let sim = match restart {
                 Some(c) => Simulation::resume(mech, integrator, &settings, c),

@@ -40,7 +40,7 @@ pub struct Checkpoint {
     /// Current values of the prescribed nodal DOFs.
     pub prescribed: Vec<f64>,
     /// What the scheme carries (velocities, accelerations, joint rates,
-    /// drivers' reactions), in the scheme's order ([`Tape`]).
+    /// drivers' reactions), in the order the scheme writes them.
     pub scheme: Vec<f64>,
 }
 

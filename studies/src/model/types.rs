@@ -27,6 +27,7 @@ pub enum TimeFunction {
 /// Cross-section and material, per unit length.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SectionSpec {
+    /// Its name (`section` of a beam refers to it).
     pub name: String,
     /// Axial stiffness EA.
     pub ea: f64,
@@ -48,8 +49,11 @@ pub enum BeamGeometry {
     /// Straight from `start` to `end`; `e2` is the section's second axis (not
     /// parallel to the beam; it is orthogonalised against the beam axis).
     Straight {
+        /// First end (the beam's `start` node).
         start: [f64; 3],
+        /// Second end (the beam's `end` node).
         end: [f64; 3],
+        /// The section's second axis (before orthogonalisation).
         e2: [f64; 3],
     },
     /// Circular arc: starts at `start`, turns about `normal` (unit) through
@@ -57,10 +61,15 @@ pub enum BeamGeometry {
     /// `normal × (start − center)/radius`. `e2` defaults to the direction from
     /// the point towards the center.
     Arc {
+        /// First point of the arc.
         start: [f64; 3],
+        /// Centre of the circle.
         center: [f64; 3],
+        /// Unit normal of the arc's plane (the turning axis).
         normal: [f64; 3],
+        /// Angle swept, radians.
         sweep: f64,
+        /// The section's second axis at the start, if given.
         e2: Option<[f64; 3]>,
     },
 }
@@ -68,10 +77,13 @@ pub enum BeamGeometry {
 /// A beam meshed into equal elements.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BeamSpec {
+    /// Its name (node labels start with it).
     pub name: String,
     /// Index into [`Model::sections`].
     pub section: usize,
+    /// Its initial geometry.
     pub geometry: BeamGeometry,
+    /// Number of elements.
     pub elements: usize,
     /// 2 (linear) or 3 (quadratic).
     pub nodes_per_element: usize,
@@ -87,17 +99,22 @@ impl BeamSpec {
 /// A support: the listed DOFs of a node are held at their initial values.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SupportSpec {
+    /// The supported node.
     pub node: NodeRef,
     /// `[ux, uy, uz, rx, ry, rz]`: true where fixed.
     pub fixed: [bool; 6],
 }
 
+/// A `[[joint]]`: a master–slave relation between two nodes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JointSpec {
+    /// Its name (`/joints/<name>` in results).
     pub name: String,
     /// The registered kind and its parameters ([`super::JointRegistry`]).
     pub kind: super::JointKind,
+    /// The master node (carries the joint frame).
     pub master: NodeRef,
+    /// The slave node (its DOFs are eliminated).
     pub slave: NodeRef,
     /// Initial released angle ψ₀ (default 0).
     pub angle: f64,
@@ -105,33 +122,52 @@ pub struct JointSpec {
     pub rate: f64,
 }
 
+/// A `[[load]]`: a dead force and a fixed-axis moment on a node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoadSpec {
+    /// The loaded node.
     pub node: NodeRef,
+    /// Force, global components.
     pub force: [f64; 3],
+    /// Moment about fixed global axes.
     pub moment: [f64; 3],
     /// `None` when the file gives no `time` table.
     pub time: Option<TimeFunction>,
 }
 
+/// A `[[prescribed]]` motion.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PrescribedSpec {
     /// The released angle of joint `joint` (index into [`Model::joints`]) follows `angle`.
-    JointAngle { joint: usize, angle: TimeFunction },
+    JointAngle {
+        /// Index into [`Model::joints`].
+        joint: usize,
+        /// The angle over time.
+        angle: TimeFunction,
+    },
     /// DOF `dof` (0..6 = ux,uy,uz,rx,ry,rz) of `node` follows `value`
     /// (displacement from the initial position / rotation-vector component).
     NodeDof {
+        /// The node.
         node: NodeRef,
+        /// 0..6 = ux, uy, uz, rx, ry, rz.
         dof: usize,
+        /// Its value over time.
         value: TimeFunction,
     },
 }
 
+/// An `[[initial_velocity]]`: a rigid-body velocity field on a set of nodes,
+/// `v = linear + angular × (x − origin)`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InitialVelocitySpec {
+    /// The nodes it applies to.
     pub nodes: Vec<NodeRef>,
+    /// Velocity at `origin`.
     pub linear: [f64; 3],
+    /// Angular velocity.
     pub angular: [f64; 3],
+    /// Reference point of `linear`.
     pub origin: [f64; 3],
 }
 
@@ -139,37 +175,50 @@ pub struct InitialVelocitySpec {
 /// files and Rust (`IntegratorKind::name` gives the model-file name).
 pub use flexmech_integrators::dynamics::Integrator as IntegratorKind;
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MassKind {
-    Consistent,
-    Lumped,
-}
+/// How translational mass is distributed: the solvers' own enum.
+pub use flexmech_core::MassKind;
 
+/// What is solved.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Analysis {
     /// Load factor from 0 to 1 in `load_steps` equal steps.
-    Static { load_steps: usize },
+    Static {
+        /// Number of equal load steps.
+        load_steps: usize,
+    },
+    /// Time integration from 0 to `t_end`.
     Dynamic {
+        /// The scheme.
         integrator: IntegratorKind,
+        /// Nominal time step.
         dt: f64,
+        /// End time.
         t_end: f64,
     },
 }
 
+/// `[solver]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SolverSpec {
+    /// Static or dynamic, with its steps.
     pub analysis: Analysis,
+    /// Newton's tolerance on the scaled residual norm.
     pub tolerance: f64,
+    /// Newton iterations per step before the step is halved.
     pub max_iterations: usize,
+    /// Halvings of a step before the run stops.
     pub max_halvings: usize,
+    /// Translational mass distribution.
     pub mass: MassKind,
     /// `newton = "modified"`: keep a factorised tangent while it converges
     /// fast enough (dynamic analyses; default `"full"`).
     pub modified_newton: bool,
 }
 
+/// `[output]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutputSpec {
+    /// Keep every k-th converged step (and the last).
     pub every: usize,
     /// Tracked nodes: the label as written in the file and the node it names.
     pub track: Vec<(String, NodeRef)>,
@@ -178,19 +227,30 @@ pub struct OutputSpec {
 /// A validated model file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
+    /// The model's name (result file `<name>.h5`).
     pub name: String,
     /// The file the model came from (for error messages).
     pub path: PathBuf,
     /// The TOML text, stored verbatim in result files.
     pub source_text: String,
+    /// Gravity acceleration (acts on ρA).
     pub gravity: [f64; 3],
+    /// `[[section]]` entries.
     pub sections: Vec<SectionSpec>,
+    /// `[[beam]]` entries.
     pub beams: Vec<BeamSpec>,
+    /// `[[support]]` entries.
     pub supports: Vec<SupportSpec>,
+    /// `[[joint]]` entries.
     pub joints: Vec<JointSpec>,
+    /// `[[load]]` entries.
     pub loads: Vec<LoadSpec>,
+    /// `[[prescribed]]` entries.
     pub prescribed: Vec<PrescribedSpec>,
+    /// `[[initial_velocity]]` entries, in file order.
     pub initial_velocities: Vec<InitialVelocitySpec>,
+    /// `[solver]`.
     pub solver: SolverSpec,
+    /// `[output]`.
     pub output: OutputSpec,
 }

@@ -98,27 +98,42 @@ impl ReproduceOptions {
 pub enum ReproduceError {
     /// A model name that is not one of the paper's examples.
     #[error("unknown model `{name}`; the paper's examples are {known}")]
-    UnknownModel { name: String, known: String },
+    UnknownModel {
+        /// The name given.
+        name: String,
+        /// The examples' names.
+        known: String,
+    },
     /// `time_scale` must be positive and finite.
     #[error("the time scale must be positive and finite, found {0}")]
     TimeScale(f64),
     /// A run could not start (bad model, unwritable directory, HDF5 error).
     #[error("{model} with {integrator}: {message}")]
     Run {
+        /// The example.
         model: String,
+        /// The integrator.
         integrator: String,
+        /// What went wrong.
         message: String,
     },
     /// Reading a result file back failed.
     #[error("reading {}: {message}", file.display())]
-    Read { file: PathBuf, message: String },
+    Read {
+        /// The result file.
+        file: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
     /// Drawing a chart failed.
     #[error(transparent)]
     Chart(#[from] crate::charts::ChartError),
     /// Writing the summary failed.
     #[error("writing {}: {source}", file.display())]
     Write {
+        /// The summary file.
         file: PathBuf,
+        /// The system's error.
         source: std::io::Error,
     },
 }
