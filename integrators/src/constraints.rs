@@ -306,28 +306,13 @@ impl Topology {
         out: &mut [f64],
     ) {
         out.iter_mut().for_each(|v| *v = 0.0);
-        let mut acc = g.to_vec();
-        for &j in self.order.iter().rev() {
-            let joint = &mech.joints[j];
-            let (m, s) = (joint.master, joint.slave);
-            let step = JointStep::new(
-                joint.map.as_ref(),
-                [
-                    (&start.config.x[m], &start.config.rot[m]),
-                    (&end.config.x[m], &end.config.rot[m]),
-                ],
-                [&start.released[j], &end.released[j]],
-            );
-            let t = step.transfer(&Vector6::from_column_slice(&acc[6 * s..6 * s + 6]));
-            for d in 0..6 {
-                acc[6 * m + d] += t[d];
-            }
+        let acc = self.fold_slaves(mech, Some(start), end, g, |j, _, t| {
             for (c, eq) in self.released_eqs[j].iter().enumerate() {
                 if let Some(e) = eq {
                     out[*e] += t[6 + c];
                 }
             }
-        }
+        });
         for (n, map) in self.dofs.nodes.iter().enumerate() {
             if self.slave_of[n].is_some() {
                 continue;
@@ -337,6 +322,83 @@ impl Topology {
                 out[e] += c.dot(&gn);
             }
         }
+    }
+
+    /// Folds every slave's nodal residual into its master's, deepest slaves
+    /// first — through `Nᵀ` at `end`, or through the step's `Ñᵀ` when `start`
+    /// is given (the conserving schemes) — calling `each(j, g_s, t)` with
+    /// joint `j`'s slave residual `g_s` (its own slaves' already folded in)
+    /// and its transfer `t` (master part, then released). Returns the nodal
+    /// residuals with every slave's carried by the independent nodes.
+    fn fold_slaves(
+        &self,
+        mech: &Mechanism,
+        start: Option<&MechanismState>,
+        end: &MechanismState,
+        g: &[f64],
+        mut each: impl FnMut(usize, &Vector6<f64>, &SVector<f64, LOCAL>),
+    ) -> Vec<f64> {
+        let mut acc = g.to_vec();
+        for &j in self.order.iter().rev() {
+            let joint = &mech.joints[j];
+            let (m, s) = (joint.master, joint.slave);
+            let gs = Vector6::from_column_slice(&acc[6 * s..6 * s + 6]);
+            let t = match start {
+                Some(start) => JointStep::new(
+                    joint.map.as_ref(),
+                    [
+                        (&start.config.x[m], &start.config.rot[m]),
+                        (&end.config.x[m], &end.config.rot[m]),
+                    ],
+                    [&start.released[j], &end.released[j]],
+                )
+                .transfer(&gs),
+                None => {
+                    joint
+                        .map
+                        .variation(&end.config.x[m], &end.config.rot[m], &end.released[j])
+                        .transpose()
+                        * gs
+                }
+            };
+            for d in 0..6 {
+                acc[6 * m + d] += t[d];
+            }
+            each(j, &gs, &t);
+        }
+        acc
+    }
+
+    /// The reactions of a converged step with nodal residuals `g` (internal
+    /// and inertial minus external forces, 6 per node): what every joint
+    /// exerts on its slave node (force, then moment, global components; the
+    /// slave's residual with its own slaves' folded in) and what holds every
+    /// node of [`Mechanism::supported_nodes`] (the folded residual at its
+    /// fixed and prescribed DOFs, zero at its free ones). Slaves fold into
+    /// masters as the scheme reduces (`start` given: through `Ñᵀ`).
+    pub fn reactions(
+        &self,
+        mech: &Mechanism,
+        start: Option<&MechanismState>,
+        end: &MechanismState,
+        g: &[f64],
+    ) -> (Vec<[f64; 6]>, Vec<[f64; 6]>) {
+        let mut joints = vec![[0.0; 6]; mech.joints.len()];
+        let acc = self.fold_slaves(mech, start, end, g, |j, gs, _| {
+            joints[j].copy_from_slice(gs.as_slice());
+        });
+        let supports = mech
+            .supported_nodes()
+            .into_iter()
+            .map(|n| {
+                let mut held = mech.fixed[n];
+                for p in mech.prescribed.iter().filter(|p| p.node == n) {
+                    held[p.dof] = true;
+                }
+                std::array::from_fn(|d| if held[d] { acc[6 * n + d] } else { 0.0 })
+            })
+            .collect();
+        (joints, supports)
     }
 
     /// The generalised reactions of the drivers for nodal residuals `g`
@@ -350,21 +412,12 @@ impl Topology {
         state: &MechanismState,
         g: &[f64],
     ) -> (Vec<Vec<f64>>, Vec<f64>) {
-        let mut acc = g.to_vec();
         let mut joints = vec![Vec::new(); mech.joints.len()];
-        for &j in self.order.iter().rev() {
-            let joint = &mech.joints[j];
-            let (m, s) = (joint.master, joint.slave);
-            let n =
-                joint
-                    .map
-                    .variation(&state.config.x[m], &state.config.rot[m], &state.released[j]);
-            let t = n.transpose() * Vector6::from_column_slice(&acc[6 * s..6 * s + 6]);
-            for d in 0..6 {
-                acc[6 * m + d] += t[d];
-            }
-            joints[j] = (0..joint.map.released_count()).map(|c| t[6 + c]).collect();
-        }
+        let acc = self.fold_slaves(mech, None, state, g, |j, _, t| {
+            joints[j] = (0..mech.joints[j].map.released_count())
+                .map(|c| t[6 + c])
+                .collect();
+        });
         let prescribed = mech
             .prescribed
             .iter()
@@ -520,6 +573,7 @@ pub fn joint_records(mech: &Mechanism, state: &MechanismState) -> Vec<JointRecor
             let pos = (c.x[s] - c.x[m] - c.rot[m] * rr).norm();
             let rot: Matrix3<f64> = c.rot[m].transpose() * c.rot[s] - lr;
             JointRecord {
+                reaction: [f64::NAN; 6],
                 angle: joint
                     .map
                     .reported_angle(&state.released[j])

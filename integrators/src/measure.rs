@@ -73,6 +73,7 @@ pub fn static_record(
             })
             .collect(),
         joints: joint_records(mech, state),
+        support_reactions: vec![[f64::NAN; 6]; mech.supported_nodes().len()],
         velocities: Vec::new(),
         angular_velocities: Vec::new(),
     }

@@ -113,6 +113,16 @@ impl Mechanism {
         }
     }
 
+    /// The nodes held at one DOF at least (fixed or prescribed), ascending:
+    /// the nodes whose reactions results report.
+    pub fn supported_nodes(&self) -> Vec<usize> {
+        (0..self.mesh.node_count())
+            .filter(|&n| {
+                self.fixed[n].iter().any(|&h| h) || self.prescribed.iter().any(|p| p.node == n)
+            })
+            .collect()
+    }
+
     /// The round-off floor of a residual norm in the initial configuration
     /// (see [`Mechanism::round_off_floor_at`]).
     pub fn round_off_floor(&self) -> f64 {

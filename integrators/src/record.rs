@@ -29,6 +29,10 @@ pub struct JointRecord {
     pub released_translation: [f64; 3],
     /// `‖r_s − r_m − Λ_m f(ψ)‖ + ‖Λ_mᵀΛ_s − exp(ψ t̂)‖` (Frobenius).
     pub constraint_error: f64,
+    /// What the joint exerts on its slave node in the step's equations:
+    /// force, then moment (global components). NaN in records taken before
+    /// any step (no residual has been evaluated yet).
+    pub reaction: [f64; 6],
 }
 
 /// One converged (time or load) step.
@@ -62,6 +66,10 @@ pub struct StepRecord {
     pub quaternions: Vec<[f64; 4]>,
     /// One record per joint, in model order.
     pub joints: Vec<JointRecord>,
+    /// What holds each node of `Mechanism::supported_nodes`: force, then
+    /// moment, at its fixed and prescribed DOFs (zero at free ones). NaN in
+    /// records taken before any step.
+    pub support_reactions: Vec<[f64; 6]>,
     /// Dynamics: every node's translational velocity `v` (spatial); empty
     /// in statics.
     pub velocities: Vec<[f64; 3]>,

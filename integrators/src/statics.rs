@@ -128,6 +128,7 @@ pub fn solve_static(
                 // The stability count is of the converged iterate's tangent.
                 prob.update_tangent(&mut r);
                 step.negative_pivots = inertia.negative_eigenvalues(&prob.asm.values);
+                prob.record_reactions(&mut step);
                 on_step(&step);
                 control.succeeded();
             }

@@ -25,6 +25,7 @@ use crate::free_motion::FreeMotion;
 use crate::linsolve::TangentRef;
 use crate::mechanism::Mechanism;
 use crate::newton::NewtonSystem;
+use crate::record::StepRecord;
 use flexmech_core::Configuration;
 
 /// How the joints reduce the nodal residuals to the unknowns.
@@ -148,6 +149,20 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
                     .reduce_incremental(self.mech, &self.start, &self.end, g, out)
             }
         }
+    }
+
+    /// The reactions of the last evaluated residual (see
+    /// [`Topology::reactions`]) into `record`: slaves fold into masters as the
+    /// scheme reduces.
+    pub fn record_reactions(&self, record: &mut StepRecord) {
+        let start = (self.terms.reduction() == Reduction::Incremental).then_some(&self.start);
+        let (joints, supports) = self
+            .topo
+            .reactions(self.mech, start, &self.end, &self.nodal);
+        for (rec, r) in record.joints.iter_mut().zip(joints) {
+            rec.reaction = r;
+        }
+        record.support_reactions = supports;
     }
 
     /// The residual into `r` (returns the force scale) and, if `tangent`,

@@ -273,6 +273,12 @@ fn run(
     })?;
     let file = file.to_path_buf();
     let mech = &built.mechanism;
+    let mesh = mesh_meta(model, &built);
+    let supports = mech
+        .supported_nodes()
+        .into_iter()
+        .map(|n| mesh.node_labels[n].clone())
+        .collect();
     let meta = RunMeta {
         model_text: model.source_text.clone(),
         integrator: match model.solver.analysis {
@@ -298,7 +304,8 @@ fn run(
             .map(|j| j.map.reported_angle(&j.initial).is_some())
             .collect(),
         command_line: command_line(),
-        mesh: Some(mesh_meta(model, &built)),
+        supports,
+        mesh: Some(mesh),
     };
     let mut writer = ResultWriter::create(&file, &meta)?;
     if let Some((c, from)) = restart_from {

@@ -374,6 +374,7 @@ fn record(step: usize) -> StepRecord {
         positions: vec![[0.0; 3], [1.0 - 0.1 * t * t, 0.0, 0.4 * t]],
         quaternions: vec![[1.0, 0.0, 0.0, 0.0]; 2],
         joints: vec![],
+        support_reactions: vec![],
         negative_pivots: None,
         velocities: Vec::new(),
         angular_velocities: Vec::new(),

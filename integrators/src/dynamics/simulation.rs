@@ -301,6 +301,10 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
             report,
         );
         rec.energy.driver_work = self.driver_work;
+        if report.is_some() {
+            // The converged iterate's residual, the last one Newton evaluated.
+            sys.record_reactions(&mut rec);
+        }
         rec
     }
 }

@@ -30,6 +30,18 @@ pub const ATTR_COMMAND_LINE: &str = "command_line";
 /// The text of [`ATTR_UNITS`].
 pub const UNITS_NOTE: &str = "the model file's consistent units (e.g. m, kg, s, N, J); angles and \
                               rotation vectors in radians";
+/// T×3 per joint: the force the joint exerts on its slave node (global).
+pub const JOINT_REACTION_FORCE: &str = "reaction_force";
+/// T×3 per joint: the moment the joint exerts on its slave node (global).
+pub const JOINT_REACTION_MOMENT: &str = "reaction_moment";
+/// `/supports`: one group per supported node (a fixed or prescribed DOF).
+pub const SUPPORTS: &str = "/supports";
+
+/// `/supports/<label>/<leaf>`.
+pub fn support_path(label: &str, leaf: &str) -> String {
+    format!("{SUPPORTS}/{label}/{leaf}")
+}
+
 /// `/mesh`: the mesh, written once.
 pub const MESH: &str = "/mesh";
 /// nodes (strings): every node's label, in `/configuration` order.

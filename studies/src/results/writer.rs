@@ -46,6 +46,10 @@ pub struct RunMeta {
     /// The command line that made the run; root attribute `command_line`
     /// (omitted when empty).
     pub command_line: String,
+    /// Labels of the supported nodes (`Mechanism::supported_nodes` order):
+    /// `/supports/<label>/reaction_force` and `reaction_moment`; every
+    /// [`StepRecord`] must then carry as many support reactions.
+    pub supports: Vec<String>,
     /// The mesh: `/mesh` (omitted when `None`).
     pub mesh: Option<super::mesh::MeshMeta>,
 }
@@ -98,8 +102,8 @@ pub enum ResultError {
         path: PathBuf,
         /// Index of the rejected step (= steps written before it).
         step: usize,
-        /// `"positions"`, `"quaternions"`, `"joints"`, `"velocities"` or
-        /// `"angular_velocities"` (dynamics).
+        /// `"positions"`, `"quaternions"`, `"joints"`, `"support_reactions"`,
+        /// `"velocities"` or `"angular_velocities"` (dynamics).
         field: &'static str,
         /// Length given by [`RunMeta`].
         expected: usize,
@@ -334,6 +338,8 @@ struct NodeSets {
 struct JointSets {
     /// Absent for a joint without a released angle.
     angle: Option<Series>,
+    reaction_force: Series,
+    reaction_moment: Series,
     released_translation: Series,
     constraint_error: Series,
 }
@@ -358,6 +364,8 @@ struct Datasets {
     newton_residuals: Series,
     newton_offsets: Series,
     nodes: Vec<NodeSets>,
+    /// Per supported node: reaction force and moment.
+    supports: Vec<[Series; 2]>,
     joints: Vec<JointSets>,
     config_position: Series,
     config_quaternion: Series,
@@ -393,10 +401,14 @@ impl Datasets {
                 .flat_map(|n| [&n.position, &n.displacement, &n.rotation]),
         )
         .chain(self.joints.iter().flat_map(|j| {
-            j.angle
-                .iter()
-                .chain([&j.released_translation, &j.constraint_error])
+            j.angle.iter().chain([
+                &j.released_translation,
+                &j.constraint_error,
+                &j.reaction_force,
+                &j.reaction_moment,
+            ])
         }))
+        .chain(self.supports.iter().flatten())
     }
 }
 
@@ -520,6 +532,14 @@ impl ResultWriter {
         ];
         for (name, description) in groups {
             create_group(&file, path, name, description)?;
+        }
+        if !meta.supports.is_empty() {
+            create_group(
+                &file,
+                path,
+                names::SUPPORTS,
+                "supported nodes (a fixed or prescribed DOF), one group per label",
+            )?;
         }
 
         let f64s = |name: &str, tail: &[usize], description: &str| {
@@ -673,12 +693,46 @@ impl ResultWriter {
                     &[3],
                     "released translation r_R in the master frame",
                 )?,
+                reaction_force: f64s(
+                    &names::joint_path(name, names::JOINT_REACTION_FORCE),
+                    &[3],
+                    "force the joint exerts on its slave node in the step's equations (NaN at t = 0)",
+                )?,
+                reaction_moment: f64s(
+                    &names::joint_path(name, names::JOINT_REACTION_MOMENT),
+                    &[3],
+                    "moment the joint exerts on its slave node in the step's equations (NaN at t = 0)",
+                )?,
                 constraint_error: f64s(
                     &names::joint_path(name, names::JOINT_CONSTRAINT_ERROR),
                     &[],
                     "|r_s - r_m - L_m f(psi)| + |L_m^T L_s - exp(psi t^)|_F",
                 )?,
             });
+        }
+
+        let mut supports = Vec::with_capacity(meta.supports.len());
+        for label in &meta.supports {
+            create_group(
+                &file,
+                path,
+                &format!("{}/{label}", names::SUPPORTS),
+                "supported node",
+            )?;
+            supports.push([
+                f64s(
+                    &names::support_path(label, names::JOINT_REACTION_FORCE),
+                    &[3],
+                    "force the supports exert on the node at its held DOFs (zero at free ones; \
+                     NaN at t = 0)",
+                )?,
+                f64s(
+                    &names::support_path(label, names::JOINT_REACTION_MOMENT),
+                    &[3],
+                    "moment the supports exert on the node at its held DOFs (zero at free ones; \
+                     NaN at t = 0)",
+                )?,
+            ]);
         }
 
         let config = |name: &str, width: usize, description: &str| {
@@ -736,6 +790,7 @@ impl ResultWriter {
             newton_offsets,
             nodes,
             joints,
+            supports,
             config_position,
             config_quaternion,
             config_velocity,
@@ -771,8 +826,15 @@ impl ResultWriter {
             ("quaternions", n_nodes, step.quaternions.len()),
             ("joints", self.sets.joints.len(), step.joints.len()),
         ];
+        let supports = self.sets.supports.len();
+        let found_supports = if supports == 0 {
+            0
+        } else {
+            step.support_reactions.len()
+        };
         let velocities = self.sets.config_velocity.as_ref().map_or(0, |_| n_nodes);
         let lengths = lengths.into_iter().chain([
+            ("support_reactions", supports, found_supports),
             ("velocities", velocities, step.velocities.len()),
             (
                 "angular_velocities",
@@ -856,6 +918,15 @@ impl ResultWriter {
             joint
                 .constraint_error
                 .push_scalar(t, record.constraint_error, path)?;
+            let r = record.reaction;
+            joint.reaction_force.push_row(t, [r[0], r[1], r[2]], path)?;
+            joint
+                .reaction_moment
+                .push_row(t, [r[3], r[4], r[5]], path)?;
+        }
+        for ([force, moment], r) in s.supports.iter().zip(&step.support_reactions) {
+            force.push_row(t, [r[0], r[1], r[2]], path)?;
+            moment.push_row(t, [r[3], r[4], r[5]], path)?;
         }
         s.config_position.push_block(t, &step.positions, path)?;
         s.config_quaternion.push_block(t, &step.quaternions, path)?;
