@@ -81,7 +81,12 @@ fn joint_map(spec: &JointSpec) -> (Arc<dyn JointMap>, ReleasedState) {
 }
 
 /// Builds the mechanism of `model`.
+///
+/// The model's invariants are checked first ([`Model::check`]), so a model
+/// built or changed in Rust is refused with a message naming the key rather
+/// than meshed with an index out of range.
 pub fn build(model: &Model) -> Result<Built, ModelError> {
+    model.check()?;
     let mut mesh = Mesh::default();
     let mut beam_nodes = Vec::with_capacity(model.beams.len());
     for (b, beam) in model.beams.iter().enumerate() {

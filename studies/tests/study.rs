@@ -655,7 +655,10 @@ fn slurm_array_variables_select_the_shard() {
 fn the_shipped_study_file_loads() {
     let spec = load_study(&data("studies/pitch_dt.toml")).unwrap();
     assert_eq!(spec.name, "pitch-dt");
-    assert!(spec.model_file.ends_with("dynamics/free_chain.toml"));
+    assert!(spec
+        .model_file()
+        .unwrap()
+        .ends_with("dynamics/free_chain.toml"));
     let runs: usize = spec.grid.iter().map(|g| g.values.len()).product();
     assert_eq!(runs, 8);
     for plan in flexmech_studies::study::execute::plans(&spec) {

@@ -18,6 +18,7 @@
 
 use std::path::Path;
 
+mod check;
 pub mod error;
 mod labels;
 mod locate;

@@ -1,13 +1,20 @@
 //! The runs of a reproduction: every (model, integrator) pair in parallel,
-//! and what each left in its result file.
+//! and what each left in its result file. Each example's runs are a study
+//! defined in Rust over the example's model ([`example_study`]): its grid
+//! sets the integrator (and the step and end time), the study machinery
+//! builds each run's model.
 
 use super::{result_path, ReproduceError, CONSISTENCY_INTEGRATORS, CONSISTENCY_MODEL, INTEGRATORS};
-use crate::model::parse_model;
+use crate::model::{parse_model, Analysis};
 use crate::results::reader::drift_of;
 use crate::results::{ReadError, ResultReader};
 use crate::run::{run_model_to, RunError};
+use crate::study::execute::plans;
+use crate::study::sweep::{model_for, RunPlan};
+use crate::study::{Figure, StudySpec};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+use toml::Value;
 
 /// One run of a reproduction, with the series the charts and the summary use.
 #[derive(Debug, Clone, PartialEq)]
@@ -71,99 +78,108 @@ impl RunRecord {
     }
 }
 
+/// The study of one paper example: a grid over `solver.integrator`
+/// (`integrators`), with `solver.t_end` scaled by `time_scale` (when it is
+/// not 1) and `solver.dt` halved for the consistency study's `half_step`
+/// runs. Every run's model is the example's with those values put in and
+/// every model-file check applied, so its result file stores exactly the
+/// model it ran.
+pub fn example_study(
+    (name, path, text): (&str, &str, &str),
+    integrators: &[&str],
+    half_step: bool,
+    time_scale: f64,
+) -> Result<StudySpec, ReproduceError> {
+    let fail = |message: String| ReproduceError::Run {
+        model: name.to_string(),
+        integrator: integrators.join(", "),
+        message,
+    };
+    let base = parse_model(text, Path::new(path)).map_err(|e| fail(e.to_string()))?;
+    let Analysis::Dynamic { dt, t_end, .. } = base.solver.analysis else {
+        return Err(fail("the paper's examples are dynamic analyses".into()));
+    };
+    let mut grid = vec![(
+        "solver.integrator".to_string(),
+        integrators.iter().map(|&i| Value::from(i)).collect(),
+    )];
+    if time_scale != 1.0 {
+        grid.push(("solver.t_end".into(), vec![Value::from(t_end * time_scale)]));
+    }
+    if half_step {
+        grid.push(("solver.dt".into(), vec![Value::from(dt * 0.5)]));
+    }
+    let study = if half_step {
+        format!("{name}-half-dt")
+    } else {
+        name.to_string()
+    };
+    StudySpec::over_model(&study, Path::new(path), text, grid, Figure::ALL.to_vec())
+        .map_err(|e| fail(e.to_string()))
+}
+
+/// One run of a reproduction: the example, its study and the run's plan.
+struct Job {
+    model: &'static str,
+    study: usize,
+    plan: RunPlan,
+    half_step: bool,
+}
+
 /// Runs every model of `models` with every integrator, and the consistency
 /// study's half-step runs, in parallel. Returns `(runs, half_step)`.
 pub fn run_all(
-    models: &[(&str, &str, &str)],
+    models: &[(&'static str, &'static str, &'static str)],
     out: &Path,
     time_scale: f64,
 ) -> Result<(Vec<RunRecord>, Vec<RunRecord>), ReproduceError> {
-    let mut jobs: Vec<(&str, &str, &str, &str, bool)> = models
-        .iter()
-        .flat_map(|&(name, path, text)| {
-            INTEGRATORS
-                .iter()
-                .map(move |&i| (name, path, text, i, false))
-        })
-        .collect();
-    for &(name, path, text) in models.iter().filter(|m| m.0 == CONSISTENCY_MODEL) {
-        jobs.extend(
-            CONSISTENCY_INTEGRATORS
-                .iter()
-                .map(|&i| (name, path, text, i, true)),
-        );
+    let mut studies = Vec::new();
+    let mut jobs = Vec::new();
+    let mut add = |model: (&'static str, &'static str, &'static str),
+                   integrators: &[&str],
+                   half_step: bool|
+     -> Result<(), ReproduceError> {
+        let spec = example_study(model, integrators, half_step, time_scale)?;
+        jobs.extend(plans(&spec).into_iter().map(|plan| Job {
+            model: model.0,
+            study: studies.len(),
+            plan,
+            half_step,
+        }));
+        studies.push(spec);
+        Ok(())
+    };
+    for &model in models {
+        add(model, &INTEGRATORS, false)?;
+    }
+    for &model in models.iter().filter(|m| m.0 == CONSISTENCY_MODEL) {
+        add(model, &CONSISTENCY_INTEGRATORS, true)?;
     }
     let mut all: Vec<RunRecord> = jobs
         .par_iter()
-        .map(|&(name, path, text, integrator, half)| {
-            run_one(name, path, text, integrator, half, out, time_scale)
-        })
+        .map(|job| run_one(job, &studies[job.study], out))
         .collect::<Result<_, _>>()?;
-    let half = all.split_off(all.len() - (jobs.iter().filter(|j| j.4).count()));
+    let half = all.split_off(all.len() - jobs.iter().filter(|j| j.half_step).count());
     Ok((all, half))
 }
 
-/// The number on a `key = value  # comment` line.
-fn value_of(line: &str) -> f64 {
-    line.split('=')
-        .nth(1)
-        .and_then(|v| v.split('#').next())
-        .and_then(|v| v.trim().parse().ok())
-        .unwrap_or(0.0)
-}
-
-/// The model text with the integrator (and `t_end`, scaled, and `dt`,
-/// halved for a half-step run) replaced, so the result file's stored model
-/// reproduces exactly this run.
-fn adapted_text(text: &str, integrator: &str, half_step: bool, time_scale: f64) -> String {
-    text.lines()
-        .map(|line| {
-            let key = line.split('=').next().unwrap_or("").trim();
-            if key == "integrator" {
-                format!("integrator = \"{integrator}\"")
-            } else if key == "t_end" && time_scale != 1.0 {
-                format!("t_end = {}", value_of(line) * time_scale)
-            } else if key == "dt" && half_step {
-                format!("dt = {}", value_of(line) * 0.5)
-            } else {
-                line.to_string()
-            }
-        })
-        .collect::<Vec<_>>()
-        .join("\n")
-}
-
-fn run_one(
-    name: &str,
-    path: &str,
-    text: &str,
-    integrator: &str,
-    half_step: bool,
-    out: &Path,
-    time_scale: f64,
-) -> Result<RunRecord, ReproduceError> {
+fn run_one(job: &Job, spec: &StudySpec, out: &Path) -> Result<RunRecord, ReproduceError> {
+    let integrator = job.plan.values[0].as_str().unwrap_or_default();
     let fail = |message: String| ReproduceError::Run {
-        model: name.to_string(),
+        model: job.model.to_string(),
         integrator: integrator.to_string(),
         message,
     };
-    let model = parse_model(
-        &adapted_text(text, integrator, half_step, time_scale),
-        Path::new(path),
-    )
-    .map_err(|e| fail(e.to_string()))?;
-    let nominal_dt = match model.solver.analysis {
-        crate::model::Analysis::Dynamic { dt, .. } => dt,
-        crate::model::Analysis::Static { .. } => {
-            return Err(fail("the paper's examples are dynamic analyses".into()))
-        }
+    let model = model_for(spec, &job.plan).map_err(|e| fail(e.to_string()))?;
+    let Analysis::Dynamic { dt: nominal_dt, .. } = model.solver.analysis else {
+        return Err(fail("the paper's examples are dynamic analyses".into()));
     };
-    let file = result_path(out, name, integrator, half_step);
+    let file = result_path(out, job.model, integrator, job.half_step);
     match run_model_to(&model, &file) {
         Ok(_) | Err(RunError::Solve { .. }) => {}
         Err(e) => return Err(fail(e.to_string())),
     }
-    read_back(name, integrator, &file, nominal_dt)
+    read_back(job.model, integrator, &file, nominal_dt)
 }
 
 /// Reads a run's series back from its result file.

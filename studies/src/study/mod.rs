@@ -99,6 +99,7 @@ pub mod figures;
 pub mod key_path;
 pub mod merge;
 pub mod shard;
+pub mod source;
 pub mod spec;
 pub mod summary;
 pub mod sweep;
@@ -107,6 +108,7 @@ pub use dataset_figure::{Component, DatasetFigure, Reduce};
 pub use execute::{run_study, StudyOptions};
 pub use merge::{merge_study, MergeError};
 pub use shard::{select_shard, Shard, ShardError, SlurmArray};
+pub use source::{BuildFn, ModelFn, RunParams, RunSource};
 pub use spec::{load_study, parse_study, Figure, SpecError, StudySpec};
 pub use sweep::SweepError;
 

@@ -13,6 +13,7 @@ use toml::{Table, Value};
 
 use super::dataset_figure::DatasetFigure;
 use super::key_path::{base_dir, check_key, KeyPath};
+use super::source::RunSource;
 use crate::model::{load_model, ModelError};
 
 /// A per-run scalar of the summary table (see the module docs of
@@ -109,20 +110,21 @@ impl GridKey {
     }
 }
 
-/// A checked study file.
+/// A checked study: a study file, or a study defined in Rust
+/// ([`StudySpec::from_fn`], [`StudySpec::over_model`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StudySpec {
-    /// The study file.
+    /// The study file (for a study defined in Rust, a description naming
+    /// it, used in messages).
     pub file: PathBuf,
-    /// Its text (stored as the `study` attribute of the summary HDF5).
+    /// Its text (stored as the `study` attribute of the summary HDF5; for a
+    /// study defined in Rust, its name, grid and figures as TOML).
     pub text: String,
     /// The study name; results go to `<out>/<name>/`.
     pub name: String,
-    /// The base model file (the `model` key resolved against the study
-    /// file's directory).
-    pub model_file: PathBuf,
-    /// The base model, parsed as TOML.
-    pub model_table: Table,
+    /// Where each run's model comes from: the base model file (a study
+    /// file's `model`) or a Rust function ([`StudySpec::from_fn`]).
+    pub source: RunSource,
     /// The swept keys, in the order written in `[grid]`.
     pub grid: Vec<GridKey>,
     /// The summary figures, in the order written.
@@ -448,20 +450,13 @@ pub fn parse_study(text: &str, path: &Path) -> Result<StudySpec, SpecError> {
         Some(Value::String(s)) => s.clone(),
         Some(v) => return Err(wrong_type("name", "a string", v)),
     };
-    let bad_name = |reason| SpecError::BadName {
-        file: file.clone(),
-        line: lines.get("name"),
-        name: name.clone(),
-        reason,
-    };
-    if name.trim().is_empty() {
-        return Err(bad_name("is empty"));
-    }
-    if name == "." || name == ".." {
-        return Err(bad_name("names a directory that is not the study's own"));
-    }
-    if name.contains(['/', '\\', '\0']) {
-        return Err(bad_name("contains a path separator"));
+    if let Some(reason) = name_problem(&name) {
+        return Err(SpecError::BadName {
+            file,
+            line: lines.get("name"),
+            name,
+            reason,
+        });
     }
 
     let model_rel = match root.get("model") {
@@ -599,11 +594,26 @@ pub fn parse_study(text: &str, path: &Path) -> Result<StudySpec, SpecError> {
         file,
         text: text.to_owned(),
         name,
-        model_file,
-        model_table,
+        source: RunSource::ModelFile {
+            file: model_file,
+            table: model_table,
+        },
         grid,
         figures,
     })
+}
+
+/// Why `name` cannot name a study's output directory, if it cannot.
+pub(crate) fn name_problem(name: &str) -> Option<&'static str> {
+    if name.trim().is_empty() {
+        Some("is empty")
+    } else if name == "." || name == ".." {
+        Some("names a directory that is not the study's own")
+    } else if name.contains(['/', '\\', '\0']) {
+        Some("contains a path separator")
+    } else {
+        None
+    }
 }
 
 impl fmt::Display for Figure {

@@ -4,9 +4,10 @@
 
 use std::path::PathBuf;
 
-use toml::Value;
+use toml::{Table, Value};
 
 use super::key_path::lookup_mut;
+use super::source::{RunParams, RunSource};
 use super::spec::StudySpec;
 use crate::model::{parse_model, Model};
 
@@ -101,6 +102,18 @@ pub enum SweepError {
         /// What is wrong.
         problem: String,
     },
+    /// The study's Rust function gave no model for a run.
+    #[error("{}: {run} ({overrides}): the study's function gives no model: {message}", .study.display())]
+    Function {
+        /// The study (its description).
+        study: PathBuf,
+        /// The run id.
+        run: String,
+        /// `key = value, …` of the run.
+        overrides: String,
+        /// What the function said.
+        message: String,
+    },
     /// The overridden model could not be written back as TOML.
     #[error("{}: {run}: cannot write the overridden model as TOML: {message}", .study.display())]
     Serialize {
@@ -126,10 +139,10 @@ pub fn describe_values(spec: &StudySpec, plan: &RunPlan) -> String {
         .join(", ")
 }
 
-/// The model-file text of `plan`: the base model with each grid key set to
-/// the run's value, serialized back to TOML.
-pub fn model_text(spec: &StudySpec, plan: &RunPlan) -> Result<String, SweepError> {
-    let mut table = spec.model_table.clone();
+/// The model-file text of `plan` over the base model `table`: each grid key
+/// set to the run's value, serialized back to TOML.
+fn model_text(spec: &StudySpec, table: &Table, plan: &RunPlan) -> Result<String, SweepError> {
+    let mut table = table.clone();
     for (g, value) in spec.grid.iter().zip(&plan.values) {
         let slot = lookup_mut(&mut table, &g.path).map_err(|problem| SweepError::Key {
             study: spec.file.clone(),
@@ -146,18 +159,47 @@ pub fn model_text(spec: &StudySpec, plan: &RunPlan) -> Result<String, SweepError
     })
 }
 
-/// The validated model of `plan` (see [`model_text`]): every model-file check
-/// applies to the overridden text.
+/// The model of `plan`. Over a base model file, the base with each grid key
+/// set to the run's value, written back as TOML and loaded with every
+/// model-file check. From a Rust function, what the function returns for
+/// the run's parameters, checked ([`Model::check`]), its model text headed by
+/// the study, run and values.
 pub fn model_for(spec: &StudySpec, plan: &RunPlan) -> Result<Model, SweepError> {
-    let text = model_text(spec, plan)?;
-    parse_model(&text, &spec.model_file).map_err(|e| {
-        SweepError::InvalidRun(Box::new(InvalidRun {
-            study: spec.file.clone(),
-            run: plan.id.clone(),
-            overrides: describe_values(spec, plan),
-            model: spec.model_file.clone(),
-            key: e.key().to_owned(),
-            message: e.message().to_owned(),
-        }))
-    })
+    match &spec.source {
+        RunSource::ModelFile { file, table } => {
+            let text = model_text(spec, table, plan)?;
+            parse_model(&text, file).map_err(|e| {
+                SweepError::InvalidRun(Box::new(InvalidRun {
+                    study: spec.file.clone(),
+                    run: plan.id.clone(),
+                    overrides: describe_values(spec, plan),
+                    model: file.clone(),
+                    key: e.key().to_owned(),
+                    message: e.message().to_owned(),
+                }))
+            })
+        }
+        RunSource::Function(build) => {
+            let params = RunParams {
+                run: &plan.id,
+                keys: &spec.grid,
+                values: &plan.values,
+            };
+            let overrides = describe_values(spec, plan);
+            let refuse = |message: String| SweepError::Function {
+                study: spec.file.clone(),
+                run: plan.id.clone(),
+                overrides: overrides.clone(),
+                message,
+            };
+            let mut model = (build.0)(&params).map_err(refuse)?;
+            model.check().map_err(|e| refuse(e.to_string()))?;
+            model.source_text = format!(
+                "# study `{}`, {} ({overrides}): the model was built by a Rust function; the \
+                 text below, if any, is the model it started from, before these values\n{}",
+                spec.name, plan.id, model.source_text
+            );
+            Ok(model)
+        }
+    }
 }

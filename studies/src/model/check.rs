@@ -1,0 +1,235 @@
+//! The invariants of a [`Model`] that the model-file checks establish,
+//! checked on the typed model itself: a model built or changed in Rust (a
+//! study's function, a researcher's program) is refused with a message naming
+//! the key, instead of reaching the mesher with an index out of range or a
+//! stiffness of zero.
+//!
+//! A model loaded from a file always passes (the file checks are stricter:
+//! they also locate the line); [`crate::build`] runs this check first.
+
+use super::{Analysis, Model, ModelError, NodeRef, PrescribedSpec, TimeFunction};
+
+/// Collects the first violation with its key.
+struct Checker<'a> {
+    model: &'a Model,
+}
+
+type Res = Result<(), ModelError>;
+
+impl Checker<'_> {
+    fn fail(&self, key: impl Into<String>, message: impl Into<String>) -> ModelError {
+        ModelError::new(&self.model.path, key, None, message)
+    }
+
+    fn finite(&self, key: &str, values: &[f64]) -> Res {
+        match values.iter().find(|v| !v.is_finite()) {
+            Some(v) => Err(self.fail(key, format!("{v} is not a finite number"))),
+            None => Ok(()),
+        }
+    }
+
+    fn positive(&self, key: &str, values: &[f64]) -> Res {
+        match values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+            Some(v) => Err(self.fail(key, format!("must be positive and finite, found {v}"))),
+            None => Ok(()),
+        }
+    }
+
+    fn non_negative(&self, key: &str, values: &[f64]) -> Res {
+        match values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+            Some(v) => Err(self.fail(
+                key,
+                format!("must be zero or positive and finite, found {v}"),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    fn node(&self, key: &str, r: NodeRef) -> Res {
+        let Some(beam) = self.model.beams.get(r.beam) else {
+            return Err(self.fail(
+                key,
+                format!(
+                    "names beam {} but the model has {} beam(s)",
+                    r.beam,
+                    self.model.beams.len()
+                ),
+            ));
+        };
+        if r.node >= beam.node_count() {
+            return Err(self.fail(
+                key,
+                format!(
+                    "names node {} of beam `{}`, which has nodes 0..={}",
+                    r.node,
+                    beam.name,
+                    beam.node_count() - 1
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn time(&self, key: &str, f: &TimeFunction) -> Res {
+        match f {
+            TimeFunction::Constant(c) => self.finite(key, &[*c]),
+            TimeFunction::Table(rows) => {
+                if rows.is_empty() {
+                    return Err(self.fail(key, "the time table has no rows"));
+                }
+                for (i, (t, v)) in rows.iter().enumerate() {
+                    self.finite(key, &[*t, *v])?;
+                    if i > 0 && *t < rows[i - 1].0 {
+                        return Err(self.fail(
+                            key,
+                            format!("the times must not decrease; row {i} has t = {t}"),
+                        ));
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+
+    fn sections_and_beams(&self) -> Res {
+        for (i, s) in self.model.sections.iter().enumerate() {
+            let k = |name: &str| format!("section[{i}].{name}");
+            self.positive(&k("EA"), &[s.ea])?;
+            self.positive(&k("GA"), &s.ga)?;
+            self.positive(&k("GJ"), &[s.gj])?;
+            self.positive(&k("EI"), &s.ei)?;
+            self.non_negative(&k("rhoA"), &[s.rho_a])?;
+            self.non_negative(&k("rhoJ"), &s.rho_j)?;
+        }
+        for (b, beam) in self.model.beams.iter().enumerate() {
+            let k = |name: &str| format!("beam[{b}].{name}");
+            if beam.section >= self.model.sections.len() {
+                return Err(self.fail(
+                    k("section"),
+                    format!(
+                        "names section {} but the model has {} section(s)",
+                        beam.section,
+                        self.model.sections.len()
+                    ),
+                ));
+            }
+            if beam.elements == 0 {
+                return Err(self.fail(k("elements"), "must be at least 1"));
+            }
+            if !matches!(beam.nodes_per_element, 2 | 3) {
+                return Err(self.fail(
+                    k("nodes_per_element"),
+                    format!("must be 2 or 3, found {}", beam.nodes_per_element),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn loading(&self) -> Res {
+        let m = self.model;
+        self.finite("gravity", &m.gravity)?;
+        for (i, s) in m.supports.iter().enumerate() {
+            self.node(&format!("support[{i}].node"), s.node)?;
+        }
+        for (i, l) in m.loads.iter().enumerate() {
+            let k = |name: &str| format!("load[{i}].{name}");
+            self.node(&k("node"), l.node)?;
+            self.finite(&k("force"), &l.force)?;
+            self.finite(&k("moment"), &l.moment)?;
+            if let Some(f) = &l.time {
+                self.time(&k("time"), f)?;
+            }
+        }
+        for (j, joint) in m.joints.iter().enumerate() {
+            let k = |name: &str| format!("joint[{j}].{name}");
+            self.node(&k("master"), joint.master)?;
+            self.node(&k("slave"), joint.slave)?;
+            if joint.master == joint.slave {
+                return Err(self.fail(k("slave"), "the slave is the master node"));
+            }
+            self.finite(&k("angle"), &[joint.angle])?;
+            self.finite(&k("rate"), &[joint.rate])?;
+        }
+        for (i, p) in m.prescribed.iter().enumerate() {
+            let k = |name: &str| format!("prescribed[{i}].{name}");
+            match p {
+                PrescribedSpec::JointAngle { joint, angle } => {
+                    let Some(spec) = m.joints.get(*joint) else {
+                        return Err(self.fail(
+                            k("joint"),
+                            format!(
+                                "names joint {joint} but the model has {} joint(s)",
+                                m.joints.len()
+                            ),
+                        ));
+                    };
+                    if !spec.kind.has_angle() {
+                        return Err(self.fail(
+                            k("joint"),
+                            format!("joint `{}` has no released angle to drive", spec.name),
+                        ));
+                    }
+                    self.time(&k("angle"), angle)?;
+                }
+                PrescribedSpec::NodeDof { node, dof, value } => {
+                    self.node(&k("node"), *node)?;
+                    if *dof >= 6 {
+                        return Err(self.fail(
+                            k("dof"),
+                            format!("must be 0..6 (ux, uy, uz, rx, ry, rz), found {dof}"),
+                        ));
+                    }
+                    self.time(&k("value"), value)?;
+                }
+            }
+        }
+        for (i, v) in m.initial_velocities.iter().enumerate() {
+            let k = |name: &str| format!("initial_velocity[{i}].{name}");
+            for r in &v.nodes {
+                self.node(&k("nodes"), *r)?;
+            }
+            self.finite(&k("linear"), &v.linear)?;
+            self.finite(&k("angular"), &v.angular)?;
+            self.finite(&k("origin"), &v.origin)?;
+        }
+        Ok(())
+    }
+
+    fn solver_and_output(&self) -> Res {
+        let s = &self.model.solver;
+        self.positive("solver.tolerance", &[s.tolerance])?;
+        if s.max_iterations == 0 {
+            return Err(self.fail("solver.max_iterations", "must be at least 1"));
+        }
+        match s.analysis {
+            Analysis::Static { load_steps: 0 } => {
+                return Err(self.fail("solver.load_steps", "must be at least 1"));
+            }
+            Analysis::Static { .. } => {}
+            Analysis::Dynamic { dt, t_end, .. } => {
+                self.positive("solver.dt", &[dt])?;
+                self.positive("solver.t_end", &[t_end])?;
+            }
+        }
+        if self.model.output.every == 0 {
+            return Err(self.fail("output.every", "must be at least 1"));
+        }
+        for (label, r) in &self.model.output.track {
+            self.node(&format!("output.track (\"{label}\")"), *r)?;
+        }
+        Ok(())
+    }
+}
+
+impl Model {
+    /// Checks the invariants the model-file checks establish (indices in
+    /// range, stiffnesses positive, numbers finite, time tables sorted,
+    /// steps positive); the error names the model key and what to change.
+    pub fn check(&self) -> Result<(), ModelError> {
+        let c = Checker { model: self };
+        c.sections_and_beams()?;
+        c.loading()?;
+        c.solver_and_output()
+    }
+}
