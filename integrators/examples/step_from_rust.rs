@@ -1,4 +1,5 @@
-//! A mechanism built and stepped from Rust: a cantilever released from rest
+//! A mechanism built (with the validating `MechanismBuilder`) and stepped
+//! from Rust: a cantilever released from rest
 //! under gravity, integrated by the energy–momentum scheme one step at a
 //! time and stopped by the program's own rule — when the tip first reaches
 //! its lowest point. Under a suddenly applied load the first peak of the
@@ -9,9 +10,12 @@
 //!
 //! Run with `cargo run --release -p flexmech-integrators --example step_from_rust`.
 
-use flexmech_core::{MassKind, Mesh, Section};
+use flexmech_core::MassKind;
+use flexmech_integrators::builder::{
+    BeamDef, BeamShape, BuildError, Dof, MechanismBuilder, SectionValues,
+};
 use flexmech_integrators::dynamics::{DynamicSettings, Integrator, Motion, Simulation};
-use flexmech_integrators::{Mechanism, NewtonSettings, SolveError};
+use flexmech_integrators::{NewtonSettings, Schedule, SolveError};
 use nalgebra::Vector3;
 
 /// Bending stiffness, mass per length, length and gravity of the cantilever.
@@ -32,22 +36,34 @@ struct Peak {
 /// is saved after step `k` and continued by a new simulation from the saved
 /// state alone, as a later process would do from a result file.
 fn first_peak(restart_at: Option<usize>) -> Result<Peak, SolveError> {
-    let section = Section::new([1.0e6, 1.0e6, 1.0e6], [EI, EI, EI], RHO_A, [1e-4; 3]);
-    let mut mesh = Mesh::default();
-    let nodes = mesh
-        .add_straight_beam(
-            Vector3::zeros(),
-            Vector3::new(LENGTH, 0.0, 0.0),
-            Vector3::y(),
-            20,
-            2,
-            section,
-        )
-        .map_err(|e| SolveError::InvalidMechanism(e.to_string()))?;
-    let tip = *nodes.last().expect("a beam has nodes");
-    let mut mech = Mechanism::new(mesh);
-    mech.fixed[nodes[0]] = [true; 6];
-    mech.gravity = Vector3::new(0.0, -G, 0.0);
+    let rod = SectionValues {
+        ea: 1.0e6,
+        ga: [1.0e6; 2],
+        gj: EI,
+        ei: [EI; 2],
+        rho_a: RHO_A,
+        rho_j: [1e-4; 3],
+    };
+    let invalid = |e: BuildError| SolveError::InvalidMechanism(e.to_string());
+    let mut builder = MechanismBuilder::new();
+    let beam = builder
+        .beam(BeamDef {
+            shape: BeamShape::Straight {
+                start: Vector3::zeros(),
+                end: Vector3::new(LENGTH, 0.0, 0.0),
+                e2: Vector3::y(),
+            },
+            elements: 20,
+            nodes_per_element: 2,
+            section: rod,
+        })
+        .map_err(invalid)?;
+    builder.fix(beam.start(), &Dof::ALL).map_err(invalid)?;
+    builder
+        .gravity(Vector3::new(0.0, -G, 0.0), Schedule::constant(1.0))
+        .map_err(invalid)?;
+    let tip = beam.end().index();
+    let mech = builder.build();
     let settings = DynamicSettings {
         dt: 1e-3,
         t_end: 0.5,

@@ -6,6 +6,7 @@
 
 pub mod assembly;
 pub mod band_lu;
+pub mod builder;
 pub mod constraints;
 pub mod dofs;
 pub mod dynamics;
@@ -25,7 +26,7 @@ pub mod tolerances;
 
 pub use constraints::{MechanismState, Topology};
 pub use error::{NewtonFailure, SolveError};
-pub use mechanism::{JointInstance, Mechanism, NodalLoad, PrescribedDof, Schedule};
+pub use mechanism::{JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof, Schedule};
 pub use newton::NewtonSettings;
 pub use record::{Energies, JointRecord, StepRecord};
 pub use statics::{solve_static, StaticOutcome, StaticSettings};

@@ -49,6 +49,38 @@ pub struct NodalLoad {
     pub scale: Schedule,
 }
 
+/// A user's dead load field: adds nodal forces and moments about fixed
+/// global axes at time `t` (statics: at the load factor) to `out` (6 per
+/// node: force, then moment). Any time dependence and any distribution over
+/// the nodes a researcher writes — a line load lumped to nodes, a measured
+/// force history — enters every solver exactly where the built-in loads do
+/// ([`Mechanism::external_forces`]), so the schemes' load evaluation, work
+/// and reactions treat it alike. It must not depend on the state (its
+/// tangent would be missing).
+#[derive(Clone)]
+pub struct LoadField(Arc<LoadFn>);
+
+/// The function of a [`LoadField`]: time, and the nodal forces to add to.
+pub type LoadFn = dyn Fn(f64, &mut [f64]) + Send + Sync;
+
+impl LoadField {
+    /// A field from `f(t, out)`, which adds its forces into `out`.
+    pub fn new(f: impl Fn(f64, &mut [f64]) + Send + Sync + 'static) -> Self {
+        Self(Arc::new(f))
+    }
+
+    /// Adds the field's forces at `t` into `out`.
+    pub fn add(&self, t: f64, out: &mut [f64]) {
+        (self.0)(t, out)
+    }
+}
+
+impl std::fmt::Debug for LoadField {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("LoadField(<fn>)")
+    }
+}
+
 /// A joint of the mechanism: master–slave relation (1) between two nodes.
 #[derive(Debug, Clone)]
 pub struct JointInstance {
@@ -88,6 +120,8 @@ pub struct Mechanism {
     pub fixed: Vec<[bool; 6]>,
     /// Nodal loads.
     pub loads: Vec<NodalLoad>,
+    /// Users' load fields, added after the nodal loads.
+    pub load_fields: Vec<LoadField>,
     /// Gravity acceleration (acts on `ρA`).
     pub gravity: Vector3<f64>,
     /// Scale of gravity over time (statics: ramped with the load factor).
@@ -106,6 +140,7 @@ impl Mechanism {
             mesh,
             fixed: vec![[false; 6]; n],
             loads: Vec::new(),
+            load_fields: Vec::new(),
             gravity: Vector3::zeros(),
             gravity_scale: Schedule::constant(1.0),
             joints: Vec::new(),
@@ -156,8 +191,8 @@ impl Mechanism {
     }
 
     /// External nodal forces and moments at time `t` (6 per node:
-    /// force, then spatial moment), including consistent nodal gravity
-    /// forces `∫ρA g Iᵢ ds`.
+    /// force, then spatial moment): the nodal loads, the users' load fields
+    /// and consistent nodal gravity forces `∫ρA g Iᵢ ds`.
     pub fn external_forces(&self, t: f64, out: &mut [f64]) {
         out.iter_mut().for_each(|v| *v = 0.0);
         for load in &self.loads {
@@ -166,6 +201,9 @@ impl Mechanism {
                 out[6 * load.node + c] += s * load.force[c];
                 out[6 * load.node + 3 + c] += s * load.moment[c];
             }
+        }
+        for field in &self.load_fields {
+            field.add(t, out);
         }
         if self.gravity != Vector3::zeros() {
             let g = self.gravity * self.gravity_scale.at(t);

@@ -1,7 +1,7 @@
 //! Cylindrical joint: a released rotation `ψ` about `axis` and an independent
 //! released translation `s` along `slide`: `r_R = s t_r`, `Λ_R = exp((ψ−ψ₀) t̂)`.
 
-use crate::kinematics::{axis_rotation, Increments, JointKinematics, ReleasedState};
+use crate::kinematics::{axis_rotation, AngleAt, AngleSlide, JointKinematics};
 use crate::model_joint::{direction, ModelJoint, ParamError};
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Matrix3, Vector3};
@@ -17,22 +17,13 @@ pub struct Cylindrical {
 }
 
 impl JointKinematics for Cylindrical {
-    const RELEASED: usize = 2;
+    type Coordinates = AngleSlide;
 
-    fn released<T: Scalar>(
-        &self,
-        state: &ReleasedState,
-        inc: Increments<'_, T>,
-    ) -> (Vector3<T>, Matrix3<T>) {
-        let psi = inc.coordinate(state, 0) - cst::<T>(state.q0[0]);
+    fn released<T: Scalar>(&self, (angle, s): &(AngleAt<T>, T)) -> (Vector3<T>, Matrix3<T>) {
         (
-            self.slide.map(cst::<T>) * inc.coordinate(state, 1),
-            axis_rotation(&self.axis, psi),
+            self.slide.map(cst::<T>) * *s,
+            axis_rotation(&self.axis, angle.turn()),
         )
-    }
-
-    fn coordinate_names(&self) -> &'static [&'static str] {
-        &["angle", "slide"]
     }
 }
 

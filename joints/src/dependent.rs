@@ -39,9 +39,9 @@
 //! That is the whole joint: it can be used in a mechanism like the built-in
 //! kinds, and its `N`, `G`, `Ñ` and tangents follow from `translation`.
 
-use crate::kinematics::{axis_rotation, Increments, JointKinematics, ReleasedState};
+use crate::kinematics::{axis_rotation, Angle, AngleAt, JointKinematics};
 use flexmech_core::rotation::{cayley_mid, skew};
-use flexmech_core::{cst, Scalar};
+use flexmech_core::Scalar;
 use nalgebra::{Matrix3, SMatrix, Vector3};
 use num_dual::{Dual2_64, Dual64};
 use std::fmt::Debug;
@@ -56,20 +56,13 @@ pub trait DependentJoint: Send + Sync + Debug {
 }
 
 impl<J: DependentJoint> JointKinematics for J {
-    const RELEASED: usize = 1;
+    type Coordinates = Angle;
 
-    fn released<T: Scalar>(
-        &self,
-        state: &ReleasedState,
-        inc: Increments<'_, T>,
-    ) -> (Vector3<T>, Matrix3<T>) {
-        let psi = inc.coordinate(state, 0);
-        let rel = psi - cst::<T>(state.q0[0]);
-        (self.translation(psi), axis_rotation(&self.axis(), rel))
-    }
-
-    fn coordinate_names(&self) -> &'static [&'static str] {
-        &["angle"]
+    fn released<T: Scalar>(&self, psi: &AngleAt<T>) -> (Vector3<T>, Matrix3<T>) {
+        (
+            self.translation(psi.angle),
+            axis_rotation(&self.axis(), psi.turn()),
+        )
     }
 }
 

@@ -4,7 +4,9 @@
 //! and the incremental map `Ñ` of a step.
 
 use crate::incremental::{JointStep, NodePose};
-use crate::kinematics::{Increments, JointKinematics, ReleasedState, LOCAL, MAX_RELEASED};
+use crate::kinematics::{
+    released_count, Increments, JointKinematics, ReleasedState, LOCAL, MAX_RELEASED,
+};
 use flexmech_core::rotation::exp;
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Const, Matrix3, SMatrix, SVector, Vector3, Vector6, U1};
@@ -74,6 +76,12 @@ pub trait JointMap: Send + Sync + Debug {
     fn advance(&self, state: &mut ReleasedState, delta: &[f64]);
     /// The angle reported in results.
     fn reported_angle(&self, state: &ReleasedState) -> Option<f64>;
+
+    /// Whether the first released coordinate is a rotation angle (named
+    /// `angle`): the kinds that take an initial angle and can be driven.
+    fn has_angle(&self) -> bool {
+        self.coordinate_names().first() == Some(&"angle")
+    }
 }
 
 /// Slave increment `(Δx, spin)` for the local increment `e` applied after `h`,
@@ -94,7 +102,7 @@ fn slave_increment<J: JointKinematics, T: Scalar>(
         let rm = exp(&Vector3::new(a[3], a[4], a[5]))
             * exp(&Vector3::new(b[3], b[4], b[5]))
             * r_m.map(cst::<T>);
-        let (rr, lr) = joint.released(
+        let (rr, lr) = joint.released_at_state(
             state,
             Increments {
                 first: &a[6..],
@@ -117,7 +125,7 @@ fn slave_increment<J: JointKinematics, T: Scalar>(
 
 impl<J: JointKinematics> JointMap for J {
     fn released_count(&self) -> usize {
-        J::RELEASED
+        released_count::<J>()
     }
 
     fn coordinate_names(&self) -> &'static [&'static str] {
@@ -126,7 +134,7 @@ impl<J: JointKinematics> JointMap for J {
 
     fn released_placement(&self, state: &ReleasedState) -> (Vector3<f64>, Matrix3<f64>) {
         let z = [0.0; MAX_RELEASED];
-        self.released(
+        self.released_at_state(
             state,
             Increments {
                 first: &z,
@@ -163,7 +171,7 @@ impl<J: JointKinematics> JointMap for J {
                 &spin[r].eps.unwrap_generic(Const::<LOCAL>, U1).transpose(),
             );
         }
-        for c in 6 + J::RELEASED..LOCAL {
+        for c in 6 + released_count::<J>()..LOCAL {
             n.column_mut(c).fill(0.0);
         }
         n
@@ -184,7 +192,7 @@ impl<J: JointKinematics> JointMap for J {
         let w = dx.dot(&gh.fixed_rows::<3>(0)) + spin.dot(&gh.fixed_rows::<3>(3));
         let mut ntg = w.eps1.unwrap_generic(Const::<LOCAL>, U1);
         let mut k = w.eps1eps2.unwrap_generic(Const::<LOCAL>, Const::<LOCAL>);
-        for c in 6 + J::RELEASED..LOCAL {
+        for c in 6 + released_count::<J>()..LOCAL {
             ntg[c] = 0.0;
             k.row_mut(c).fill(0.0);
             k.column_mut(c).fill(0.0);
@@ -217,7 +225,7 @@ impl<J: JointKinematics> JointMap for J {
         for r in 0..LOCAL {
             k.set_row(r, &t[r].eps.unwrap_generic(Const::<LOCAL>, U1).transpose());
         }
-        for c in 6 + J::RELEASED..LOCAL {
+        for c in 6 + released_count::<J>()..LOCAL {
             value[c] = 0.0;
             k.row_mut(c).fill(0.0);
             k.column_mut(c).fill(0.0);

@@ -18,7 +18,7 @@
 //! variational map `N` of paper eqs 5–6 (`p_s = N p_Rm`) and the derivative of
 //! `Nᵀ g` that Newton's tangent needs. No kind writes a derivative by hand.
 
-use flexmech_core::rotation::{cayley_inverse, exp, skew};
+use flexmech_core::rotation::{cayley_inverse, exp, log, skew};
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Const, Matrix3, SMatrix, Vector3, Vector6, U1};
 use num_dual::HyperDualSVec64;
@@ -75,53 +75,234 @@ impl<T: Scalar> Increments<'_, T> {
     }
 }
 
-/// What a joint kind provides: the released translation `r_R` and rotation
-/// `Λ_R` (master body frame) of the state advanced by the increments.
-pub trait JointKinematics: Send + Sync + Debug {
+/// What a kind's released coordinates are: how many, their names, how a
+/// state advanced by increments looks to the kind ([`Coordinates::At`]), how
+/// a converged increment moves the state and how a step's released motion
+/// depends on the coordinates' increments (`B`, paper eq. 22).
+///
+/// The solvers keep every joint's coordinates in one storage type,
+/// [`ReleasedState`]; a kind never reads it: it sees its own typed
+/// coordinates — an angle, a slide, both, a rotation, or none — through the
+/// kind's associated type [`JointKinematics::Coordinates`], and automatic
+/// differentiation seeds the increments inside [`Coordinates::at`].
+pub trait Coordinates: Send + Sync + 'static {
     /// Number of released coordinates (≤ [`MAX_RELEASED`]).
-    const RELEASED: usize;
+    const COUNT: usize;
+    /// Their names (messages and outputs); a first coordinate named
+    /// `"angle"` is the released rotation angle ψ that model files set and
+    /// drive.
+    const NAMES: &'static [&'static str];
+    /// The coordinates of `state ⊕ inc` as the kind sees them.
+    type At<T: Scalar>;
 
-    /// `(r_R, Λ_R)` at `state ⊕ inc`.
-    fn released<T: Scalar>(
-        &self,
-        state: &ReleasedState,
-        inc: Increments<'_, T>,
-    ) -> (Vector3<T>, Matrix3<T>);
+    /// The coordinates of the state advanced by `inc`.
+    fn at<T: Scalar>(state: &ReleasedState, inc: Increments<'_, T>) -> Self::At<T>;
 
-    /// Advances the state by a converged (or Newton) increment `delta`.
-    /// Additive coordinates by default; kinds with a multiplicative rotation override.
-    fn advance(&self, state: &mut ReleasedState, delta: &[f64]) {
-        for (q, d) in state.q.iter_mut().zip(delta).take(Self::RELEASED) {
+    /// Advances the state by a converged (or Newton) increment `delta`:
+    /// additive by default.
+    fn advance(state: &mut ReleasedState, delta: &[f64]) {
+        for (q, d) in state.q.iter_mut().zip(delta).take(Self::COUNT) {
             *q += d;
         }
     }
 
+    /// `B` with `(u_R, θ_R) = B τ` over a step (see
+    /// [`JointKinematics::step_map`]): [`additive_step_map`] by default.
+    fn step_map<J: JointKinematics + ?Sized, T: Scalar>(
+        joint: &J,
+        start: &ReleasedState,
+        end: &ReleasedState,
+        inc: &[T; MAX_RELEASED],
+    ) -> SMatrix<T, 6, MAX_RELEASED> {
+        additive_step_map(joint, start, end, inc)
+    }
+
+    /// The angle reported as `/joints/<name>/angle`: the first coordinate
+    /// when it is the angle, else none.
+    fn reported_angle(state: &ReleasedState) -> Option<f64> {
+        (Self::NAMES.first() == Some(&"angle")).then_some(state.q[0])
+    }
+}
+
+/// A released rotation angle ψ about a fixed axis, with its value at t = 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AngleAt<T> {
+    /// ψ.
+    pub angle: T,
+    /// ψ₀.
+    pub initial: f64,
+}
+
+impl<T: Scalar> AngleAt<T> {
+    /// The turn since t = 0, `ψ − ψ₀` (the released rotation is
+    /// `exp((ψ − ψ₀) t̂)`: the identity at the initial angle).
+    pub fn turn(&self) -> T {
+        self.angle - cst::<T>(self.initial)
+    }
+}
+
+/// No released coordinate (rigid joints).
+#[derive(Debug, Clone, Copy)]
+pub struct NoCoordinates;
+
+impl Coordinates for NoCoordinates {
+    const COUNT: usize = 0;
+    const NAMES: &'static [&'static str] = &[];
+    type At<T: Scalar> = ();
+    fn at<T: Scalar>(_: &ReleasedState, _: Increments<'_, T>) {}
+}
+
+/// One released angle ψ (revolute, screw, rack-and-pinion, cam, lobe).
+#[derive(Debug, Clone, Copy)]
+pub struct Angle;
+
+impl Coordinates for Angle {
+    const COUNT: usize = 1;
+    const NAMES: &'static [&'static str] = &["angle"];
+    type At<T: Scalar> = AngleAt<T>;
+    fn at<T: Scalar>(state: &ReleasedState, inc: Increments<'_, T>) -> AngleAt<T> {
+        AngleAt {
+            angle: inc.coordinate(state, 0),
+            initial: state.q0[0],
+        }
+    }
+}
+
+/// One released translation `s` (prismatic).
+#[derive(Debug, Clone, Copy)]
+pub struct Slide;
+
+impl Coordinates for Slide {
+    const COUNT: usize = 1;
+    const NAMES: &'static [&'static str] = &["slide"];
+    type At<T: Scalar> = T;
+    fn at<T: Scalar>(state: &ReleasedState, inc: Increments<'_, T>) -> T {
+        inc.coordinate(state, 0)
+    }
+}
+
+/// A released angle and a released translation (cylindrical).
+#[derive(Debug, Clone, Copy)]
+pub struct AngleSlide;
+
+impl Coordinates for AngleSlide {
+    const COUNT: usize = 2;
+    const NAMES: &'static [&'static str] = &["angle", "slide"];
+    type At<T: Scalar> = (AngleAt<T>, T);
+    fn at<T: Scalar>(state: &ReleasedState, inc: Increments<'_, T>) -> (AngleAt<T>, T) {
+        (
+            AngleAt {
+                angle: inc.coordinate(state, 0),
+                initial: state.q0[0],
+            },
+            inc.coordinate(state, 1),
+        )
+    }
+}
+
+/// A released rotation of three axes (spherical), kept as a matrix and
+/// updated multiplicatively, `Λ_R ← exp(ω̂) Λ_R` with `ω` in the master
+/// body frame: the kind sees `Λ_R ⊕ inc = exp(first^) exp(second^) Λ_R`.
+#[derive(Debug, Clone, Copy)]
+pub struct BallRotation;
+
+impl Coordinates for BallRotation {
+    const COUNT: usize = 3;
+    const NAMES: &'static [&'static str] = &["rx", "ry", "rz"];
+    type At<T: Scalar> = Matrix3<T>;
+    fn at<T: Scalar>(state: &ReleasedState, inc: Increments<'_, T>) -> Matrix3<T> {
+        let a = Vector3::new(inc.first[0], inc.first[1], inc.first[2]);
+        let b = Vector3::new(inc.second[0], inc.second[1], inc.second[2]);
+        exp(&a) * exp(&b) * state.rot.map(cst::<T>)
+    }
+
+    fn advance(state: &mut ReleasedState, delta: &[f64]) {
+        state.rot = exp(&Vector3::new(delta[0], delta[1], delta[2])) * state.rot;
+    }
+
+    /// The released increment is the rotation increment itself: `τ = θ_R`,
+    /// `B = [0; I]`.
+    fn step_map<J: JointKinematics + ?Sized, T: Scalar>(
+        _joint: &J,
+        _start: &ReleasedState,
+        _end: &ReleasedState,
+        _inc: &[T; MAX_RELEASED],
+    ) -> SMatrix<T, 6, MAX_RELEASED> {
+        let mut b = SMatrix::<T, 6, MAX_RELEASED>::zeros();
+        b.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&Matrix3::identity());
+        b
+    }
+
+    /// The magnitude of the released rotation.
+    fn reported_angle(state: &ReleasedState) -> Option<f64> {
+        Some(log(&state.rot).norm())
+    }
+}
+
+/// The coordinates of kind `J` as it sees them.
+pub type CoordinatesOf<J, T> = <<J as JointKinematics>::Coordinates as Coordinates>::At<T>;
+
+/// What a joint kind provides: its coordinates' type and the released
+/// translation `r_R` and rotation `Λ_R` (master body frame) as functions of
+/// them, for any scalar. Everything else has a default from the coordinates'
+/// type.
+pub trait JointKinematics: Send + Sync + Debug {
+    /// The kind's released coordinates ([`Angle`], [`Slide`],
+    /// [`AngleSlide`], [`BallRotation`], [`NoCoordinates`], or a type of
+    /// the author's).
+    type Coordinates: Coordinates;
+
+    /// `(r_R, Λ_R)` at the coordinates `q`.
+    fn released<T: Scalar>(&self, q: &CoordinatesOf<Self, T>) -> (Vector3<T>, Matrix3<T>);
+
+    /// `(r_R, Λ_R)` at `state ⊕ inc` (what the derived maps evaluate; the
+    /// increments are where automatic differentiation seeds).
+    fn released_at_state<T: Scalar>(
+        &self,
+        state: &ReleasedState,
+        inc: Increments<'_, T>,
+    ) -> (Vector3<T>, Matrix3<T>) {
+        self.released(&<Self::Coordinates as Coordinates>::at(state, inc))
+    }
+
+    /// Advances the state by a converged (or Newton) increment `delta`.
+    fn advance(&self, state: &mut ReleasedState, delta: &[f64]) {
+        <Self::Coordinates as Coordinates>::advance(state, delta)
+    }
+
     /// Names of the released coordinates (for messages and outputs).
-    fn coordinate_names(&self) -> &'static [&'static str];
+    fn coordinate_names(&self) -> &'static [&'static str] {
+        <Self::Coordinates as Coordinates>::NAMES
+    }
 
     /// The released increments of a step as linear functions of the
     /// coordinates' increments `τ`: `(u_R, θ_R) = B τ` exactly, with
     /// `u_R = r_R,ₙ₊₁ − r_R,ₙ` and `θ_R = cay⁻¹(Λ_R,ₙ₊₁ Λ_R,ₙᵀ)` (paper eq. 22;
-    /// see [`crate::incremental`]). The default, for additive coordinates
-    /// (`τ = qₙ₊₁ − qₙ`), is [`additive_step_map`]; a kind
-    /// with a multiplicative rotation overrides it. The end state is
-    /// `end ⊕ inc` (`inc` as in [`JointKinematics::released`]), so that
-    /// automatic differentiation can follow `B` as the end state moves.
+    /// see [`crate::incremental`]). The coordinates' type gives it: for
+    /// additive coordinates (`τ = qₙ₊₁ − qₙ`) [`additive_step_map`], for a
+    /// multiplicative rotation `[0; I]`. The end state is `end ⊕ inc` (`inc`
+    /// as in [`JointKinematics::released_at_state`]), so that automatic
+    /// differentiation can follow `B` as the end state moves.
     fn step_map<T: Scalar>(
         &self,
         start: &ReleasedState,
         end: &ReleasedState,
         inc: &[T; MAX_RELEASED],
     ) -> SMatrix<T, 6, MAX_RELEASED> {
-        additive_step_map(self, start, end, inc)
+        <Self::Coordinates as Coordinates>::step_map(self, start, end, inc)
     }
 
     /// The released rotation angle reported as `/joints/<name>/angle`, or
-    /// `None` for a kind without one (the dataset is then absent). By
-    /// default the first coordinate when it is named `"angle"`.
+    /// `None` for a kind without one (the dataset is then absent).
     fn reported_angle(&self, state: &ReleasedState) -> Option<f64> {
-        (self.coordinate_names().first() == Some(&"angle")).then_some(state.q[0])
+        <Self::Coordinates as Coordinates>::reported_angle(state)
     }
+}
+
+/// Number of released coordinates of kind `J`.
+pub fn released_count<J: JointKinematics + ?Sized>() -> usize {
+    <J::Coordinates as Coordinates>::COUNT
 }
 
 /// `exp(φ t̂)` for a unit axis `t` and an angle `φ` (one-axis released rotation).
@@ -170,7 +351,7 @@ pub fn additive_step_map<J: JointKinematics + ?Sized, T: Scalar>(
         )
     };
     let mut b = SMatrix::<T, 6, MAX_RELEASED>::zeros();
-    for k in 0..J::RELEASED {
+    for k in 0..released_count::<J>() {
         let column: Vector6<T> = if tau[k].value().abs() >= TAYLOR_BELOW {
             (f(k + 1) - f(k)) / tau[k]
         } else {
@@ -198,7 +379,7 @@ pub(crate) fn released_at<J: JointKinematics + ?Sized, T: Scalar>(
     first: &[T; MAX_RELEASED],
 ) -> (Vector3<T>, Matrix3<T>) {
     let zero = [T::zero(); MAX_RELEASED];
-    joint.released(
+    joint.released_at_state(
         state,
         Increments {
             first,

@@ -32,7 +32,10 @@ pub use cylindrical::Cylindrical;
 pub use dependent::{DependentJoint, DependentJointMaps};
 pub use incremental::JointStep;
 pub use joint_map::JointMap;
-pub use kinematics::{JointKinematics, ReleasedState, LOCAL, MAX_RELEASED};
+pub use kinematics::{
+    Angle, AngleAt, AngleSlide, BallRotation, Coordinates, CoordinatesOf, JointKinematics,
+    NoCoordinates, ReleasedState, Slide, LOCAL, MAX_RELEASED,
+};
 pub use lobe::{Lift, Lobe, PeriodicSpline};
 pub use model_joint::{ModelJoint, ParamError};
 pub use prismatic::Prismatic;

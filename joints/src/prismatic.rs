@@ -1,7 +1,7 @@
 //! Prismatic (slider) joint: one released translation `s` along the unit
 //! `slide` direction, no released rotation: `r_R = s t_r`, `Λ_R = I`.
 
-use crate::kinematics::{Increments, JointKinematics, ReleasedState};
+use crate::kinematics::{JointKinematics, Slide};
 use crate::model_joint::{direction, ModelJoint, ParamError, SlideParams};
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Matrix3, Vector3};
@@ -14,21 +14,10 @@ pub struct Prismatic {
 }
 
 impl JointKinematics for Prismatic {
-    const RELEASED: usize = 1;
+    type Coordinates = Slide;
 
-    fn released<T: Scalar>(
-        &self,
-        state: &ReleasedState,
-        inc: Increments<'_, T>,
-    ) -> (Vector3<T>, Matrix3<T>) {
-        (
-            self.slide.map(cst::<T>) * inc.coordinate(state, 0),
-            Matrix3::identity(),
-        )
-    }
-
-    fn coordinate_names(&self) -> &'static [&'static str] {
-        &["slide"]
+    fn released<T: Scalar>(&self, s: &T) -> (Vector3<T>, Matrix3<T>) {
+        (self.slide.map(cst::<T>) * *s, Matrix3::identity())
     }
 }
 

@@ -1,7 +1,7 @@
 //! Rigid joint: nothing released; the slave moves with the master
 //! (`r_R = 0`, `Λ_R = I`), so two beams that meet at a point act as one.
 
-use crate::kinematics::{Increments, JointKinematics, ReleasedState};
+use crate::kinematics::{JointKinematics, NoCoordinates};
 use crate::model_joint::{ModelJoint, NoParams, ParamError};
 use flexmech_core::Scalar;
 use nalgebra::{Matrix3, Vector3};
@@ -11,18 +11,10 @@ use nalgebra::{Matrix3, Vector3};
 pub struct Rigid;
 
 impl JointKinematics for Rigid {
-    const RELEASED: usize = 0;
+    type Coordinates = NoCoordinates;
 
-    fn released<T: Scalar>(
-        &self,
-        _: &ReleasedState,
-        _: Increments<'_, T>,
-    ) -> (Vector3<T>, Matrix3<T>) {
+    fn released<T: Scalar>(&self, _: &()) -> (Vector3<T>, Matrix3<T>) {
         (Vector3::zeros(), Matrix3::identity())
-    }
-
-    fn coordinate_names(&self) -> &'static [&'static str] {
-        &[]
     }
 }
 

@@ -2,15 +2,15 @@
 //! the beams, number the nodes, apply supports, loads and gravity.
 
 use crate::model::{
-    Analysis, BeamGeometry, IntegratorKind, JointSpec, Model, ModelError, NodeRef, PrescribedSpec,
+    Analysis, BeamGeometry, IntegratorKind, Model, ModelError, NodeRef, PrescribedSpec,
     TimeFunction,
 };
-use flexmech_core::{Mesh, Section};
+use flexmech_integrators::builder::{
+    BeamDef, BeamShape, BuildError, Dof, JointDef, MechanismBuilder, NodeId, SectionValues,
+};
 use flexmech_integrators::dynamics::Motion;
-use flexmech_integrators::{JointInstance, Mechanism, NodalLoad, PrescribedDof, Schedule};
-use flexmech_joints::{JointMap, ReleasedState, MAX_RELEASED};
+use flexmech_integrators::{Mechanism, Schedule};
 use nalgebra::Vector3;
-use std::sync::Arc;
 
 /// A mechanism with the numbering that relates it back to the model file.
 #[derive(Debug, Clone)]
@@ -70,31 +70,58 @@ fn schedule_of(f: &TimeFunction) -> Schedule {
     Schedule::new(move |t| f.eval(t))
 }
 
-/// The kinematics of a joint and its initial released coordinates: `angle`
-/// starts the first coordinate of kinds whose first coordinate is an angle.
-fn joint_map(spec: &JointSpec) -> (Arc<dyn JointMap>, ReleasedState) {
-    let mut q0 = [0.0; MAX_RELEASED];
-    if spec.kind.has_angle() {
-        q0[0] = spec.angle;
-    }
-    (spec.kind.map().clone(), ReleasedState::new(q0))
+/// The builder's refusal as a model error: the key of the model entry it is
+/// about (`key`), in the model's words.
+fn refused(model: &Model, key: String, e: BuildError) -> ModelError {
+    let message = match &e {
+        BuildError::Mesh { beam, source } => {
+            format!("beam `{}`: {source}", model.beams[*beam].name)
+        }
+        BuildError::NonFiniteRelease { joint, expected } => format!(
+            "joint `{joint}`: its released translation at the initial angle is not a finite \
+             number ({expected:?}); check the joint's parameters (pitch, radius, profile \
+             coefficients or table, period) and its `angle`"
+        ),
+        BuildError::SlaveOff {
+            joint,
+            at,
+            expected,
+            gap,
+        } => {
+            let spec = model.joints.iter().find(|j| &j.name == joint);
+            let label = |r: Option<NodeRef>| r.map(|r| model.node_label(r)).unwrap_or_default();
+            let p = |x: &[f64; 3]| format!("({:.6}, {:.6}, {:.6})", x[0], x[1], x[2]);
+            format!(
+                "joint `{joint}`: the slave `{}` starts at {} but the master `{}` plus the \
+                 released translation at the initial angle puts it at {} (off by {gap:.3e}); \
+                 move the beam, or set the joint's `angle`",
+                label(spec.map(|s| s.slave)),
+                p(at),
+                label(spec.map(|s| s.master)),
+                p(expected)
+            )
+        }
+        other => other.to_string(),
+    };
+    ModelError::new(&model.path, key, None, message)
 }
 
-/// Builds the mechanism of `model`.
+/// Builds the mechanism of `model` through the [`MechanismBuilder`], whose
+/// checks (sections, geometry, joints placed by relation (1)) apply.
 ///
 /// The model's invariants are checked first ([`Model::check`]), so a model
 /// built or changed in Rust is refused with a message naming the key rather
 /// than meshed with an index out of range.
 pub fn build(model: &Model) -> Result<Built, ModelError> {
     model.check()?;
-    let mut mesh = Mesh::default();
-    let mut beam_nodes = Vec::with_capacity(model.beams.len());
-    for (b, beam) in model.beams.iter().enumerate() {
+    let mut b = MechanismBuilder::new();
+    let mut beam_nodes: Vec<Vec<NodeId>> = Vec::with_capacity(model.beams.len());
+    for (i, beam) in model.beams.iter().enumerate() {
         if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
             if integrator == IntegratorKind::EnergyMomentumPaper && beam.nodes_per_element != 2 {
                 return Err(ModelError::new(
                     &model.path,
-                    format!("beam[{b}].nodes_per_element"),
+                    format!("beam[{i}].nodes_per_element"),
                     None,
                     format!(
                         "integrator = \"{}\" runs on 2-node elements (the paper's internal force is the midpoint form of the linear element); use nodes_per_element = 2 with more elements, or integrator = \"energy-momentum\"",
@@ -104,138 +131,110 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
             }
         }
         let s = &model.sections[beam.section];
-        let section = Section::new(
-            [s.ea, s.ga[0], s.ga[1]],
-            [s.gj, s.ei[0], s.ei[1]],
-            s.rho_a,
-            s.rho_j,
-        );
-        let nodes = match &beam.geometry {
-            BeamGeometry::Straight { start, end, e2 } => mesh.add_straight_beam(
-                v(*start),
-                v(*end),
-                v(*e2),
-                beam.elements,
-                beam.nodes_per_element,
-                section,
-            ),
+        let shape = match &beam.geometry {
+            BeamGeometry::Straight { start, end, e2 } => BeamShape::Straight {
+                start: v(*start),
+                end: v(*end),
+                e2: v(*e2),
+            },
             BeamGeometry::Arc {
                 start,
                 center,
                 normal,
                 sweep,
                 e2,
-            } => mesh.add_arc_beam(
-                v(*start),
-                v(*center),
-                v(*normal),
-                *sweep,
-                e2.map(v),
-                beam.elements,
-                beam.nodes_per_element,
-                section,
-            ),
-        }
-        .map_err(|e| {
-            ModelError::new(
-                &model.path,
-                format!("beam[{b}]"),
-                None,
-                format!("beam `{}`: {e}", beam.name),
-            )
-        })?;
-        beam_nodes.push(nodes);
+            } => BeamShape::Arc {
+                start: v(*start),
+                center: v(*center),
+                normal: v(*normal),
+                sweep: *sweep,
+                e2: e2.map(v),
+            },
+        };
+        let nodes = b
+            .beam(BeamDef {
+                shape,
+                elements: beam.elements,
+                nodes_per_element: beam.nodes_per_element,
+                section: SectionValues {
+                    ea: s.ea,
+                    ga: s.ga,
+                    gj: s.gj,
+                    ei: s.ei,
+                    rho_a: s.rho_a,
+                    rho_j: s.rho_j,
+                },
+            })
+            .map_err(|e| refused(model, format!("beam[{i}]"), e))?;
+        beam_nodes.push(nodes.nodes().to_vec());
     }
-    let mut mechanism = Mechanism::new(mesh);
     let node = |r: NodeRef| beam_nodes[r.beam][r.node];
-    for s in &model.supports {
-        let f = &mut mechanism.fixed[node(s.node)];
-        for (d, held) in s.fixed.iter().enumerate() {
-            f[d] |= *held;
-        }
+    for (i, s) in model.supports.iter().enumerate() {
+        let dofs: Vec<Dof> = (0..6)
+            .filter(|&d| s.fixed[d])
+            .filter_map(Dof::from_index)
+            .collect();
+        b.fix(node(s.node), &dofs)
+            .map_err(|e| refused(model, format!("support[{i}]"), e))?;
     }
-    for l in &model.loads {
-        mechanism.loads.push(NodalLoad {
-            node: node(l.node),
-            force: v(l.force),
-            moment: v(l.moment),
-            scale: schedule(&l.time, &model.solver.analysis),
-        });
+    for (i, l) in model.loads.iter().enumerate() {
+        b.load(
+            node(l.node),
+            v(l.force),
+            v(l.moment),
+            schedule(&l.time, &model.solver.analysis),
+        )
+        .map_err(|e| refused(model, format!("load[{i}]"), e))?;
     }
-    mechanism.gravity = v(model.gravity);
-    mechanism.gravity_scale = schedule(&None, &model.solver.analysis);
-    let scale = mechanism
-        .mesh
-        .positions
-        .iter()
-        .map(|x| x.norm())
-        .fold(1.0, f64::max);
+    b.gravity(v(model.gravity), schedule(&None, &model.solver.analysis))
+        .map_err(|e| refused(model, "gravity".into(), e))?;
+    let mut joints = Vec::with_capacity(model.joints.len());
     for (j, spec) in model.joints.iter().enumerate() {
-        let (map, initial) = joint_map(spec);
-        let (master, slave) = (node(spec.master), node(spec.slave));
-        // The slave must start where relation (1) puts it.
-        let x0 = &mechanism.mesh.positions;
-        let (expected, _) = map.slave(&x0[master], &nalgebra::Matrix3::identity(), &initial);
-        let gap = (x0[slave] - expected).norm();
-        if !gap.is_finite() {
-            // A profile that evaluates to NaN or ∞ (a tiny period, huge
-            // coefficients, a pitch of 1e308) would pass a plain comparison.
-            return Err(ModelError::new(
-                &model.path,
-                format!("joint[{j}]"),
-                None,
-                format!(
-                    "joint `{}`: its released translation at the initial angle is not a finite \
-                     number ({expected:?}); check the joint's parameters (pitch, radius, \
-                     profile coefficients or table, period) and its `angle`",
-                    spec.name
-                ),
-            ));
-        }
-        if gap > 1e-9 * scale {
-            let p = |x: &Vector3<f64>| format!("({:.6}, {:.6}, {:.6})", x.x, x.y, x.z);
-            return Err(ModelError::new(
-                &model.path,
-                format!("joint[{j}].slave"),
-                None,
-                format!(
-                    "joint `{}`: the slave `{}` starts at {} but the master `{}` plus the released translation at the initial angle puts it at {} (off by {gap:.3e}); move the beam, or set the joint's `angle`",
-                    spec.name,
-                    model.node_label(spec.slave),
-                    p(&x0[slave]),
-                    model.node_label(spec.master),
-                    p(&expected)
-                ),
-            ));
-        }
-        let driven = vec![None; map.released_count()];
-        mechanism.joints.push(JointInstance {
-            name: spec.name.clone(),
-            master,
-            slave,
-            map,
-            initial,
-            driven,
-        });
+        let id = b
+            .joint(JointDef {
+                name: spec.name.clone(),
+                map: spec.kind.map().clone(),
+                master: node(spec.master),
+                slave: node(spec.slave),
+                angle: if spec.kind.has_angle() {
+                    spec.angle
+                } else {
+                    0.0
+                },
+            })
+            .map_err(|e| {
+                let key = match e {
+                    BuildError::SlaveOff { .. } => format!("joint[{j}].slave"),
+                    _ => format!("joint[{j}]"),
+                };
+                refused(model, key, e)
+            })?;
+        joints.push(id);
     }
-    for p in &model.prescribed {
+    for (i, p) in model.prescribed.iter().enumerate() {
         match p {
             PrescribedSpec::JointAngle { joint, angle } => {
-                mechanism.joints[*joint].driven[0] = Some(schedule_of(angle));
+                b.drive(joints[*joint], schedule_of(angle))
             }
             PrescribedSpec::NodeDof {
                 node: r,
                 dof,
                 value,
-            } => {
-                mechanism.prescribed.push(PrescribedDof {
-                    node: node(*r),
-                    dof: *dof,
-                    value: schedule_of(value),
-                });
-            }
+            } => match Dof::from_index(*dof) {
+                Some(d) => b.prescribe(node(*r), d, schedule_of(value)),
+                None => Err(BuildError::NotFinite {
+                    what: format!("dof index {dof} (0..6)"),
+                    value: *dof as f64,
+                }),
+            },
         }
+        .map_err(|e| refused(model, format!("prescribed[{i}]"), e))?;
     }
+    let mechanism = b.build();
+    let beam_nodes = beam_nodes
+        .into_iter()
+        .map(|nodes| nodes.into_iter().map(NodeId::index).collect())
+        .collect();
     let mut built = Built {
         mechanism,
         beam_nodes,

@@ -21,6 +21,8 @@
 //! # Ok(()) }
 //! ```
 
+use std::ops::ControlFlow;
+
 use super::checkpoint::{Checkpoint, CheckpointMismatch, Tape};
 use super::midpoint::MidpointTerms;
 use super::newmark_terms::NewmarkTerms;
@@ -174,6 +176,20 @@ impl<'m> Simulation<'m> {
             on_step(&record);
         }
         Ok(())
+    }
+
+    /// Steps until `observe` breaks (after the step it was shown) or `t_end`
+    /// is reached; returns the break value, if any.
+    pub fn run_until<B>(
+        &mut self,
+        mut observe: impl FnMut(&StepRecord, &Self) -> ControlFlow<B>,
+    ) -> Result<Option<B>, SolveError> {
+        while let Some(record) = self.step()? {
+            if let ControlFlow::Break(b) = observe(&record, self) {
+                return Ok(Some(b));
+            }
+        }
+        Ok(None)
     }
 
     /// The record of the current state (the initial one before any step).

@@ -77,7 +77,7 @@ impl JointKind {
     /// (the kinds that take the `angle` and `rate` keys and whose angle can
     /// be prescribed).
     pub fn has_angle(&self) -> bool {
-        self.map.coordinate_names().first() == Some(&"angle")
+        self.map.has_angle()
     }
 }
 
