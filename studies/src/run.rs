@@ -6,7 +6,7 @@ use crate::build::{build, Built};
 use crate::checks::{Balance, Stability};
 use crate::model::{Analysis, Model, ModelError};
 use crate::results::{
-    layout, read_checkpoint, MeshMeta, RestartError, ResultError, ResultWriter, RunMeta,
+    layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultWriter, RunMeta,
 };
 use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
 use flexmech_integrators::{
@@ -112,6 +112,8 @@ struct Sink<'a> {
     balance: Option<Balance>,
     /// The stability of the load path, for static runs.
     stability: Option<Stability>,
+    /// The run's figures of merit over every converged step.
+    merit: Merit,
     every: usize,
     count: usize,
     iterations: usize,
@@ -128,6 +130,7 @@ impl Sink<'_> {
         if let Some(s) = &mut self.stability {
             s.push(step);
         }
+        self.merit.push(step);
         self.count += 1;
         self.iterations += step.iterations;
         if self.error.is_some() {
@@ -317,6 +320,12 @@ fn run(
         mech,
         balance: dynamic.then(Balance::default),
         stability: (!dynamic).then(|| Stability::new(conservative(model))),
+        merit: Merit::new(
+            meta.tracked
+                .iter()
+                .map(|&(_, n)| (n, meta.initial_positions[n]))
+                .collect(),
+        ),
         every: model.output.every.max(1),
         count: 0,
         iterations: 0,
@@ -385,6 +394,11 @@ fn run(
     };
     let wall = start.elapsed().as_secs_f64();
     sink.flush_last();
+    if sink.error.is_none() {
+        if let Err(e) = sink.writer.figures(&sink.merit) {
+            sink.error = Some(e);
+        }
+    }
     if let Some(e) = sink.error.take() {
         // The file is as valid as HDF5 left it; report the write failure.
         let _ = sink

@@ -16,6 +16,17 @@ pub const ATTR_VERSION: &str = "version";
 pub const ATTR_STATUS: &str = "status";
 /// Root attribute: wall-clock time of the run in seconds (written by `finish`).
 pub const ATTR_WALL_TIME: &str = "wall_time_s";
+/// Root attribute: the run's energy drift over every converged step
+/// ([`super::merit`]).
+pub const ATTR_ENERGY_DRIFT: &str = "energy_drift";
+/// Root attribute: largest displacement of a tracked node over every
+/// converged step ([`super::merit`]).
+pub const ATTR_MAX_DISPLACEMENT: &str = "max_displacement";
+/// Root attribute: Newton iterations of every converged step
+/// ([`super::merit`]).
+pub const ATTR_NEWTON_ITERATIONS: &str = "newton_iterations";
+/// Root attribute: converged steps ([`super::merit`]).
+pub const ATTR_STEPS: &str = "steps";
 /// Root attribute: warnings about a completed result (absent when none).
 pub const ATTR_WARNINGS: &str = "warnings";
 /// Root attribute: the git revision flexmech was built from (`+modified`

@@ -54,6 +54,7 @@
 //! | `version` | version of `flexmech-studies` that wrote the file |
 //! | `status` | `"running"` until [`ResultWriter::finish`], then `"completed"` or `"failed: <reason>"` |
 //! | `wall_time_s` | `f64`, written by [`ResultWriter::finish`] |
+//! | `energy_drift`, `max_displacement`, `newton_iterations`, `steps` | `f64`, the run's figures of merit over every converged step ([`merit`]) |
 //!
 //! A file whose `status` is still `"running"` comes from a process that
 //! stopped without calling `finish`; it holds every step appended before.
@@ -82,12 +83,14 @@
 //! ```
 
 pub mod layout;
+pub mod merit;
 mod mesh;
 pub mod reader;
 pub mod restart;
 mod writer;
 
+pub use merit::Merit;
 pub use mesh::MeshMeta;
-pub use reader::{ReadError, ResultReader};
+pub use reader::{EnergyDrift, ReadError, ResultReader};
 pub use restart::{read_checkpoint, RestartError};
 pub use writer::{rotation_vector, ResultError, ResultWriter, RunMeta};

@@ -130,6 +130,14 @@ impl ResultReader {
         Ok(self.status()?.starts_with(layout::STATUS_FAILED_PREFIX))
     }
 
+    /// A numeric root attribute, if the file has it.
+    pub fn f64_attr(&self, name: &str) -> Option<f64> {
+        self.file
+            .attr(name)
+            .and_then(|a| a.read_scalar::<f64>())
+            .ok()
+    }
+
     /// The root attribute `wall_time_s`, NaN while the run has not finished.
     pub fn wall_time_s(&self) -> f64 {
         self.file
@@ -301,24 +309,72 @@ impl ResultReader {
 /// that starts at rest, unstrained, with no drivers (`S = 0`) is measured
 /// against `max_t (K + U)`. 0 when `B` never changes; NaN for no steps.
 pub fn energy_drift(total: &[f64], work: &[f64], kinetic: &[f64], strain: &[f64]) -> f64 {
-    let w = |i: usize| work.get(i).copied().unwrap_or(0.0);
-    let balance: Vec<f64> = total.iter().enumerate().map(|(i, e)| e - w(i)).collect();
-    drift_of(&balance, energy_scale(total, work, kinetic, strain))
+    accumulate(total, work, kinetic, strain).drift()
 }
 
 /// `S` of [`energy_drift`].
 pub fn energy_scale(total: &[f64], work: &[f64], kinetic: &[f64], strain: &[f64]) -> f64 {
-    let moving =
-        |i: usize| kinetic.get(i).copied().unwrap_or(0.0) + strain.get(i).copied().unwrap_or(0.0);
-    let e0 = total.first().map_or(0.0, |e| e.abs());
-    let scale = work
-        .iter()
-        .map(|x| x.abs())
-        .fold(e0.max(moving(0)), f64::max);
-    if scale > 0.0 {
-        scale
-    } else {
-        (0..total.len()).map(moving).fold(0.0, f64::max)
+    accumulate(total, work, kinetic, strain).scale()
+}
+
+fn accumulate(total: &[f64], work: &[f64], kinetic: &[f64], strain: &[f64]) -> EnergyDrift {
+    let at = |v: &[f64], i: usize| v.get(i).copied().unwrap_or(0.0);
+    let mut d = EnergyDrift::default();
+    for (i, &e) in total.iter().enumerate() {
+        d.push(e, at(work, i), at(kinetic, i), at(strain, i));
+    }
+    d
+}
+
+/// [`energy_drift`] step by step: the one definition, for series read back
+/// from a file and for a run's every converged step as it is computed
+/// ([`super::merit::Merit`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EnergyDrift {
+    /// `B(0)` and `max |B − B(0)|`.
+    first: Option<f64>,
+    change: f64,
+    /// `max(|E(0)|, K(0) + U(0), max |W|)`.
+    given: f64,
+    /// `max (K + U)`, the scale of a run given no energy.
+    moving: f64,
+}
+
+impl EnergyDrift {
+    /// Takes in one step's total energy `E`, drivers' work `W`, kinetic `K`
+    /// and strain energy `U`.
+    pub fn push(&mut self, total: f64, work: f64, kinetic: f64, strain: f64) {
+        let b = total - work;
+        let moving = kinetic + strain;
+        if self.first.is_none() {
+            self.first = Some(b);
+            self.given = total.abs().max(moving);
+        }
+        let b0 = self.first.unwrap_or(b);
+        self.change = self.change.max((b - b0).abs());
+        self.given = self.given.max(work.abs());
+        self.moving = self.moving.max(moving);
+    }
+
+    /// `S`: the energy the run starts with or is given, else `max (K + U)`.
+    pub fn scale(&self) -> f64 {
+        if self.given > 0.0 {
+            self.given
+        } else {
+            self.moving
+        }
+    }
+
+    /// The drift `max |B − B(0)| / S`: 0 when `B` never changed, NaN before
+    /// the first step.
+    pub fn drift(&self) -> f64 {
+        if self.first.is_none() {
+            f64::NAN
+        } else if self.change == 0.0 {
+            0.0
+        } else {
+            self.change / self.scale()
+        }
     }
 }
 

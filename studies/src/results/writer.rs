@@ -991,6 +991,20 @@ impl ResultWriter {
         })
     }
 
+    /// Writes the run's figures of merit as root attributes (see
+    /// [`super::merit`]); called once, when the run ends.
+    pub fn figures(&mut self, merit: &super::merit::Merit) -> Result<(), ResultError> {
+        for (name, value) in merit.figures() {
+            self.file
+                .new_attr::<f64>()
+                .shape(())
+                .create(name)
+                .and_then(|a| a.as_writer().write_scalar(&value))
+                .ctx(&self.path, || format!("writing root attribute {name}"))?;
+        }
+        Ok(())
+    }
+
     /// Rewrites `/restart` with the run's state at the step appended last
     /// (see [`super::restart`]).
     pub fn checkpoint(

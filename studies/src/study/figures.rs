@@ -73,37 +73,51 @@ pub struct FigureError(#[from] pub ReadError);
 
 /// Reads the status and figures of the run whose result file is `file`.
 ///
+/// `energy_drift`, `max_displacement` and `newton_iterations` are the run's
+/// figures of merit, computed while it ran over every converged step
+/// ([`crate::results::merit`]) and stored as root attributes. A file
+/// written before they were recorded is summarised from its stored steps
+/// with the same definitions:
+///
 /// - `energy_drift`: [`ResultReader::energy_drift`] (the definition of
 ///   [`crate::results::reader::energy_drift`]);
 /// - `max_displacement`: largest `|/nodes/<label>/displacement|` over every
 ///   tracked node and stored step (NaN when no node is tracked);
-/// - `failure_time`: last value of `/time` when the status starts with
-///   `failed`, else NaN;
+/// - `newton_iterations`: sum of `/solver/iterations`.
+///
+/// The others:
+///
+/// - `failure_time`: last value of `/time` (the last converged step, always
+///   stored) when the status starts with `failed`, else NaN;
 /// - `wall_time`: root attribute `wall_time_s` (NaN if absent);
-/// - `newton_iterations`: sum of `/solver/iterations`;
 /// - every [`Figure::Dataset`] of `figures`: its reduction of its dataset.
 pub fn read_figures(file: &Path, figures: &[Figure]) -> Result<RunFigures, FigureError> {
     let r = ResultReader::open(file)?;
     let status = r.status()?;
-    let mut max_displacement = f64::NAN;
-    for label in r.node_labels()? {
-        for row in r.rows3(&layout::node_path(&label, layout::NODE_DISPLACEMENT))? {
-            let norm = (row[0] * row[0] + row[1] * row[1] + row[2] * row[2]).sqrt();
-            // NaN-aware: NaN.max(x) is x.
-            max_displacement = max_displacement.max(norm);
-        }
-    }
+    let stored = |name: &str| r.f64_attr(name);
+    let energy_drift = match stored(layout::ATTR_ENERGY_DRIFT) {
+        Some(v) => v,
+        None => r.energy_drift()?,
+    };
+    let max_displacement = match stored(layout::ATTR_MAX_DISPLACEMENT) {
+        Some(v) => v,
+        None => stored_max_displacement(&r)?,
+    };
+    let newton_iterations = match stored(layout::ATTR_NEWTON_ITERATIONS) {
+        Some(v) => v,
+        None => r.counts(layout::SOLVER_ITERATIONS)?.iter().sum::<u64>() as f64,
+    };
     let failure_time = if is_failed(&status) {
         r.time()?.last().copied().unwrap_or(f64::NAN)
     } else {
         f64::NAN
     };
     Ok(RunFigures {
-        energy_drift: r.energy_drift()?,
+        energy_drift,
         max_displacement,
         failure_time,
         wall_time: r.wall_time_s(),
-        newton_iterations: r.counts(layout::SOLVER_ITERATIONS)?.iter().sum::<u64>() as f64,
+        newton_iterations,
         datasets: figures
             .iter()
             .filter_map(|f| match f {
@@ -113,4 +127,17 @@ pub fn read_figures(file: &Path, figures: &[Figure]) -> Result<RunFigures, Figur
             .collect::<Result<_, _>>()?,
         status,
     })
+}
+
+/// Largest tracked-node displacement over the stored steps.
+fn stored_max_displacement(r: &ResultReader) -> Result<f64, ReadError> {
+    let mut max_displacement = f64::NAN;
+    for label in r.node_labels()? {
+        for row in r.rows3(&layout::node_path(&label, layout::NODE_DISPLACEMENT))? {
+            let norm = (row[0] * row[0] + row[1] * row[1] + row[2] * row[2]).sqrt();
+            // NaN-aware: NaN.max(x) is x.
+            max_displacement = max_displacement.max(norm);
+        }
+    }
+    Ok(max_displacement)
 }

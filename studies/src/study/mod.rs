@@ -54,11 +54,11 @@
 //!
 //! | figure | value |
 //! |---|---|
-//! | `energy_drift` | max \|E(t) − E(0)\| / max(\|E(0)\|, max \|E\|) of `/energy/total` (less `/energy/driver_work` when present) |
-//! | `max_displacement` | max over tracked nodes and steps of \|`/nodes/<label>/displacement`\| (NaN if none is tracked) |
+//! | `energy_drift` | [`crate::results::reader::energy_drift`] over every converged step (the result file's root attribute) |
+//! | `max_displacement` | max over tracked nodes and every converged step of the displacement's norm (NaN if none is tracked) |
 //! | `failure_time` | last `/time` of a run whose status starts with `failed`, else NaN |
 //! | `wall_time` | root attribute `wall_time_s` |
-//! | `newton_iterations` | sum of `/solver/iterations` |
+//! | `newton_iterations` | Newton iterations of every converged step |
 //!
 //! It is written to `<out>/<name>/summary.csv` and `summary.h5` (one 1-D
 //! dataset per column: numbers `f64`, text variable-length UTF-8; root
