@@ -26,7 +26,7 @@ use std::process::ExitCode;
 
 use flexmech_studies::model::{
     Analysis, BeamGeometry, BeamSpec, LoadSpec, MassKind, Model, NodeRef, OutputSpec, SectionSpec,
-    SolverSpec, SupportSpec,
+    SectionValues, SolverSpec, SupportSpec,
 };
 use flexmech_studies::study::{
     merge_study, run_study, select_shard, Component, DatasetFigure, Figure, Reduce, SlurmArray,
@@ -54,12 +54,14 @@ fn cantilever(ei: f64, force: f64) -> Model {
         gravity: [0.0; 3],
         sections: vec![SectionSpec {
             name: "rod".into(),
-            ea: 1.0e7,
-            ga: [SHEAR, SHEAR],
-            gj: ei,
-            ei: [ei, ei],
-            rho_a: 0.0,
-            rho_j: [0.0; 3],
+            values: SectionValues {
+                ea: 1.0e7,
+                ga: [SHEAR, SHEAR],
+                gj: ei,
+                ei: [ei, ei],
+                rho_a: 0.0,
+                rho_j: [0.0; 3],
+            },
         }],
         beams: vec![BeamSpec {
             name: "beam".into(),

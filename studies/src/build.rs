@@ -6,7 +6,7 @@ use crate::model::{
     TimeFunction,
 };
 use flexmech_integrators::builder::{
-    BeamDef, BeamShape, BuildError, Dof, JointDef, MechanismBuilder, NodeId, SectionValues,
+    BeamDef, BeamShape, BuildError, Dof, JointDef, MechanismBuilder, NodeId,
 };
 use flexmech_integrators::dynamics::Motion;
 use flexmech_integrators::{Mechanism, Schedule};
@@ -156,14 +156,7 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
                 shape,
                 elements: beam.elements,
                 nodes_per_element: beam.nodes_per_element,
-                section: SectionValues {
-                    ea: s.ea,
-                    ga: s.ga,
-                    gj: s.gj,
-                    ei: s.ei,
-                    rho_a: s.rho_a,
-                    rho_j: s.rho_j,
-                },
+                section: s.values,
             })
             .map_err(|e| refused(model, format!("beam[{i}]"), e))?;
         beam_nodes.push(nodes.nodes().to_vec());

@@ -205,8 +205,8 @@ fn base_file_parses_with_defaults() {
     let m = parse(BASE).unwrap();
     assert_eq!(m.name, "base");
     assert_eq!(m.gravity, [0.0; 3]);
-    assert_eq!(m.sections[0].rho_a, 0.0);
-    assert_eq!(m.sections[0].rho_j, [0.0; 3]);
+    assert_eq!(m.sections[0].values.rho_a, 0.0);
+    assert_eq!(m.sections[0].values.rho_j, [0.0; 3]);
     assert_eq!(m.beams.len(), 3);
     assert_eq!(m.beams[0].nodes_per_element, 2);
     assert_eq!(m.beams[0].node_count(), 3);
@@ -237,14 +237,14 @@ fn full_file_parses_with_the_right_values() {
 
     // Sections, integers accepted as numbers, defaults.
     assert_eq!(m.sections.len(), 2);
-    let s = &m.sections[0];
+    let s = &m.sections[0].values;
     assert_eq!(
         (s.ea, s.ga, s.gj, s.ei),
         (2.0e6, [8.0e5, 8.0e5], 1.0e3, [1.5e3, 1.5e3])
     );
     assert_eq!((s.rho_a, s.rho_j), (1.0, [0.02, 0.01, 0.01]));
-    assert_eq!(m.sections[1].ea, 1000.0);
-    assert_eq!(m.sections[1].rho_a, 0.5);
+    assert_eq!(m.sections[1].values.ea, 1000.0);
+    assert_eq!(m.sections[1].values.rho_a, 0.5);
 
     // Beams.
     let post = &m.beams[0];

@@ -75,7 +75,7 @@ fn a_function_that_gives_no_model_stops_the_study_naming_the_run() {
         |p| {
             let mut m = base();
             let ei = p.f64("EI")?;
-            m.sections[0].ei = [ei, ei];
+            m.sections[0].values.ei = [ei, ei];
             Ok(m)
         },
     )
@@ -125,8 +125,11 @@ fn a_function_that_gives_no_model_stops_the_study_naming_the_run() {
 fn models_built_in_rust_are_checked_before_meshing() {
     type Edit = fn(&mut Model);
     let cases: [(Edit, &str); 14] = [
-        (|m| m.sections[0].ea = 0.0, "section[0].EA"),
-        (|m| m.sections[0].rho_j[1] = f64::NAN, "section[0].rhoJ"),
+        (|m| m.sections[0].values.ea = 0.0, "section[0].EA"),
+        (
+            |m| m.sections[0].values.rho_j[1] = f64::NAN,
+            "section[0].rhoJ",
+        ),
         (|m| m.beams[1].section = 7, "beam[1].section"),
         (|m| m.beams[0].elements = 0, "beam[0].elements"),
         (

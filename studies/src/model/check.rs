@@ -35,16 +35,6 @@ impl Checker<'_> {
         }
     }
 
-    fn non_negative(&self, key: &str, values: &[f64]) -> Res {
-        match values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-            Some(v) => Err(self.fail(
-                key,
-                format!("must be zero or positive and finite, found {v}"),
-            )),
-            None => Ok(()),
-        }
-    }
-
     fn node(&self, key: &str, r: NodeRef) -> Res {
         let Some(beam) = self.model.beams.get(r.beam) else {
             return Err(self.fail(
@@ -93,13 +83,23 @@ impl Checker<'_> {
 
     fn sections_and_beams(&self) -> Res {
         for (i, s) in self.model.sections.iter().enumerate() {
-            let k = |name: &str| format!("section[{i}].{name}");
-            self.positive(&k("EA"), &[s.ea])?;
-            self.positive(&k("GA"), &s.ga)?;
-            self.positive(&k("GJ"), &[s.gj])?;
-            self.positive(&k("EI"), &s.ei)?;
-            self.non_negative(&k("rhoA"), &[s.rho_a])?;
-            self.non_negative(&k("rhoJ"), &s.rho_j)?;
+            // The builder's own check of the values, named by the model key.
+            if let Err((what, value)) = s.values.section() {
+                let key = match what {
+                    "GA2" | "GA3" => "GA",
+                    "EI2" | "EI3" => "EI",
+                    other => other,
+                };
+                let need = if key.starts_with("rho") {
+                    "must be zero or positive and finite"
+                } else {
+                    "must be positive and finite"
+                };
+                return Err(self.fail(
+                    format!("section[{i}].{key}"),
+                    format!("{need}, found {value}"),
+                ));
+            }
         }
         for (b, beam) in self.model.beams.iter().enumerate() {
             let k = |name: &str| format!("beam[{b}].{name}");

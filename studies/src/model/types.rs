@@ -24,23 +24,17 @@ pub enum TimeFunction {
     Table(Vec<(f64, f64)>),
 }
 
-/// Cross-section and material, per unit length.
+/// The section values of the builder, one vocabulary for model files and
+/// Rust: `EA`, `GA₂,₃`, `GJ`, `EI₂,₃`, `ρA`, `ρJ` per unit length.
+pub use flexmech_integrators::builder::SectionValues;
+
+/// A named `[[section]]`: cross-section and material, per unit length.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SectionSpec {
     /// Its name (`section` of a beam refers to it).
     pub name: String,
-    /// Axial stiffness EA.
-    pub ea: f64,
-    /// Shear stiffnesses GA2, GA3.
-    pub ga: [f64; 2],
-    /// Torsional stiffness GJ.
-    pub gj: f64,
-    /// Bending stiffnesses EI2, EI3.
-    pub ei: [f64; 2],
-    /// Mass per unit length ρA (0 allowed in statics).
-    pub rho_a: f64,
-    /// Rotational inertia per unit length `ρ(I2+I3), ρI2, ρI3`.
-    pub rho_j: [f64; 3],
+    /// Its values (`rho_a` 0 allowed in statics).
+    pub values: SectionValues,
 }
 
 /// Initial geometry of a beam.

@@ -56,12 +56,14 @@ impl Ctx<'_> {
             };
             out.push(SectionSpec {
                 name,
-                ea: self.positive(ea, &k("EA"))?,
-                ga: self.positive_n(ga, &k("GA"))?,
-                gj: self.positive(gj, &k("GJ"))?,
-                ei: self.positive_n(ei, &k("EI"))?,
-                rho_a,
-                rho_j,
+                values: SectionValues {
+                    ea: self.positive(ea, &k("EA"))?,
+                    ga: self.positive_n(ga, &k("GA"))?,
+                    gj: self.positive(gj, &k("GJ"))?,
+                    ei: self.positive_n(ei, &k("EI"))?,
+                    rho_a,
+                    rho_j,
+                },
             });
         }
         Ok(out)
@@ -82,7 +84,7 @@ impl Ctx<'_> {
         }
         for beam in beams {
             let (i, sec) = (beam.section, &sections[beam.section]);
-            if sec.rho_a > 0.0 {
+            if sec.values.rho_a > 0.0 {
                 continue;
             }
             let key = format!("section[{i}].rhoA");
