@@ -24,6 +24,8 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use nalgebra::Vector3;
+
 use flexmech_studies::model::{
     Analysis, BeamGeometry, BeamSpec, LoadSpec, MassKind, Model, NodeRef, OutputSpec, SectionSpec,
     SectionValues, SolverSpec, SupportSpec,
@@ -67,9 +69,9 @@ fn cantilever(ei: f64, force: f64) -> Model {
             name: "beam".into(),
             section: 0,
             geometry: BeamGeometry::Straight {
-                start: [0.0; 3],
-                end: [LENGTH, 0.0, 0.0],
-                e2: [0.0, 1.0, 0.0],
+                start: Vector3::zeros(),
+                end: Vector3::new(LENGTH, 0.0, 0.0),
+                e2: Vector3::y(),
             },
             elements: ELEMENTS,
             nodes_per_element: 2,

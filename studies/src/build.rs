@@ -2,12 +2,9 @@
 //! the beams, number the nodes, apply supports, loads and gravity.
 
 use crate::model::{
-    Analysis, BeamGeometry, IntegratorKind, Model, ModelError, NodeRef, PrescribedSpec,
-    TimeFunction,
+    Analysis, IntegratorKind, Model, ModelError, NodeRef, PrescribedSpec, TimeFunction,
 };
-use flexmech_integrators::builder::{
-    BeamDef, BeamShape, BuildError, Dof, JointDef, MechanismBuilder, NodeId,
-};
+use flexmech_integrators::builder::{BeamDef, BuildError, Dof, JointDef, MechanismBuilder, NodeId};
 use flexmech_integrators::dynamics::Motion;
 use flexmech_integrators::{Mechanism, Schedule};
 use nalgebra::Vector3;
@@ -131,29 +128,9 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
             }
         }
         let s = &model.sections[beam.section];
-        let shape = match &beam.geometry {
-            BeamGeometry::Straight { start, end, e2 } => BeamShape::Straight {
-                start: v(*start),
-                end: v(*end),
-                e2: v(*e2),
-            },
-            BeamGeometry::Arc {
-                start,
-                center,
-                normal,
-                sweep,
-                e2,
-            } => BeamShape::Arc {
-                start: v(*start),
-                center: v(*center),
-                normal: v(*normal),
-                sweep: *sweep,
-                e2: e2.map(v),
-            },
-        };
         let nodes = b
             .beam(BeamDef {
-                shape,
+                shape: beam.geometry,
                 elements: beam.elements,
                 nodes_per_element: beam.nodes_per_element,
                 section: s.values,

@@ -254,9 +254,12 @@ fn full_file_parses_with_the_right_values() {
     );
     match &post.geometry {
         BeamGeometry::Straight { start, end, e2 } => {
-            assert_eq!(*start, [0.0, 0.0, 0.0]);
-            assert_eq!(*end, [0.0, 0.0, 10.0]);
-            assert!(close(*e2, [1.0, 0.0, 0.0]), "e2 normalised: {e2:?}");
+            assert_eq!(<[f64; 3]>::from(*start), [0.0, 0.0, 0.0]);
+            assert_eq!(<[f64; 3]>::from(*end), [0.0, 0.0, 10.0]);
+            assert!(
+                close((*e2).into(), [1.0, 0.0, 0.0]),
+                "e2 normalised: {e2:?}"
+            );
         }
         g => panic!("post should be straight: {g:?}"),
     }
@@ -275,9 +278,9 @@ fn full_file_parses_with_the_right_values() {
             sweep,
             e2,
         } => {
-            assert_eq!(*start, [0.0; 3]);
-            assert_eq!(*center, [100.0, 0.0, 0.0]);
-            assert!(close(*normal, [0.0, 0.0, -1.0]));
+            assert_eq!(<[f64; 3]>::from(*start), [0.0; 3]);
+            assert_eq!(<[f64; 3]>::from(*center), [100.0, 0.0, 0.0]);
+            assert!(close((*normal).into(), [0.0, 0.0, -1.0]));
             assert_eq!(*sweep, 0.7853981634);
             assert_eq!(*e2, None);
         }
@@ -551,8 +554,8 @@ e2 = [0.0, 0.0, 2.0]
         BeamGeometry::Arc {
             normal, e2, sweep, ..
         } => {
-            assert!(close(*normal, [0.0, 0.0, 1.0]));
-            assert_eq!(*e2, Some([0.0, 0.0, 1.0]));
+            assert!(close((*normal).into(), [0.0, 0.0, 1.0]));
+            assert_eq!(e2.map(<[f64; 3]>::from), Some([0.0, 0.0, 1.0]));
             assert_eq!(*sweep, -std::f64::consts::TAU);
         }
         g => panic!("{g:?}"),

@@ -37,36 +37,15 @@ pub struct SectionSpec {
     pub values: SectionValues,
 }
 
-/// Initial geometry of a beam.
-#[derive(Debug, Clone, PartialEq)]
-pub enum BeamGeometry {
-    /// Straight from `start` to `end`; `e2` is the section's second axis (not
-    /// parallel to the beam; it is orthogonalised against the beam axis).
-    Straight {
-        /// First end (the beam's `start` node).
-        start: [f64; 3],
-        /// Second end (the beam's `end` node).
-        end: [f64; 3],
-        /// The section's second axis (before orthogonalisation).
-        e2: [f64; 3],
-    },
-    /// Circular arc: starts at `start`, turns about `normal` (unit) through
-    /// `sweep` radians around `center`. Tangent at start is
-    /// `normal × (start − center)/radius`. `e2` defaults to the direction from
-    /// the point towards the center.
-    Arc {
-        /// First point of the arc.
-        start: [f64; 3],
-        /// Centre of the circle.
-        center: [f64; 3],
-        /// Unit normal of the arc's plane (the turning axis).
-        normal: [f64; 3],
-        /// Angle swept, radians.
-        sweep: f64,
-        /// The section's second axis at the start, if given.
-        e2: Option<[f64; 3]>,
-    },
-}
+/// Initial geometry of a beam: the builder's [`BeamShape`](flexmech_integrators::builder::BeamShape),
+/// one vocabulary for model files and Rust. `Straight { start, end, e2 }`:
+/// `e2` is the section's second axis (not parallel to the beam; it is
+/// orthogonalised against the beam axis). `Arc { start, center, normal,
+/// sweep, e2 }`: starts at `start`, turns about the unit `normal` through
+/// `sweep` radians around `center`; the tangent at start is
+/// `normal × (start − center)/radius`; `e2` defaults to the direction from
+/// the point towards the center.
+pub use flexmech_integrators::builder::BeamShape as BeamGeometry;
 
 /// A beam meshed into equal elements.
 #[derive(Debug, Clone, PartialEq)]

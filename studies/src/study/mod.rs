@@ -108,8 +108,9 @@ pub use dataset_figure::{Component, DatasetFigure, Reduce};
 pub use execute::{run_study, StudyOptions};
 pub use merge::{merge_study, MergeError};
 pub use shard::{select_shard, Shard, ShardError, SlurmArray};
-pub use source::{BuildFn, ModelFn, RunParams, RunSource};
-pub use spec::{load_study, parse_study, Figure, SpecError, StudySpec};
+pub use spec::{
+    load_study, parse_study, BuildFn, Figure, ModelFn, RunParams, RunSource, SpecError, StudySpec,
+};
 pub use sweep::SweepError;
 
 /// Why a study could not be run or merged. Failed runs are not errors: they

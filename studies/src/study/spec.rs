@@ -8,13 +8,13 @@
 
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use toml::{Table, Value};
 
 use super::dataset_figure::DatasetFigure;
 use super::key_path::{base_dir, check_key, KeyPath};
-use super::source::RunSource;
-use crate::model::{load_model, ModelError};
+use crate::model::{load_model, Model, ModelError};
 
 /// A per-run scalar of the summary table (see the module docs of
 /// [`crate::study`] for the definitions).
@@ -107,6 +107,111 @@ impl GridKey {
         self.values
             .iter()
             .all(|v| matches!(v, Value::Integer(_) | Value::Float(_)))
+    }
+}
+
+/// The signature of a run-building function: the run's parameters to its
+/// model, or a message saying why these values give no model.
+pub type BuildFn = dyn Fn(&RunParams<'_>) -> Result<Model, String> + Send + Sync;
+
+/// A shared run-building function (compared by identity).
+#[derive(Clone)]
+pub struct ModelFn(pub Arc<BuildFn>);
+
+impl fmt::Debug for ModelFn {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("ModelFn(<Rust function>)")
+    }
+}
+
+impl PartialEq for ModelFn {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+/// Where the runs of a study come from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunSource {
+    /// A base model file: each run puts its grid values at their keys
+    /// ([`super::key_path`]) and loads the result with every model-file
+    /// check.
+    ModelFile {
+        /// The base model file (the study file's `model`, resolved against
+        /// the study file's directory).
+        file: PathBuf,
+        /// The base model, parsed as TOML.
+        table: Table,
+    },
+    /// A Rust function from a run's parameters to its model
+    /// ([`StudySpec::from_fn`]).
+    Function(ModelFn),
+}
+
+/// The parameters of one run of a study defined in Rust: each grid key with
+/// the run's value.
+#[derive(Debug, Clone, Copy)]
+pub struct RunParams<'a> {
+    /// The run id (`run-0003`).
+    pub run: &'a str,
+    pub(crate) keys: &'a [GridKey],
+    pub(crate) values: &'a [Value],
+}
+
+impl<'a> RunParams<'a> {
+    /// The value of grid key `key`, if the study has that key.
+    pub fn get(&self, key: &str) -> Option<&'a Value> {
+        self.keys
+            .iter()
+            .position(|g| g.key == key)
+            .map(|i| &self.values[i])
+    }
+
+    /// `(key, value)` of every grid key, in grid order.
+    pub fn iter(&self) -> impl Iterator<Item = (&'a str, &'a Value)> + 'a {
+        let keys = self.keys;
+        keys.iter().map(|g| g.key.as_str()).zip(self.values.iter())
+    }
+
+    fn value(&self, key: &str) -> Result<&'a Value, String> {
+        self.get(key).ok_or_else(|| {
+            let known: Vec<&str> = self.keys.iter().map(|g| g.key.as_str()).collect();
+            format!(
+                "the function asks for parameter `{key}`, which is not a grid key (the grid has {})",
+                if known.is_empty() {
+                    "no keys".to_string()
+                } else {
+                    known.join(", ")
+                }
+            )
+        })
+    }
+
+    /// The number at `key` (an integer value is converted).
+    pub fn f64(&self, key: &str) -> Result<f64, String> {
+        match self.value(key)? {
+            Value::Float(x) => Ok(*x),
+            Value::Integer(i) => Ok(*i as f64),
+            other => Err(format!("parameter `{key}` = {other} is not a number")),
+        }
+    }
+
+    /// The non-negative integer at `key`.
+    pub fn usize(&self, key: &str) -> Result<usize, String> {
+        match self.value(key)? {
+            Value::Integer(i) if *i >= 0 => Ok(*i as usize),
+            other => Err(format!(
+                "parameter `{key}` = {other} is not a non-negative integer"
+            )),
+        }
+    }
+
+    /// The string at `key`.
+    pub fn str(&self, key: &str) -> Result<&'a str, String> {
+        match self.value(key)? {
+            Value::String(s) => Ok(s),
+            other => Err(format!("parameter `{key}` = {other} is not a string")),
+        }
     }
 }
 

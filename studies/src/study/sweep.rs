@@ -7,8 +7,7 @@ use std::path::PathBuf;
 use toml::{Table, Value};
 
 use super::key_path::lookup_mut;
-use super::source::{RunParams, RunSource};
-use super::spec::StudySpec;
+use super::spec::{RunParams, RunSource, StudySpec};
 use crate::model::{parse_model, Model};
 
 /// One run of a study: its position in grid order and its values.

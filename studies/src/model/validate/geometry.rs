@@ -278,7 +278,11 @@ impl Ctx<'_> {
                 ),
             ));
         }
-        Ok(BeamGeometry::Straight { start, end, e2 })
+        Ok(BeamGeometry::Straight {
+            start: start.into(),
+            end: end.into(),
+            e2: e2.into(),
+        })
     }
 
     fn arc(&self, arc_s: &S<RawArc>, e2_s: Option<&S<Vec3>>, tk: &str) -> Res<BeamGeometry> {
@@ -374,11 +378,11 @@ impl Ctx<'_> {
             }
         };
         Ok(BeamGeometry::Arc {
-            start,
-            center,
-            normal,
+            start: start.into(),
+            center: center.into(),
+            normal: normal.into(),
             sweep,
-            e2,
+            e2: e2.map(Into::into),
         })
     }
 }
