@@ -54,6 +54,21 @@ fn post_and_arm(arm_z: f64) -> (MechanismBuilder, Vec<flexmech_integrators::buil
     (b, vec![post.start(), post.end(), arm.start(), arm.end()])
 }
 
+/// The screw `drive` (pitch 0.05) from the post's top to the arm's start.
+fn drive_screw(
+    b: &mut MechanismBuilder,
+    n: &[flexmech_integrators::builder::NodeId],
+) -> flexmech_integrators::builder::JointId {
+    b.joint(JointDef {
+        name: "drive".into(),
+        map: screw(0.05),
+        master: n[1],
+        slave: n[2],
+        angle: 0.0,
+    })
+    .unwrap()
+}
+
 #[test]
 fn handles_number_nodes_and_joints_in_order() {
     let (mut b, n) = post_and_arm(2.0);
@@ -61,15 +76,7 @@ fn handles_number_nodes_and_joints_in_order() {
         n.iter().map(|x| x.index()).collect::<Vec<_>>(),
         [0, 4, 5, 9]
     );
-    let j = b
-        .joint(JointDef {
-            name: "drive".into(),
-            map: screw(0.05),
-            master: n[1],
-            slave: n[2],
-            angle: 0.0,
-        })
-        .unwrap();
+    let j = drive_screw(&mut b, &n);
     assert_eq!(j.index(), 0);
     b.drive(j, Schedule::new(|t| 2.0 * t)).unwrap();
     b.prescribe(n[3], Dof::Rz, Schedule::constant(0.0)).unwrap();
@@ -87,15 +94,7 @@ fn handles_number_nodes_and_joints_in_order() {
 #[test]
 fn a_driven_screw_built_here_raises_its_arm_by_the_pitch() {
     let (mut b, n) = post_and_arm(2.0);
-    let j = b
-        .joint(JointDef {
-            name: "drive".into(),
-            map: screw(0.05),
-            master: n[1],
-            slave: n[2],
-            angle: 0.0,
-        })
-        .unwrap();
+    let j = drive_screw(&mut b, &n);
     let turns = 0.5;
     b.drive(j, Schedule::new(move |t| t * turns * std::f64::consts::TAU))
         .unwrap();
