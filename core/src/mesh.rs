@@ -210,6 +210,13 @@ impl Mesh {
         self.positions.len()
     }
 
+    /// A node of no element at `x` (a point of the ground a joint hangs
+    /// from); returns its number.
+    pub fn add_node(&mut self, x: Vector3<f64>) -> usize {
+        self.positions.push(x);
+        self.positions.len() - 1
+    }
+
     /// Meshes a beam given node positions and triads along its length
     /// (`count` nodes, parameter `u ∈ [0, 1]`), returning its node numbers.
     fn add_beam(

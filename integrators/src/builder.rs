@@ -36,7 +36,9 @@ use flexmech_core::{Mesh, MeshError, Section};
 use flexmech_joints::{JointMap, ReleasedState, MAX_RELEASED};
 use nalgebra::{Matrix3, Vector3};
 
-use crate::mechanism::{JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof, Schedule};
+use crate::mechanism::{
+    nodal_weights, JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof, Schedule,
+};
 
 /// Relative distance (to the mechanism's size, at least 1) within which a
 /// slave node is where relation (1) puts it: round-off of a mesher's
@@ -197,6 +199,7 @@ pub struct BeamDef {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Beam {
     nodes: Vec<NodeId>,
+    elements: std::ops::Range<usize>,
 }
 
 impl Beam {
@@ -218,6 +221,11 @@ impl Beam {
     /// Every node, first to last.
     pub fn nodes(&self) -> &[NodeId] {
         &self.nodes
+    }
+
+    /// Its elements' indices in the mesh, first to last.
+    pub fn elements(&self) -> std::ops::Range<usize> {
+        self.elements.clone()
     }
 }
 
@@ -388,6 +396,7 @@ impl MechanismBuilder {
             .section()
             .map_err(|(what, value)| BuildError::Section { beam, what, value })?;
         let mesh = &mut self.mech.mesh;
+        let first_element = mesh.elements.len();
         let nodes = match def.shape {
             BeamShape::Straight { start, end, e2 } => {
                 finite(
@@ -432,6 +441,7 @@ impl MechanismBuilder {
         self.beams += 1;
         Ok(Beam {
             nodes: nodes.into_iter().map(NodeId).collect(),
+            elements: first_element..self.mech.mesh.elements.len(),
         })
     }
 
@@ -472,6 +482,49 @@ impl MechanismBuilder {
     /// time `t` (see [`LoadField`]).
     pub fn load_field(&mut self, f: impl Fn(f64, &mut [f64]) + Send + Sync + 'static) {
         self.mech.load_fields.push(LoadField::new(f));
+    }
+
+    /// A dead force and a moment about fixed global axes per unit length on
+    /// every element of `beam`, scaled by `scale(t)`: the consistent nodal
+    /// loads `∫ q Nᵢ ds` — `qh/2` at each end of a 2-node element,
+    /// `qh/6, 2qh/3, qh/6` on a 3-node one — the weights gravity uses.
+    pub fn distributed_load(
+        &mut self,
+        beam: &Beam,
+        force: Vector3<f64>,
+        moment: Vector3<f64>,
+        scale: Schedule,
+    ) -> Result<(), BuildError> {
+        finite(
+            || "distributed load: force, moment".into(),
+            force.iter().chain(&moment),
+        )?;
+        let count = self.mech.mesh.elements.len();
+        if beam.elements.end > count {
+            return Err(BuildError::UnknownNode {
+                node: beam.nodes.last().map_or(0, |n| n.0),
+                count: self.mech.mesh.node_count(),
+            });
+        }
+        let mut shares: Vec<(usize, f64)> = Vec::new();
+        for e in &self.mech.mesh.elements[beam.elements.clone()] {
+            let length = e.length();
+            for (&node, w) in e.nodes().iter().zip(nodal_weights(e.nodes().len())) {
+                match shares.iter_mut().find(|(n, _)| *n == node) {
+                    Some((_, s)) => *s += w * length,
+                    None => shares.push((node, w * length)),
+                }
+            }
+        }
+        for (node, share) in shares {
+            self.mech.loads.push(NodalLoad {
+                node,
+                force: force * share,
+                moment: moment * share,
+                scale: scale.clone(),
+            });
+        }
+        Ok(())
     }
 
     /// Gravity acceleration `g` (acting on ρA), scaled by `scale(t)`.
@@ -531,6 +584,51 @@ impl MechanismBuilder {
             driven,
         });
         Ok(JointId(self.mech.joints.len() - 1))
+    }
+
+    /// A joint whose master is the ground: the slave's initial pose is the
+    /// joint frame, fixed in space (global axes). A node of no element is
+    /// added where relation (1) puts the master at the initial angle,
+    /// `x_M = x_S − r_R(ψ₀)` (`Λ_M = I`), with all six DOFs held; it is
+    /// returned with the joint. Every joint kind and every scheme apply,
+    /// and the ground node's support reaction is what the joint transmits to
+    /// the ground.
+    pub fn ground_joint(
+        &mut self,
+        name: String,
+        map: Arc<dyn JointMap>,
+        slave: NodeId,
+        angle: f64,
+    ) -> Result<(JointId, NodeId), BuildError> {
+        let s = self.check(slave)?;
+        finite(|| format!("joint `{name}`: angle"), &[angle])?;
+        let mut q0 = [0.0; MAX_RELEASED];
+        if map.has_angle() {
+            q0[0] = angle;
+        }
+        let (r_r, _) = map.released_placement(&ReleasedState::new(q0));
+        let master = self.mech.mesh.positions[s] - r_r;
+        if !master.iter().all(|c| c.is_finite()) {
+            return Err(BuildError::NonFiniteRelease {
+                joint: name,
+                expected: [master.x, master.y, master.z],
+            });
+        }
+        let ground = NodeId(self.mech.mesh.add_node(master));
+        self.mech.fixed.push([true; 6]);
+        let joint = self.joint(JointDef {
+            name,
+            map,
+            master: ground,
+            slave,
+            angle,
+        });
+        if joint.is_err() {
+            // Leave no ground node behind a refused joint.
+            self.mech.mesh.positions.pop();
+            self.mech.fixed.pop();
+        }
+        Ok((joint?, ground))
     }
 
     /// Drives the released angle of `joint` by `angle(t)` (statics: of the

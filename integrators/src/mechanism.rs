@@ -36,6 +36,16 @@ impl fmt::Debug for Schedule {
     }
 }
 
+/// The consistent nodal weights (fractions of the element length) of a
+/// uniform load on an element of `n` nodes, `∫ Nᵢ ds / h`: ½, ½ for two
+/// nodes; ⅙, ⅔, ⅙ for three.
+pub(crate) fn nodal_weights(n: usize) -> &'static [f64] {
+    match n {
+        2 => &[0.5, 0.5],
+        _ => &[1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
+    }
+}
+
 /// A dead nodal force and a fixed-axis (spatial) moment, scaled by `scale(t)`.
 #[derive(Debug, Clone)]
 pub struct NodalLoad {
@@ -209,11 +219,7 @@ impl Mechanism {
             let g = self.gravity * self.gravity_scale.at(t);
             for e in &self.mesh.elements {
                 let m = e.section().rho_a * e.length();
-                let weights: &[f64] = match e.nodes().len() {
-                    2 => &[0.5, 0.5],
-                    _ => &[1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
-                };
-                for (&n, w) in e.nodes().iter().zip(weights) {
+                for (&n, w) in e.nodes().iter().zip(nodal_weights(e.nodes().len())) {
                     for c in 0..3 {
                         out[6 * n + c] += m * w * g[c];
                     }

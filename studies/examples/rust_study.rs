@@ -87,6 +87,7 @@ fn cantilever(ei: f64, force: f64) -> Model {
             moment: [0.0; 3],
             time: None,
         }],
+        distributed_loads: Vec::new(),
         prescribed: Vec::new(),
         initial_velocities: Vec::new(),
         solver: SolverSpec {

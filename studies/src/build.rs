@@ -18,6 +18,10 @@ pub struct Built {
     pub beam_nodes: Vec<Vec<usize>>,
     /// Initial velocities (dynamic analyses).
     pub motion: Motion,
+    /// The ground node of every joint to the ground: `(joint index, node)`
+    /// (nodes of no element, after the beams' nodes; labelled
+    /// `ground.<joint name>`).
+    pub ground_nodes: Vec<(usize, usize)>,
 }
 
 impl Built {
@@ -94,7 +98,10 @@ fn refused(model: &Model, key: String, e: BuildError) -> ModelError {
                  move the beam, or set the joint's `angle`",
                 label(spec.map(|s| s.slave)),
                 p(at),
-                label(spec.map(|s| s.master)),
+                spec.map_or_else(String::new, |s| match s.master {
+                    Some(m) => model.node_label(m),
+                    None => "ground".into(),
+                }),
                 p(expected)
             )
         }
@@ -113,6 +120,7 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
     model.check()?;
     let mut b = MechanismBuilder::new();
     let mut beam_nodes: Vec<Vec<NodeId>> = Vec::with_capacity(model.beams.len());
+    let mut beams = Vec::with_capacity(model.beams.len());
     for (i, beam) in model.beams.iter().enumerate() {
         if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
             if integrator == IntegratorKind::EnergyMomentumPaper && beam.nodes_per_element != 2 {
@@ -137,6 +145,7 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
             })
             .map_err(|e| refused(model, format!("beam[{i}]"), e))?;
         beam_nodes.push(nodes.nodes().to_vec());
+        beams.push(nodes);
     }
     let node = |r: NodeRef| beam_nodes[r.beam][r.node];
     for (i, s) in model.supports.iter().enumerate() {
@@ -156,29 +165,52 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         )
         .map_err(|e| refused(model, format!("load[{i}]"), e))?;
     }
+    for (i, l) in model.distributed_loads.iter().enumerate() {
+        b.distributed_load(
+            &beams[l.beam],
+            v(l.force),
+            v(l.moment),
+            schedule(&l.time, &model.solver.analysis),
+        )
+        .map_err(|e| refused(model, format!("distributed_load[{i}]"), e))?;
+    }
     b.gravity(v(model.gravity), schedule(&None, &model.solver.analysis))
         .map_err(|e| refused(model, "gravity".into(), e))?;
     let mut joints = Vec::with_capacity(model.joints.len());
+    let mut ground_nodes = Vec::new();
     for (j, spec) in model.joints.iter().enumerate() {
-        let id = b
-            .joint(JointDef {
+        let angle = if spec.kind.has_angle() {
+            spec.angle
+        } else {
+            0.0
+        };
+        let placed = match spec.master {
+            Some(master) => b.joint(JointDef {
                 name: spec.name.clone(),
                 map: spec.kind.map().clone(),
-                master: node(spec.master),
+                master: node(master),
                 slave: node(spec.slave),
-                angle: if spec.kind.has_angle() {
-                    spec.angle
-                } else {
-                    0.0
-                },
-            })
-            .map_err(|e| {
-                let key = match e {
-                    BuildError::SlaveOff { .. } => format!("joint[{j}].slave"),
-                    _ => format!("joint[{j}]"),
-                };
-                refused(model, key, e)
-            })?;
+                angle,
+            }),
+            None => b
+                .ground_joint(
+                    spec.name.clone(),
+                    spec.kind.map().clone(),
+                    node(spec.slave),
+                    angle,
+                )
+                .map(|(id, ground)| {
+                    ground_nodes.push((j, ground.index()));
+                    id
+                }),
+        };
+        let id = placed.map_err(|e| {
+            let key = match e {
+                BuildError::SlaveOff { .. } => format!("joint[{j}].slave"),
+                _ => format!("joint[{j}]"),
+            };
+            refused(model, key, e)
+        })?;
         joints.push(id);
     }
     for (i, p) in model.prescribed.iter().enumerate() {
@@ -209,6 +241,7 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         mechanism,
         beam_nodes,
         motion: Motion::rest(0),
+        ground_nodes,
     };
     built.motion = initial_motion(model, &built);
     crate::initial_check::check(model, &built.mechanism, &built.beam_nodes, &built.motion)?;

@@ -467,6 +467,9 @@ fn mesh_meta(model: &Model, built: &Built) -> MeshMeta {
             node_labels[n] = model.node_label(crate::model::NodeRef { beam: b, node: k });
         }
     }
+    for &(j, n) in &built.ground_nodes {
+        node_labels[n] = format!("ground.{}", model.joints[j].name);
+    }
     MeshMeta {
         node_labels,
         elements: mesh.elements.iter().map(|e| e.nodes().to_vec()).collect(),

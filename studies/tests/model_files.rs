@@ -296,7 +296,7 @@ fn full_file_parses_with_the_right_values() {
     // Joints: labels resolved, axis normalised.
     let screw = &m.joints[0];
     assert_eq!(screw.name, "screw");
-    assert_eq!(screw.master, NodeRef { beam: 0, node: 4 });
+    assert_eq!(screw.master, Some(NodeRef { beam: 0, node: 4 }));
     assert_eq!(screw.slave, NodeRef { beam: 1, node: 0 });
     match screw.kind.downcast_ref::<Screw>() {
         Some(s) => {
@@ -316,7 +316,7 @@ fn full_file_parses_with_the_right_values() {
         "{:?}",
         weld.kind
     );
-    assert_eq!(weld.master, NodeRef { beam: 1, node: 6 });
+    assert_eq!(weld.master, Some(NodeRef { beam: 1, node: 6 }));
     assert_eq!(weld.slave, NodeRef { beam: 2, node: 8 });
     assert_eq!((weld.angle, weld.rate), (0.0, 0.0));
 
@@ -513,7 +513,7 @@ axis = [0.0, 0.0, 1.0]
 "#,
     );
     let m = parse(&text).unwrap();
-    assert_eq!(m.joints[1].master, m.joints[0].slave);
+    assert_eq!(m.joints[1].master, Some(m.joints[0].slave));
 }
 
 #[test]

@@ -142,7 +142,10 @@ fn models_built_in_rust_are_checked_before_meshing() {
         ),
         (|m| m.loads[0].node.node = 99, "load[0].node"),
         (|m| m.loads[0].force[2] = f64::INFINITY, "load[0].force"),
-        (|m| m.joints[0].slave = m.joints[0].master, "joint[0].slave"),
+        (
+            |m| m.joints[0].slave = m.joints[0].master.unwrap(),
+            "joint[0].slave",
+        ),
         (
             |m| {
                 m.prescribed = vec![PrescribedSpec::JointAngle {

@@ -141,11 +141,31 @@ impl Checker<'_> {
                 self.time(&k("time"), f)?;
             }
         }
+        for (i, l) in m.distributed_loads.iter().enumerate() {
+            let k = |name: &str| format!("distributed_load[{i}].{name}");
+            if l.beam >= m.beams.len() {
+                return Err(self.fail(
+                    k("beam"),
+                    format!(
+                        "names beam {} but the model has {} beam(s)",
+                        l.beam,
+                        m.beams.len()
+                    ),
+                ));
+            }
+            self.finite(&k("force"), &l.force)?;
+            self.finite(&k("moment"), &l.moment)?;
+            if let Some(f) = &l.time {
+                self.time(&k("time"), f)?;
+            }
+        }
         for (j, joint) in m.joints.iter().enumerate() {
             let k = |name: &str| format!("joint[{j}].{name}");
-            self.node(&k("master"), joint.master)?;
+            if let Some(master) = joint.master {
+                self.node(&k("master"), master)?;
+            }
             self.node(&k("slave"), joint.slave)?;
-            if joint.master == joint.slave {
+            if joint.master == Some(joint.slave) {
                 return Err(self.fail(k("slave"), "the slave is the master node"));
             }
             self.finite(&k("angle"), &[joint.angle])?;

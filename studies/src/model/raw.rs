@@ -55,6 +55,8 @@ pub(crate) struct RawModel {
     #[serde(default)]
     pub load: Vec<S<RawLoad>>,
     #[serde(default)]
+    pub distributed_load: Vec<S<RawDistributedLoad>>,
+    #[serde(default)]
     pub prescribed: Vec<S<RawPrescribed>>,
     #[serde(default)]
     pub initial_velocity: Vec<S<RawInitialVelocity>>,
@@ -63,12 +65,13 @@ pub(crate) struct RawModel {
 }
 
 /// The keys of [`RawModel`] that are arrays of tables (`[[name]]`).
-pub(crate) const ARRAY_TABLES: [&str; 7] = [
+pub(crate) const ARRAY_TABLES: [&str; 8] = [
     "section",
     "beam",
     "support",
     "joint",
     "load",
+    "distributed_load",
     "prescribed",
     "initial_velocity",
 ];
@@ -144,6 +147,17 @@ pub(crate) struct RawLoad {
     pub node: Option<S<String>>,
     pub force: Option<S<Vec3>>,
     pub moment: Option<S<Vec3>>,
+    pub time: Option<S<RawTimeFn>>,
+}
+
+/// `[[distributed_load]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawDistributedLoad {
+    pub beam: Option<S<String>>,
+    pub force: Option<S<Vec3>>,
+    pub moment: Option<S<Vec3>>,
+    pub follower: Option<S<bool>>,
     pub time: Option<S<RawTimeFn>>,
 }
 

@@ -85,8 +85,10 @@ pub struct JointSpec {
     pub name: String,
     /// The registered kind and its parameters ([`super::JointRegistry`]).
     pub kind: super::JointKind,
-    /// The master node (carries the joint frame).
-    pub master: NodeRef,
+    /// The master node (carries the joint frame); `None` for
+    /// `master = "ground"`: the joint frame is fixed in space, at the
+    /// slave's initial pose.
+    pub master: Option<NodeRef>,
     /// The slave node (its DOFs are eliminated).
     pub slave: NodeRef,
     /// Initial released angle ψ₀ (default 0).
@@ -105,6 +107,21 @@ pub struct LoadSpec {
     /// Moment about fixed global axes.
     pub moment: [f64; 3],
     /// `None` when the file gives no `time` table.
+    pub time: Option<TimeFunction>,
+}
+
+/// A `[[distributed_load]]`: a dead force and a fixed-axis moment per unit
+/// length on a whole beam, applied as consistent nodal loads (`∫ q Nᵢ ds`
+/// over each element).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DistributedLoadSpec {
+    /// Index of the loaded beam in [`Model::beams`].
+    pub beam: usize,
+    /// Force per unit length, global components.
+    pub force: [f64; 3],
+    /// Moment per unit length about fixed global axes.
+    pub moment: [f64; 3],
+    /// `None` when the file gives no `time` table (as for `[[load]]`).
     pub time: Option<TimeFunction>,
 }
 
@@ -218,6 +235,8 @@ pub struct Model {
     pub joints: Vec<JointSpec>,
     /// `[[load]]` entries.
     pub loads: Vec<LoadSpec>,
+    /// `[[distributed_load]]` entries.
+    pub distributed_loads: Vec<DistributedLoadSpec>,
     /// `[[prescribed]]` entries.
     pub prescribed: Vec<PrescribedSpec>,
     /// `[[initial_velocity]]` entries, in file order.

@@ -247,6 +247,20 @@ impl ResultReader {
             .map_err(self.hdf5(format!("listing {group}")))
     }
 
+    /// Every node's label in `/configuration` order (`/mesh/node_labels`:
+    /// `<beam>.<k>`, `<beam>.start`, `<beam>.end`, and `ground.<joint>` for
+    /// the ground node of a joint to the ground).
+    pub fn mesh_node_labels(&self) -> Result<Vec<String>, ReadError> {
+        let name = layout::MESH_NODE_LABELS;
+        Ok(self
+            .dataset(name)?
+            .read_raw::<VarLenUnicode>()
+            .map_err(self.hdf5(format!("reading {name}")))?
+            .into_iter()
+            .map(|s| s.as_str().to_owned())
+            .collect())
+    }
+
     /// The labels of the tracked nodes (the groups of `/nodes`).
     pub fn node_labels(&self) -> Result<Vec<String>, ReadError> {
         self.members(layout::NODES)

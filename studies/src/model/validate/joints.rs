@@ -17,6 +17,9 @@ use crate::model::types::*;
 /// kind's parameters.
 const COMMON_KEYS: [&str; 6] = ["name", "type", "master", "slave", "angle", "rate"];
 
+/// The `master` of a joint to the ground.
+pub(crate) const GROUND: &str = "ground";
+
 impl Ctx<'_> {
     pub(super) fn joints(&self, raw: &[S<RawJoint>], beams: &[BeamSpec]) -> Res<Vec<JointSpec>> {
         // The joint tables as plain TOML values: the kinds' parameters.
@@ -105,7 +108,7 @@ impl Ctx<'_> {
                 &j.master,
                 &k("master"),
                 &hs,
-                "the master node's label, e.g. master = \"post.end\"",
+                "the master node's label, e.g. master = \"post.end\", or master = \"ground\"",
             )?;
             let slave_s = self.need(
                 &j.slave,
@@ -113,9 +116,21 @@ impl Ctx<'_> {
                 &hs,
                 "the slave node's label, e.g. slave = \"arm.start\"",
             )?;
-            let master = self.node(master_s, &k("master"), beams)?;
+            let master = if master_s.get_ref() == GROUND {
+                None
+            } else {
+                Some(self.node(master_s, &k("master"), beams)?)
+            };
+            if slave_s.get_ref() == GROUND {
+                return Err(self.at(
+                    k("slave"),
+                    slave_s,
+                    "the ground cannot be a slave (its DOFs are not unknowns); make it the \
+                     master, master = \"ground\", and the node the slave",
+                ));
+            }
             let slave = self.node(slave_s, &k("slave"), beams)?;
-            if master == slave {
+            if master == Some(slave) {
                 return Err(self.at(
                     k("slave"),
                     slave_s,
@@ -261,7 +276,7 @@ impl Ctx<'_> {
         for start in 0..joints.len() {
             let mut chain = vec![start];
             let mut node = joints[start].master;
-            while let Some(&next) = slave_of.get(&node) {
+            while let Some(&next) = node.as_ref().and_then(|n| slave_of.get(n)) {
                 if next == start {
                     let mut names: Vec<String> = chain
                         .iter()

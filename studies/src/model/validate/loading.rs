@@ -3,7 +3,8 @@
 use super::{quoted_list, Ctx, Res, DOFS, DOF_LIST};
 use crate::model::labels::resolve_label;
 use crate::model::raw::{
-    v3, RawInitialVelocity, RawLoad, RawPrescribed, RawSupport, StrOrList, Vec3, S,
+    v3, RawDistributedLoad, RawInitialVelocity, RawLoad, RawPrescribed, RawSupport, StrOrList,
+    Vec3, S,
 };
 use crate::model::types::*;
 
@@ -108,6 +109,66 @@ impl Ctx<'_> {
             };
             out.push(LoadSpec {
                 node,
+                force: l.force.as_ref().map_or([0.0; 3], |f| v3(f.get_ref())),
+                moment: l.moment.as_ref().map_or([0.0; 3], |m| v3(m.get_ref())),
+                time,
+            });
+        }
+        Ok(out)
+    }
+
+    pub(super) fn distributed_loads(
+        &self,
+        raw: &[S<RawDistributedLoad>],
+        beams: &[BeamSpec],
+    ) -> Res<Vec<DistributedLoadSpec>> {
+        let mut out = Vec::new();
+        for (i, entry) in raw.iter().enumerate() {
+            let tk = format!("distributed_load[{i}]");
+            let k = |f: &str| format!("{tk}.{f}");
+            let hs = entry.span();
+            let l = entry.get_ref();
+            let beam_s = self.need(
+                &l.beam,
+                &k("beam"),
+                &hs,
+                "the loaded beam's name, e.g. beam = \"arm\"",
+            )?;
+            let Some(beam) = beams.iter().position(|b| &b.name == beam_s.get_ref()) else {
+                let names: Vec<String> = beams.iter().map(|b| format!("\"{}\"", b.name)).collect();
+                return Err(self.at(
+                    k("beam"),
+                    beam_s,
+                    format!(
+                        "no beam named \"{}\"; the beams are {}",
+                        beam_s.get_ref(),
+                        names.join(", ")
+                    ),
+                ));
+            };
+            if l.force.is_none() && l.moment.is_none() {
+                return Err(self.err(
+                    tk.clone(),
+                    Some(hs.clone()),
+                    "a distributed load needs `force` and/or `moment` per unit length, e.g. \
+                     force = [0.0, 0.0, -1.0]",
+                ));
+            }
+            if let Some(f) = l.follower.as_ref().filter(|f| *f.get_ref()) {
+                return Err(self.at(
+                    k("follower"),
+                    f,
+                    "follower distributed loads (turning with the beam) are not available \
+                     yet; write follower = false (dead load, fixed global direction) or \
+                     leave the key out",
+                ));
+            }
+            let time = match &l.time {
+                Some(t) => Some(self.time_fn(t, &k("time"))?),
+                None => None,
+            };
+            out.push(DistributedLoadSpec {
+                beam,
                 force: l.force.as_ref().map_or([0.0; 3], |f| v3(f.get_ref())),
                 moment: l.moment.as_ref().map_or([0.0; 3], |m| v3(m.get_ref())),
                 time,

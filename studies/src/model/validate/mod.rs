@@ -316,6 +316,7 @@ pub(crate) fn validate(
     let joints = cx.joints(&raw.joint, &beams)?;
     cx.topology(&raw.support, &supports, &raw.joint, &joints)?;
     let loads = cx.loads(&raw.load, &beams)?;
+    let distributed_loads = cx.distributed_loads(&raw.distributed_load, &beams)?;
     let prescribed = cx.prescribed(&raw.prescribed, &beams, &joints, &supports)?;
     let initial_velocities = cx.initial_velocities(&raw.initial_velocity, &beams)?;
     let solver = cx.solver(raw.solver.as_ref())?;
@@ -331,6 +332,7 @@ pub(crate) fn validate(
         supports,
         joints,
         loads,
+        distributed_loads,
         prescribed,
         initial_velocities,
         solver,
