@@ -84,6 +84,42 @@ impl Element {
         s.c_n.max() * (1.0 + radius / l) + s.c_m.max() / l
     }
 
+    /// The material stress resultants `(N, M) = (C_N Γ, C_M K)` (FORMULATION
+    /// §2) at the element's Gauss points in a global configuration (`x`,
+    /// `rot`: every node's position and rotation from the initial
+    /// configuration), each with the point's place along the element as a
+    /// fraction of its length: one point (the middle) for 2-node elements,
+    /// two (`½ ∓ ½/√3`) for 3-node ones.
+    pub fn stress_resultants(
+        &self,
+        x: &[Vector3<f64>],
+        rot: &[Matrix3<f64>],
+    ) -> Vec<(f64, Vector3<f64>, Vector3<f64>)> {
+        let stresses: Vec<_> = match self {
+            Element::Linear(e) => {
+                let (xe, re) = gather(&e.nodes, x, rot);
+                e.stresses(&xe, &re).into_iter().take(1).collect()
+            }
+            Element::Quadratic(e) => {
+                let (xe, re) = gather(&e.nodes, x, rot);
+                e.stresses(&xe, &re).to_vec()
+            }
+        };
+        self.gauss_places()
+            .into_iter()
+            .zip(stresses)
+            .map(|(u, (n, m))| (u, n, m))
+            .collect()
+    }
+
+    /// The element's Gauss points as fractions of its length (`½(1 + ξ)`).
+    pub fn gauss_places(&self) -> Vec<f64> {
+        crate::shape::reduced_gauss(self.nodes().len())
+            .iter()
+            .map(|&(xi, _)| 0.5 * (1.0 + xi))
+            .collect()
+    }
+
     /// Strain energy in a global configuration.
     pub fn energy(&self, x: &[Vector3<f64>], rot: &[Matrix3<f64>]) -> f64 {
         match self {

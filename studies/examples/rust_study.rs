@@ -101,6 +101,7 @@ fn cantilever(ei: f64, force: f64) -> Model {
         output: OutputSpec {
             every: 1,
             track: vec![("beam.end".into(), tip)],
+            resultants: false,
         },
     }
 }

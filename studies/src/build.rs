@@ -16,6 +16,8 @@ pub struct Built {
     pub mechanism: Mechanism,
     /// Global node numbers of every beam's nodes (`beam_nodes[b][k]`).
     pub beam_nodes: Vec<Vec<usize>>,
+    /// Every beam's elements' range in the mesh.
+    pub beam_elements: Vec<std::ops::Range<usize>>,
     /// Initial velocities (dynamic analyses).
     pub motion: Motion,
     /// The ground node of every joint to the ground: `(joint index, node)`
@@ -237,9 +239,11 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         .into_iter()
         .map(|nodes| nodes.into_iter().map(NodeId::index).collect())
         .collect();
+    let beam_elements = beams.iter().map(|b| b.elements()).collect();
     let mut built = Built {
         mechanism,
         beam_nodes,
+        beam_elements,
         motion: Motion::rest(0),
         ground_nodes,
     };

@@ -6,7 +6,8 @@ use crate::build::{build, Built};
 use crate::checks::{Balance, Stability};
 use crate::model::{Analysis, Model, ModelError};
 use crate::results::{
-    layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultWriter, RunMeta,
+    layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultWriter,
+    ResultantsMeta, RunMeta,
 };
 use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
 use flexmech_integrators::{
@@ -309,6 +310,15 @@ fn run(
         command_line: command_line(),
         supports,
         mesh: Some(mesh),
+        resultants: model.output.resultants.then(|| ResultantsMeta {
+            mesh: mech.mesh.clone(),
+            beams: model
+                .beams
+                .iter()
+                .zip(&built.beam_elements)
+                .map(|(b, e)| (b.name.clone(), e.clone()))
+                .collect(),
+        }),
     };
     let mut writer = ResultWriter::create(&file, &meta)?;
     if let Some((c, from)) = restart_from {

@@ -204,6 +204,7 @@ pub(crate) struct RawSolver {
 pub(crate) struct RawOutput {
     pub every: Option<S<i64>>,
     pub track: Option<S<Vec<S<String>>>>,
+    pub resultants: Option<S<bool>>,
 }
 
 /// A string or a list of strings (`fixed`, `nodes`).

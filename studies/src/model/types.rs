@@ -212,6 +212,9 @@ pub struct OutputSpec {
     pub every: usize,
     /// Tracked nodes: the label as written in the file and the node it names.
     pub track: Vec<(String, NodeRef)>,
+    /// `resultants = true`: write the stress resultants at every Gauss
+    /// point (`/resultants`).
+    pub resultants: bool,
 }
 
 /// A validated model file.

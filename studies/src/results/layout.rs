@@ -27,6 +27,14 @@ pub const ATTR_MAX_DISPLACEMENT: &str = "max_displacement";
 pub const ATTR_NEWTON_ITERATIONS: &str = "newton_iterations";
 /// Root attribute: converged steps ([`super::merit`]).
 pub const ATTR_STEPS: &str = "steps";
+/// Group of the stress resultants (`[output] resultants = true`).
+pub const RESULTANTS: &str = "/resultants";
+/// T × G × 3: `N` at every Gauss point.
+pub const RESULTANTS_FORCE: &str = "/resultants/force";
+/// T × G × 3: `M` at every Gauss point.
+pub const RESULTANTS_MOMENT: &str = "/resultants/moment";
+/// G: each Gauss point's arc length from its beam's start.
+pub const RESULTANTS_ARC_LENGTH: &str = "/resultants/arc_length";
 /// Root attribute: warnings about a completed result (absent when none).
 pub const ATTR_WARNINGS: &str = "warnings";
 /// Root attribute: the git revision flexmech was built from (`+modified`

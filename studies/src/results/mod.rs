@@ -87,10 +87,12 @@ pub mod merit;
 mod mesh;
 pub mod reader;
 pub mod restart;
+pub mod resultants;
 mod writer;
 
 pub use merit::Merit;
 pub use mesh::MeshMeta;
 pub use reader::{EnergyDrift, ReadError, ResultReader};
 pub use restart::{read_checkpoint, RestartError};
+pub use resultants::ResultantsMeta;
 pub use writer::{rotation_vector, ResultError, ResultWriter, RunMeta};

@@ -52,6 +52,9 @@ pub struct RunMeta {
     pub supports: Vec<String>,
     /// The mesh: `/mesh` (omitted when `None`).
     pub mesh: Option<super::mesh::MeshMeta>,
+    /// The stress resultants to write under `/resultants` (omitted when
+    /// `None`; see [`super::resultants`]).
+    pub resultants: Option<super::resultants::ResultantsMeta>,
 }
 
 /// Everything that can go wrong while writing a result file.
@@ -371,6 +374,8 @@ struct Datasets {
     config_quaternion: Series,
     /// Dynamics only: translational and angular velocities of every node.
     config_velocity: Option<[Series; 2]>,
+    /// `[output] resultants = true`: force and moment at every Gauss point.
+    resultants: Option<[Series; 2]>,
 }
 
 impl Datasets {
@@ -394,6 +399,7 @@ impl Datasets {
         ]
         .into_iter()
         .chain(self.config_velocity.iter().flatten())
+        .chain(self.resultants.iter().flatten())
         .chain(self.negative_pivots.iter())
         .chain(
             self.nodes
@@ -430,6 +436,7 @@ pub struct ResultWriter {
     lock: Option<(std::fs::File, PathBuf)>,
     sets: Datasets,
     initial_positions: Vec<[f64; 3]>,
+    resultants: Option<super::resultants::ResultantsMeta>,
     steps: usize,
     newton_len: usize,
     /// An append failed part-way: some datasets may hold an extra row.
@@ -771,6 +778,49 @@ impl ResultWriter {
             ])
         };
 
+        let resultants = match &meta.resultants {
+            None => None,
+            Some(r) => {
+                let (arc, offsets) = r.points();
+                let group = names::RESULTANTS;
+                file.create_group(group)
+                    .ctx(path, || format!("creating group {group}"))?;
+                let points = arc.len();
+                let rows =
+                    (CONFIG_CHUNK_BYTES / (points.max(1) * 3 * 8)).clamp(1, CONFIG_CHUNK_ROWS);
+                let chunk = [rows, points.clamp(1, CONFIG_CHUNK_NODES), 3];
+                let force = Series::create::<f64>(
+                    &file,
+                    path,
+                    names::RESULTANTS_FORCE,
+                    0,
+                    &[points, 3],
+                    &chunk,
+                    "material stress resultant N = C_N Gamma (axial, shear 2, shear 3) at every \
+                     Gauss point, element order (T x G x 3)",
+                )?;
+                let moment = Series::create::<f64>(
+                    &file,
+                    path,
+                    names::RESULTANTS_MOMENT,
+                    0,
+                    &[points, 3],
+                    &chunk,
+                    "material stress resultant M = C_M K (torsion, bending 2, bending 3) at every \
+                     Gauss point, element order (T x G x 3)",
+                )?;
+                super::resultants::write_ranges(&force.ds, r, &offsets).ctx(path, || {
+                    "writing the beams' ranges of /resultants".to_owned()
+                })?;
+                file.new_dataset::<f64>()
+                    .shape([points])
+                    .create(names::RESULTANTS_ARC_LENGTH)
+                    .and_then(|ds| ds.write_raw(&arc))
+                    .ctx(path, || format!("writing {}", names::RESULTANTS_ARC_LENGTH))?;
+                Some([force, moment])
+            }
+        };
+
         let sets = Datasets {
             time,
             kinetic,
@@ -794,6 +844,7 @@ impl ResultWriter {
             config_position,
             config_quaternion,
             config_velocity,
+            resultants,
         };
         file.flush().ctx(path, || "flushing the file".to_owned())?;
         Ok(Self {
@@ -802,6 +853,7 @@ impl ResultWriter {
             lock,
             sets,
             initial_positions: meta.initial_positions.clone(),
+            resultants: meta.resultants.clone(),
             steps: 0,
             newton_len: 0,
             inconsistent: false,
@@ -933,6 +985,11 @@ impl ResultWriter {
         if let Some([v, w]) = &s.config_velocity {
             v.push_block(t, &step.velocities, path)?;
             w.push_block(t, &step.angular_velocities, path)?;
+        }
+        if let (Some([n, m]), Some(meta)) = (&s.resultants, &self.resultants) {
+            let (force, moment) = meta.of(step);
+            n.push_block(t, &force, path)?;
+            m.push_block(t, &moment, path)?;
         }
 
         self.file

@@ -206,6 +206,7 @@ impl Ctx<'_> {
             return Ok(OutputSpec {
                 every: 1,
                 track: Vec::new(),
+                resultants: false,
             });
         };
         let o = entry.get_ref();
@@ -224,6 +225,10 @@ impl Ctx<'_> {
                 track.push((label.clone(), self.node(item, &key, beams)?));
             }
         }
-        Ok(OutputSpec { every, track })
+        Ok(OutputSpec {
+            every,
+            track,
+            resultants: o.resultants.as_ref().is_some_and(|r| *r.get_ref()),
+        })
     }
 }
