@@ -88,3 +88,25 @@ fn resultants_are_written_only_when_asked() {
         .unwrap()
         .has(layout::RESULTANTS));
 }
+
+/// `flexmech plot` draws a resultant over the Gauss points' arc length.
+#[test]
+fn resultants_are_charted_over_the_arc_length() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = run(3, dir.path());
+    let charts = flexmech_studies::charts::plot_datasets(
+        r.path(),
+        &["/resultants/moment".to_owned()],
+        &dir.path().join("plots"),
+        false,
+    )
+    .unwrap();
+    assert_eq!(charts.len(), 2);
+    assert!(std::fs::metadata(&charts[0]).unwrap().len() > 10_000);
+    let svg = std::fs::read_to_string(&charts[1]).unwrap();
+    assert!(
+        svg.contains("M2 bending") && svg.contains("arc length"),
+        "{}",
+        &svg[..200]
+    );
+}

@@ -1,4 +1,6 @@
 //! `flexmech plot`: one line chart per result-file dataset, over `/time`.
+//! `/resultants/force` and `/resultants/moment` are drawn instead over the
+//! Gauss points' arc length at the last stored step (three curves per beam).
 //!
 //! A dataset of shape T (one value per stored step) gives one curve, a T×3
 //! dataset three (its x, y and z components). The y axis is labelled with the
@@ -104,6 +106,14 @@ pub fn plot_datasets(
             shape: shape.clone(),
             steps,
         };
+        if let [n, _, 3] = shape.as_slice() {
+            if *n == steps && name.starts_with(layout::RESULTANTS) {
+                let chart = resultants_chart(&r, &name, &file_name, &time)?;
+                let stem = out_dir.join(name.trim_start_matches('/').replace('/', "_"));
+                charts.push((name, chart, stem));
+                continue;
+            }
+        }
         let values = match shape.as_slice() {
             [n] | [n, 3] if *n == steps => r.values(&name)?,
             _ => return Err(bad_shape()),
@@ -152,6 +162,61 @@ pub fn plot_datasets(
         written.push(svg);
     }
     Ok(written)
+}
+
+/// A `/resultants` dataset (T × G × 3) at the last stored step over each
+/// Gauss point's arc length, three curves per beam (the material
+/// components: axial and shear forces, or torsion and bending moments).
+fn resultants_chart(
+    r: &ResultReader,
+    name: &str,
+    file_name: &str,
+    time: &[f64],
+) -> Result<LineChart, PlotError> {
+    let values = r.values(name)?;
+    let arc = r.values(layout::RESULTANTS_ARC_LENGTH)?;
+    let points = arc.len();
+    let last = values.len() / (3 * points.max(1));
+    let row = &values[(last.saturating_sub(1)) * 3 * points..];
+    let (beams, offsets) = r.resultant_beams()?;
+    let consistent = offsets.len() == beams.len() + 1
+        && offsets.windows(2).all(|w| w[0] <= w[1])
+        && offsets.last().is_some_and(|&o| o as usize == points);
+    if !consistent {
+        return Err(PlotError::BadShape {
+            path: r.path().to_path_buf(),
+            dataset: format!("{name} (attributes beam_names, beam_offsets: {offsets:?})"),
+            shape: vec![last, points, 3],
+            steps: time.len(),
+        });
+    }
+    let labels: [&str; 3] = if name == layout::RESULTANTS_MOMENT {
+        ["M1 torsion", "M2 bending", "M3 bending"]
+    } else {
+        ["N1 axial", "N2 shear", "N3 shear"]
+    };
+    let mut series = Vec::new();
+    for (b, beam) in beams.iter().enumerate() {
+        let range = offsets[b] as usize..offsets[b + 1] as usize;
+        for (c, label) in labels.iter().enumerate() {
+            let label = if beams.len() > 1 {
+                format!("{beam}: {label}")
+            } else {
+                (*label).to_owned()
+            };
+            let y = range.clone().map(|g| row[3 * g + c]).collect();
+            series.push(Series::new(label, arc[range.clone()].to_vec(), y));
+        }
+    }
+    let t = time.last().copied().unwrap_or(f64::NAN);
+    Ok(LineChart {
+        title: format!("{file_name}: {name} at t = {t}"),
+        x_label: "arc length from the beam's start".to_owned(),
+        y_label: name.to_owned(),
+        log_y: false,
+        series,
+        markers: Vec::new(),
+    })
 }
 
 /// A marker at the last stored time of a run that did not complete.

@@ -261,6 +261,25 @@ impl ResultReader {
             .collect())
     }
 
+    /// The beams of `/resultants`: names and their Gauss points' offsets
+    /// (beams + 1), from the attributes of `/resultants/force`.
+    pub fn resultant_beams(&self) -> Result<(Vec<String>, Vec<u64>), ReadError> {
+        let name = layout::RESULTANTS_FORCE;
+        let ds = self.dataset(name)?;
+        let names: Vec<VarLenUnicode> = ds
+            .attr("beam_names")
+            .and_then(|a| a.read_raw())
+            .map_err(self.hdf5(format!("reading the attribute beam_names of {name}")))?;
+        let offsets: Vec<u64> = ds
+            .attr("beam_offsets")
+            .and_then(|a| a.read_raw())
+            .map_err(self.hdf5(format!("reading the attribute beam_offsets of {name}")))?;
+        Ok((
+            names.iter().map(|n| n.as_str().to_owned()).collect(),
+            offsets,
+        ))
+    }
+
     /// The labels of the tracked nodes (the groups of `/nodes`).
     pub fn node_labels(&self) -> Result<Vec<String>, ReadError> {
         self.members(layout::NODES)
