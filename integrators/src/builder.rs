@@ -336,6 +336,23 @@ pub enum BuildError {
     },
 }
 
+/// The released coordinates of a joint at t = 0: the angle `angle` for a
+/// kind whose first coordinate is an angle, every coordinate zero otherwise
+/// (where an angle other than zero is refused).
+fn initial_state(name: &str, map: &dyn JointMap, angle: f64) -> Result<ReleasedState, BuildError> {
+    finite(|| format!("joint `{name}`: angle"), &[angle])?;
+    let mut q0 = [0.0; MAX_RELEASED];
+    if map.has_angle() {
+        q0[0] = angle;
+    } else if angle != 0.0 {
+        return Err(BuildError::NoAngle {
+            joint: name.to_owned(),
+            what: "an initial angle was given",
+        });
+    }
+    Ok(ReleasedState::new(q0))
+}
+
 /// Builds a [`Mechanism`] step by step; see the module docs.
 #[derive(Debug, Clone)]
 pub struct MechanismBuilder {
@@ -544,17 +561,7 @@ impl MechanismBuilder {
         if master == slave {
             return Err(BuildError::SameNode { joint: def.name });
         }
-        finite(|| format!("joint `{}`: angle", def.name), &[def.angle])?;
-        let mut q0 = [0.0; MAX_RELEASED];
-        if def.map.has_angle() {
-            q0[0] = def.angle;
-        } else if def.angle != 0.0 {
-            return Err(BuildError::NoAngle {
-                joint: def.name,
-                what: "an initial angle was given",
-            });
-        }
-        let initial = ReleasedState::new(q0);
+        let initial = initial_state(&def.name, def.map.as_ref(), def.angle)?;
         let x0 = &self.mech.mesh.positions;
         let (expected, _) = def.map.slave(&x0[master], &Matrix3::identity(), &initial);
         let arr = |x: &Vector3<f64>| [x.x, x.y, x.z];
@@ -601,12 +608,7 @@ impl MechanismBuilder {
         angle: f64,
     ) -> Result<(JointId, NodeId), BuildError> {
         let s = self.check(slave)?;
-        finite(|| format!("joint `{name}`: angle"), &[angle])?;
-        let mut q0 = [0.0; MAX_RELEASED];
-        if map.has_angle() {
-            q0[0] = angle;
-        }
-        let (r_r, _) = map.released_placement(&ReleasedState::new(q0));
+        let (r_r, _) = map.released_placement(&initial_state(&name, map.as_ref(), angle)?);
         let master = self.mech.mesh.positions[s] - r_r;
         if !master.iter().all(|c| c.is_finite()) {
             return Err(BuildError::NonFiniteRelease {

@@ -742,12 +742,15 @@ impl ResultWriter {
             ]);
         }
 
-        let config = |name: &str, width: usize, description: &str| {
-            let node_chunk = n_nodes.clamp(1, CONFIG_CHUNK_NODES);
-            let rows = (CONFIG_CHUNK_BYTES / (node_chunk * width * 8)).clamp(1, CONFIG_CHUNK_ROWS);
-            let chunk = [rows, node_chunk, width];
-            Series::create::<f64>(&file, path, name, 0, &[n_nodes, width], &chunk, description)
+        // T x count x width, chunked by rows of at most CONFIG_CHUNK_BYTES.
+        let block = |name: &str, count: usize, width: usize, description: &str| {
+            let count_chunk = count.clamp(1, CONFIG_CHUNK_NODES);
+            let rows = (CONFIG_CHUNK_BYTES / (count_chunk * width * 8)).clamp(1, CONFIG_CHUNK_ROWS);
+            let chunk = [rows, count_chunk, width];
+            Series::create::<f64>(&file, path, name, 0, &[count, width], &chunk, description)
         };
+        let config =
+            |name: &str, width: usize, description: &str| block(name, n_nodes, width, description);
         let config_position = config(
             names::CONFIGURATION_POSITION,
             3,
@@ -786,26 +789,17 @@ impl ResultWriter {
                 file.create_group(group)
                     .ctx(path, || format!("creating group {group}"))?;
                 let points = arc.len();
-                let rows =
-                    (CONFIG_CHUNK_BYTES / (points.max(1) * 3 * 8)).clamp(1, CONFIG_CHUNK_ROWS);
-                let chunk = [rows, points.clamp(1, CONFIG_CHUNK_NODES), 3];
-                let force = Series::create::<f64>(
-                    &file,
-                    path,
+                let force = block(
                     names::RESULTANTS_FORCE,
-                    0,
-                    &[points, 3],
-                    &chunk,
+                    points,
+                    3,
                     "material stress resultant N = C_N Gamma (axial, shear 2, shear 3) at every \
                      Gauss point, element order (T x G x 3)",
                 )?;
-                let moment = Series::create::<f64>(
-                    &file,
-                    path,
+                let moment = block(
                     names::RESULTANTS_MOMENT,
-                    0,
-                    &[points, 3],
-                    &chunk,
+                    points,
+                    3,
                     "material stress resultant M = C_M K (torsion, bending 2, bending 3) at every \
                      Gauss point, element order (T x G x 3)",
                 )?;
