@@ -328,6 +328,7 @@ fn load_fields_enter_every_scheme_like_nodal_loads() {
     let force = |t: f64| 5.0 * (40.0 * t).sin();
     for integrator in [
         Integrator::Newmark,
+        Integrator::GeneralizedAlpha { rho_inf: 0.8 },
         Integrator::Momentum,
         Integrator::EnergyMomentum,
         Integrator::EnergyMomentumPaper,

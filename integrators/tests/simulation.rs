@@ -10,8 +10,9 @@ use flexmech_integrators::dynamics::{DynamicSettings, Motion};
 use flexmech_integrators::{Mechanism, NewtonSettings, StepRecord};
 use nalgebra::Vector3;
 
-const ALL: [Integrator; 4] = [
+const ALL: [Integrator; 5] = [
     Integrator::Newmark,
+    Integrator::GeneralizedAlpha { rho_inf: 0.8 },
     Integrator::Momentum,
     Integrator::EnergyMomentum,
     Integrator::EnergyMomentumPaper,

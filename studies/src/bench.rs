@@ -25,7 +25,7 @@ pub struct Case {
 }
 
 /// The configurations `flexmech bench` times; the first is the reference.
-pub const CASES: [Case; 6] = [
+pub const CASES: [Case; 7] = [
     Case {
         label: "newmark",
         integrator: "newmark",
@@ -36,6 +36,12 @@ pub const CASES: [Case; 6] = [
         label: "newmark/modified",
         integrator: "newmark",
         newton: "modified",
+        nodes_per_element: 2,
+    },
+    Case {
+        label: "generalized-alpha",
+        integrator: "generalized-alpha",
+        newton: "full",
         nodes_per_element: 2,
     },
     Case {

@@ -4,7 +4,7 @@
 
 use crate::build::{build, Built};
 use crate::checks::{Balance, Stability};
-use crate::model::{Analysis, Model, ModelError};
+use crate::model::{Analysis, IntegratorKind, Model, ModelError};
 use crate::results::{
     layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultWriter,
     ResultantsMeta, RunMeta,
@@ -325,10 +325,17 @@ fn run(
         writer.restarted_from(from, c.time)?;
     }
     let dynamic = matches!(model.solver.analysis, Analysis::Dynamic { .. });
+    let dissipative = matches!(
+        model.solver.analysis,
+        Analysis::Dynamic {
+            integrator: IntegratorKind::GeneralizedAlpha { .. },
+            ..
+        }
+    );
     let mut sink = Sink {
         writer,
         mech,
-        balance: dynamic.then(Balance::default),
+        balance: dynamic.then(|| Balance::new(dissipative)),
         stability: (!dynamic).then(|| Stability::new(conservative(model))),
         merit: Merit::new(
             meta.tracked

@@ -8,8 +8,9 @@ use flexmech_studies::model::{parse_model, Model};
 use flexmech_studies::results::ResultReader;
 use flexmech_studies::run_model_to;
 
-const INTEGRATORS: [&str; 4] = [
+const INTEGRATORS: [&str; 5] = [
     "newmark",
+    "generalized-alpha",
     "momentum",
     "energy-momentum",
     "energy-momentum-paper",

@@ -711,6 +711,40 @@ fn dynamic_needs_an_integrator() {
 }
 
 #[test]
+fn generalized_alpha_takes_rho_inf_in_zero_one() {
+    use flexmech_studies::model::{Analysis, IntegratorKind};
+    let solver = |int: &str, extra: &str| {
+        with(&format!(
+            "[solver]\nanalysis = \"dynamic\"\nintegrator = \"{int}\"\ndt = 0.1\nt_end = 1.0\n{extra}"
+        ))
+    };
+    let rho =
+        |text: &str| match parse(&text.replace("EI = [1.0, 1.0]", "EI = [1.0, 1.0]\nrhoA = 1.0"))
+            .unwrap()
+            .solver
+            .analysis
+        {
+            Analysis::Dynamic {
+                integrator: IntegratorKind::GeneralizedAlpha { rho_inf },
+                ..
+            } => rho_inf,
+            other => panic!("{other:?}"),
+        };
+    assert_eq!(rho(&solver("generalized-alpha", "")), 0.9);
+    assert_eq!(rho(&solver("generalized-alpha", "rho_inf = 0.0\n")), 0.0);
+    assert_eq!(rho(&solver("generalized-alpha", "rho_inf = 1\n")), 1.0);
+    for bad in ["1.5", "-0.1"] {
+        let text = solver("generalized-alpha", &format!("rho_inf = {bad}\n"));
+        let e = expect_err(&text, "solver.rho_inf", &["[0, 1]", bad]);
+        assert_eq!(e.line(), Some(line_of(&text, "rho_inf")));
+    }
+    let text = solver("newmark", "rho_inf = 0.5\n");
+    expect_err(&text, "solver.rho_inf", &["generalized-alpha", "newmark"]);
+    let text = with("[solver]\nrho_inf = 0.5\n");
+    expect_err(&text, "solver.rho_inf", &["dynamic"]);
+}
+
+#[test]
 fn non_positive_ea() {
     let text = BASE.replace("EA = 1.0", "EA = 0.0");
     let e = expect_err(&text, "section[0].EA", &["must be > 0", "found 0.0"]);

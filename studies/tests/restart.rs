@@ -94,6 +94,7 @@ fn every_integrator_continues_a_driven_cam_bit_for_bit() {
     let base = text_of("paper/cam.toml");
     for integrator in [
         "newmark",
+        "generalized-alpha",
         "momentum",
         "energy-momentum",
         "energy-momentum-paper",
@@ -188,6 +189,16 @@ fn a_result_of_another_run_is_refused_naming_what_differs() {
         e.contains("energy-momentum") && e.contains("momentum"),
         "{e}"
     );
+    // Generalized-α with another ρ∞.
+    let alpha = |t: &str, rho: f64| {
+        replaced(
+            t,
+            "integrator = \"energy-momentum\"",
+            &format!("integrator = \"generalized-alpha\"\nrho_inf = {rho:?}"),
+        )
+    };
+    let e = restart_error(&alpha(&base, 0.9), &alpha(&later, 0.5));
+    assert!(e.contains("rho_inf = 0.9") && e.contains("0.5"), "{e}");
     // Another time step.
     let other = replaced(&later, "dt = 0.01", "dt = 0.02");
     let e = restart_error(&base, &other);

@@ -1,5 +1,8 @@
-//! Newmark's trapezoidal rule (β = ¼, γ = ½) on SO(3) as terms of the
-//! shared reduced system (see [`super::newmark`] for the scheme).
+//! The Newmark family on SO(3) as terms of the shared reduced system:
+//! the trapezoidal rule (β = ¼, γ = ½, see [`super::newmark`]) and its
+//! generalized-α extension (see [`super::generalized_alpha`]), which adds
+//! the pseudo-acceleration average of Arnold & Brüls (2007) and reduces to
+//! the trapezoidal rule bit for bit when `α_m = α_f = 0`.
 
 use super::checkpoint::{CheckpointMismatch, Tape};
 use super::mass_slots::{spin_derivative, MassSlots};
@@ -16,20 +19,100 @@ use flexmech_core::rotation::log;
 use flexmech_core::{Configuration, Inertia};
 use nalgebra::{Matrix3, Vector3};
 
-const BETA: f64 = 0.25;
-const GAMMA: f64 = 0.5;
+/// The coefficients of a Newmark-family scheme: Newmark's `β`, `γ` and the
+/// generalized-α weights `α_m`, `α_f` of the pseudo-acceleration `a`,
+/// `(1 − α_m) aₙ₊₁ + α_m aₙ = (1 − α_f) q̈ₙ₊₁ + α_f q̈ₙ` (Arnold & Brüls 2007,
+/// eq. 8; FORMULATION §4.5).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coefficients {
+    /// Newmark's `β`.
+    pub beta: f64,
+    /// Newmark's `γ`.
+    pub gamma: f64,
+    /// Weight of the previous pseudo-acceleration.
+    pub alpha_m: f64,
+    /// Weight of the previous acceleration.
+    pub alpha_f: f64,
+    /// The spectral radius at infinite frequency they were made from
+    /// (`None`: the trapezoidal rule).
+    pub rho_inf: Option<f64>,
+}
 
-/// Velocities and accelerations at the end of a step.
+impl Coefficients {
+    /// The trapezoidal rule: `β = ¼`, `γ = ½`, `α_m = α_f = 0`.
+    pub const TRAPEZOIDAL: Self = Self {
+        beta: 0.25,
+        gamma: 0.5,
+        alpha_m: 0.0,
+        alpha_f: 0.0,
+        rho_inf: None,
+    };
+
+    /// Chung & Hulbert's optimal choice for the spectral radius `ρ∞` at
+    /// infinite frequency (`0 ≤ ρ∞ ≤ 1`): `α_m = (2ρ∞ − 1)/(ρ∞ + 1)`,
+    /// `α_f = ρ∞/(ρ∞ + 1)`, `γ = ½ + α_f − α_m`, `β = ¼(γ + ½)²` —
+    /// second-order accurate, unconditionally stable for linear problems,
+    /// high frequencies damped to `ρ∞` per step.
+    pub fn generalized_alpha(rho_inf: f64) -> Self {
+        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+        let alpha_f = rho_inf / (rho_inf + 1.0);
+        let gamma = 0.5 + alpha_f - alpha_m;
+        Self {
+            beta: 0.25 * (gamma + 0.5).powi(2),
+            gamma,
+            alpha_m,
+            alpha_f,
+            rho_inf: Some(rho_inf),
+        }
+    }
+
+    /// The acceleration `q̈ₙ₊₁` from the pseudo-accelerations `aₙ₊₁`, `aₙ`
+    /// and the previous acceleration `q̈ₙ` (generic, for AD).
+    fn acceleration<T: flexmech_core::Scalar>(
+        &self,
+        a1: Vector3<T>,
+        a_n: &Vector3<f64>,
+        acc_n: &Vector3<f64>,
+    ) -> Vector3<T> {
+        let c = |x: f64| T::from_subset(&x);
+        let history = a_n * self.alpha_m - acc_n * self.alpha_f;
+        (a1 * c(1.0 - self.alpha_m) + history.map(c)) / c(1.0 - self.alpha_f)
+    }
+
+    /// The mass `m` times `∂q̈ₙ₊₁/∂uₙ₊₁ = (1 − α_m)/((1 − α_f) β Δt²)`.
+    fn stiffness(&self, m: f64, dt: f64) -> f64 {
+        m * (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * dt * dt)
+    }
+}
+
+/// Velocities, pseudo-accelerations (`a`, `alpha`) and accelerations (`acc`,
+/// `ang_acc`) at the end of a step; the trapezoidal rule keeps `a = acc`.
 #[derive(Debug, Clone)]
 struct Kinematics {
     v: Vec<Vector3<f64>>,
     a: Vec<Vector3<f64>>,
     w: Vec<Vector3<f64>>,
     alpha: Vec<Vector3<f64>>,
+    acc: Vec<Vector3<f64>>,
+    ang_acc: Vec<Vector3<f64>>,
 }
 
-/// Body angular acceleration at `n+1` for the end rotation `r1` (generic, for AD).
+/// Translational pseudo-acceleration at `n+1` for the displacement `u` of
+/// the step: `aₙ₊₁ = (u − Δt vₙ − Δt²(½ − β) aₙ)/(β Δt²)`.
+fn pseudo_acceleration(
+    k: &Coefficients,
+    u: Vector3<f64>,
+    v_n: &Vector3<f64>,
+    a_n: &Vector3<f64>,
+    dt: f64,
+) -> Vector3<f64> {
+    (u - v_n * dt - a_n * (dt * dt * (0.5 - k.beta))) / (k.beta * dt * dt)
+}
+
+/// Body angular pseudo-acceleration at `n+1` for the end rotation `r1`,
+/// with the body increment `Ω = Rₙᵀ log(Rₙ₊₁Rₙᵀ)` (generic, for AD).
 fn angular_acceleration<T: flexmech_core::Scalar>(
+    k: &Coefficients,
     r_n: &Matrix3<f64>,
     r1: &Matrix3<T>,
     w_n: &Vector3<f64>,
@@ -39,12 +122,14 @@ fn angular_acceleration<T: flexmech_core::Scalar>(
     let c = |x: f64| T::from_subset(&x);
     let omega = log(&(r1 * r_n.map(c).transpose()));
     let big_omega = r_n.map(c).transpose() * omega;
-    (big_omega - w_n.map(c) * c(dt) - a_n.map(c) * c(dt * dt * (0.5 - BETA))) / c(BETA * dt * dt)
+    (big_omega - w_n.map(c) * c(dt) - a_n.map(c) * c(dt * dt * (0.5 - k.beta)))
+        / c(k.beta * dt * dt)
 }
 
-/// Inertial moment `Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁)` of node `i` for the end
-/// rotation `r1` (generic, for AD).
+/// Inertial moment `Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁)` of node `i` for the end
+/// rotation `r1`, `Ȧ` the body angular acceleration (generic, for AD).
 fn inertial_moment<T: flexmech_core::Scalar>(
+    k: &Coefficients,
     j0: &Matrix3<f64>,
     r_n: &Matrix3<f64>,
     r1: &Matrix3<T>,
@@ -53,16 +138,18 @@ fn inertial_moment<T: flexmech_core::Scalar>(
     dt: f64,
 ) -> Vector3<T> {
     let c = |x: f64| T::from_subset(&x);
-    let a1 = angular_acceleration(r_n, r1, &prev.w[i], &prev.alpha[i], dt);
-    let w1 = (prev.w[i] + prev.alpha[i] * (dt * (1.0 - GAMMA))).map(c) + a1 * c(dt * GAMMA);
+    let a1 = angular_acceleration(k, r_n, r1, &prev.w[i], &prev.alpha[i], dt);
+    let w1 = (prev.w[i] + prev.alpha[i] * (dt * (1.0 - k.gamma))).map(c) + a1 * c(dt * k.gamma);
+    let acc1 = k.acceleration(a1, &prev.alpha[i], &prev.ang_acc[i]);
     let jd = j0.map(c);
-    *r1 * (jd * a1 + w1.cross(&(jd * w1)))
+    *r1 * (jd * acc1 + w1.cross(&(jd * w1)))
 }
 
-/// Newmark's terms of the reduced system: the beams' internal forces at
-/// `tₙ₊₁`, the inertial forces `M aₙ₊₁` and `Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁)`
-/// with their tangents, joints through `N`.
+/// The Newmark family's terms of the reduced system: the beams' internal
+/// forces at `tₙ₊₁`, the inertial forces `M q̈ₙ₊₁` and
+/// `Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁)` with their tangents, joints through `N`.
 pub(crate) struct NewmarkTerms {
+    coefficients: Coefficients,
     inertia: Inertia,
     slots: MassSlots,
     /// Velocities and accelerations at the start of the step.
@@ -76,6 +163,7 @@ impl NewmarkTerms {
     /// The terms at t = 0: slave velocities through `N`, accelerations from
     /// the equations of motion ([`initial_accelerations`]; `asm` and `lu`
     /// serve as scratch).
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn new(
         mech: &Mechanism,
         topo: &Topology,
@@ -84,6 +172,7 @@ impl NewmarkTerms {
         state: &MechanismState,
         inertia: Inertia,
         initial: &Motion,
+        coefficients: Coefficients,
     ) -> Self {
         let nodes = mech.mesh.node_count();
         let slots = MassSlots::new(asm, &topo.dofs, &inertia);
@@ -94,9 +183,17 @@ impl NewmarkTerms {
         let (v, w) = slave_velocities(mech, topo, state, initial);
         let (a, alpha) = initial_accelerations(mech, topo, &inertia, asm, lu, state, &residual);
         Self {
+            coefficients,
             inertia,
             slots,
-            prev: Kinematics { v, a, w, alpha },
+            prev: Kinematics {
+                v,
+                acc: a.clone(),
+                a,
+                w,
+                ang_acc: alpha.clone(),
+                alpha,
+            },
             dt: f64::NAN,
             reactions: None,
         }
@@ -116,28 +213,26 @@ impl StepTerms for NewmarkTerms {
         abs: &mut [f64],
         tangent: Option<(&mut Assembler, &DofMap)>,
     ) {
-        let (dt, prev) = (self.dt, &self.prev);
-        // Translational inertia M aₙ₊₁, aₙ₊₁ = (u − Δt vₙ − Δt²(½−β)aₙ)/(βΔt²);
-        // rotational Rₙ₊₁(J₀Aₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), its tangent by AD in a
-        // spin of Rₙ₊₁.
+        let (dt, prev, k) = (self.dt, &self.prev, &self.coefficients);
+        // Translational inertia M q̈ₙ₊₁ from the pseudo-acceleration
+        // aₙ₊₁ = (u − Δt vₙ − Δt²(½−β)aₙ)/(βΔt²); rotational
+        // Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), its tangent by AD in a spin of Rₙ₊₁.
         self.slots.add_inertia(
             &self.inertia,
             g,
             abs,
             tangent,
             |j, m| {
-                let u = end.x[j] - start.x[j];
-                let a1 =
-                    (u - prev.v[j] * dt - prev.a[j] * (dt * dt * (0.5 - BETA))) / (BETA * dt * dt);
-                a1.map(|a| m * a)
+                let a1 = pseudo_acceleration(k, end.x[j] - start.x[j], &prev.v[j], &prev.a[j], dt);
+                k.acceleration(a1, &prev.a[j], &prev.acc[j]).map(|a| m * a)
             },
-            |m| m / (BETA * dt * dt),
+            |m| k.stiffness(m, dt),
             |i, j0, tangent| {
                 spin_derivative(
                     &end.rot[i],
                     tangent,
-                    |r1| inertial_moment(j0, &start.rot[i], r1, prev, i, dt),
-                    |r1| inertial_moment(j0, &start.rot[i], r1, prev, i, dt),
+                    |r1| inertial_moment(k, j0, &start.rot[i], r1, prev, i, dt),
+                    |r1| inertial_moment(k, j0, &start.rot[i], r1, prev, i, dt),
                 )
             },
         );
@@ -166,7 +261,9 @@ impl TimeScheme for NewmarkTerms {
     }
 
     /// `v, a, W, A`, the step size, and the drivers' reactions at the last
-    /// accepted state (flag 1 and per joint then prescribed, or flag 0).
+    /// accepted state (flag 1 and per joint then prescribed, or flag 0); the
+    /// generalized-α scheme then adds `ρ∞` and the accelerations `q̈`, `Ȧ`
+    /// (the trapezoidal rule's have `a = q̈`).
     fn save(&self, tape: &mut Tape) {
         for vs in [&self.prev.v, &self.prev.a, &self.prev.w, &self.prev.alpha] {
             tape.put_vectors(vs);
@@ -183,16 +280,19 @@ impl TimeScheme for NewmarkTerms {
                 tape.put_list(prescribed);
             }
         }
+        if let Some(rho_inf) = self.coefficients.rho_inf {
+            tape.put(rho_inf);
+            tape.put_vectors(&self.prev.acc);
+            tape.put_vectors(&self.prev.ang_acc);
+        }
     }
 
     fn restore(&mut self, mech: &Mechanism, tape: &mut Tape) -> Result<(), CheckpointMismatch> {
         let n = mech.mesh.node_count();
-        self.prev = Kinematics {
-            v: tape.take_vectors("velocities", n)?,
-            a: tape.take_vectors("accelerations", n)?,
-            w: tape.take_vectors("angular velocities", n)?,
-            alpha: tape.take_vectors("angular accelerations", n)?,
-        };
+        let v = tape.take_vectors("velocities", n)?;
+        let a = tape.take_vectors("accelerations", n)?;
+        let w = tape.take_vectors("angular velocities", n)?;
+        let alpha = tape.take_vectors("angular accelerations", n)?;
         self.dt = tape.take()?;
         self.reactions = if tape.take()? == 0.0 {
             None
@@ -203,10 +303,33 @@ impl TimeScheme for NewmarkTerms {
                 .collect::<Result<Vec<_>, _>>()?;
             Some((rs, tape.take_list("prescribed DOFs' reactions", None)?))
         };
+        let (acc, ang_acc) = match self.coefficients.rho_inf {
+            None => (a.clone(), alpha.clone()),
+            Some(rho_inf) => {
+                let saved = tape.take()?;
+                if saved != rho_inf {
+                    return Err(CheckpointMismatch(format!(
+                        "the saved run used rho_inf = {saved}, this one {rho_inf}"
+                    )));
+                }
+                (
+                    tape.take_vectors("accelerations q̈", n)?,
+                    tape.take_vectors("angular accelerations Ȧ", n)?,
+                )
+            }
+        };
+        self.prev = Kinematics {
+            v,
+            a,
+            w,
+            alpha,
+            acc,
+            ang_acc,
+        };
         tape.done()
     }
 
-    /// Newmark's updates of velocities and accelerations; the drivers' work
+    /// Newmark's updates of velocities and (pseudo-)accelerations; the drivers' work
     /// by the trapezoidal rule on their reactions at both ends of the step
     /// (the first step uses its end value twice).
     fn finish(sys: &mut ReducedSystem<'_, Self>, dt: f64) -> f64 {
@@ -215,15 +338,16 @@ impl TimeScheme for NewmarkTerms {
         let work = driver_increment_work(sys.mech, &sys.start, &sys.end, &r_start, &r_end);
         sys.terms.reactions = Some(r_end);
         let (start, end) = (&sys.start.config, &sys.end.config);
-        let kin = &mut sys.terms.prev;
+        let (kin, k) = (&mut sys.terms.prev, &sys.terms.coefficients);
         for i in 0..start.x.len() {
-            let u = end.x[i] - start.x[i];
-            let a1 = (u - kin.v[i] * dt - kin.a[i] * (dt * dt * (0.5 - BETA))) / (BETA * dt * dt);
-            kin.v[i] += (kin.a[i] * (1.0 - GAMMA) + a1 * GAMMA) * dt;
+            let a1 = pseudo_acceleration(k, end.x[i] - start.x[i], &kin.v[i], &kin.a[i], dt);
+            kin.v[i] += (kin.a[i] * (1.0 - k.gamma) + a1 * k.gamma) * dt;
+            kin.acc[i] = k.acceleration(a1, &kin.a[i], &kin.acc[i]);
             kin.a[i] = a1;
             let al: Vector3<f64> =
-                angular_acceleration(&start.rot[i], &end.rot[i], &kin.w[i], &kin.alpha[i], dt);
-            kin.w[i] += (kin.alpha[i] * (1.0 - GAMMA) + al * GAMMA) * dt;
+                angular_acceleration(k, &start.rot[i], &end.rot[i], &kin.w[i], &kin.alpha[i], dt);
+            kin.w[i] += (kin.alpha[i] * (1.0 - k.gamma) + al * k.gamma) * dt;
+            kin.ang_acc[i] = k.acceleration(al, &kin.alpha[i], &kin.ang_acc[i]);
             kin.alpha[i] = al;
         }
         work

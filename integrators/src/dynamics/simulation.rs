@@ -25,9 +25,9 @@ use std::ops::ControlFlow;
 
 use super::checkpoint::{Checkpoint, CheckpointMismatch, Tape};
 use super::midpoint::MidpointTerms;
-use super::newmark_terms::NewmarkTerms;
+use super::newmark_terms::{Coefficients, NewmarkTerms};
 use super::time_scheme::TimeScheme;
-use super::{DynamicSettings, Motion, Scheme, GROW_AFTER};
+use super::{inertia_round_off_floor, DynamicSettings, Motion, Scheme, GROW_AFTER};
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, MechanismState, Topology};
 use crate::error::SolveError;
@@ -44,10 +44,16 @@ use flexmech_core::{Configuration, Element, Inertia};
 use nalgebra::Vector3;
 
 /// The time integrators.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Integrator {
     /// Newmark's trapezoidal rule on SO(3) ([`super::newmark`]).
     Newmark,
+    /// The generalized-α scheme on the Lie group
+    /// ([`super::generalized_alpha`]).
+    GeneralizedAlpha {
+        /// Spectral radius at infinite frequency, in `[0, 1]`.
+        rho_inf: f64,
+    },
     /// The momentum-conserving midpoint scheme ([`super::momentum`]).
     Momentum,
     /// The energy–momentum scheme ([`super::energy_momentum`]).
@@ -61,6 +67,7 @@ impl Integrator {
     pub fn name(self) -> &'static str {
         match self {
             Integrator::Newmark => "newmark",
+            Integrator::GeneralizedAlpha { .. } => "generalized-alpha",
             Integrator::Momentum => "momentum",
             Integrator::EnergyMomentum => "energy-momentum",
             Integrator::EnergyMomentumPaper => "energy-momentum-paper",
@@ -91,6 +98,14 @@ impl<'m> Simulation<'m> {
         }
         let scheme = match integrator {
             Integrator::Newmark => None,
+            Integrator::GeneralizedAlpha { rho_inf } => {
+                if !(0.0..=1.0).contains(&rho_inf) {
+                    return Err(SolveError::InvalidMechanism(format!(
+                        "generalized-alpha: rho_inf must lie in [0, 1], found {rho_inf}"
+                    )));
+                }
+                None
+            }
             Integrator::Momentum => Some(Scheme::Momentum),
             Integrator::EnergyMomentum => Some(Scheme::EnergyMomentum),
             Integrator::EnergyMomentumPaper => Some(Scheme::EnergyMomentumPaper),
@@ -114,8 +129,22 @@ impl<'m> Simulation<'m> {
         let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
         let inner: Box<dyn Stepping + 'm> = match scheme {
             None => {
-                let terms =
-                    NewmarkTerms::new(mech, &topo, &mut asm, &mut lu, &state, inertia, initial);
+                let coefficients = match integrator {
+                    Integrator::GeneralizedAlpha { rho_inf } => {
+                        Coefficients::generalized_alpha(rho_inf)
+                    }
+                    _ => Coefficients::TRAPEZOIDAL,
+                };
+                let terms = NewmarkTerms::new(
+                    mech,
+                    &topo,
+                    &mut asm,
+                    &mut lu,
+                    &state,
+                    inertia,
+                    initial,
+                    coefficients,
+                );
                 let sys = ReducedSystem::new(mech, topo, asm, state, terms);
                 Box::new(Stepper::new(sys, lu, settings))
             }
@@ -335,7 +364,8 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
             let sys = &mut self.sys;
             let mech = sys.mech;
             mech.external_forces(sys.terms.load_time(t, dt), &mut sys.fext);
-            sys.floor = mech.round_off_floor_at(&sys.start.config.x);
+            sys.floor = mech.round_off_floor_at(&sys.start.config.x)
+                + inertia_round_off_floor(mech, sys.terms.mass(), &sys.start.config.x, dt);
             let outcome = S::solve(
                 sys,
                 &mut self.lu,

@@ -81,6 +81,7 @@ const WORDS: &[&str] = &[
     "lobe",
     "spherical",
     "newmark",
+    "generalized-alpha",
     "energy-momentum-paper",
     "static",
     "dynamic",

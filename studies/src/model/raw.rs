@@ -196,6 +196,7 @@ pub(crate) struct RawSolver {
     pub max_halvings: Option<S<i64>>,
     pub mass: Option<S<String>>,
     pub newton: Option<S<String>>,
+    pub rho_inf: Option<S<Num>>,
 }
 
 /// `[output]`.

@@ -23,6 +23,7 @@ use std::path::{Path, PathBuf};
 fn legend(integrator: &str) -> &'static str {
     match integrator {
         "newmark" => "Newmark (trapezoidal)",
+        "generalized-alpha" => "generalized-α",
         "momentum" => "momentum conserving",
         "energy-momentum-paper" => "energy–momentum (paper, β)",
         _ => "energy–momentum",

@@ -3,6 +3,7 @@
 use super::{limits, quoted_list, Ctx, Res};
 use crate::model::raw::{RawOutput, RawSolver, S};
 use crate::model::types::*;
+use flexmech_integrators::dynamics::generalized_alpha::DEFAULT_RHO_INF;
 
 impl Ctx<'_> {
     pub(super) fn solver(&self, raw: Option<&S<RawSolver>>) -> Res<SolverSpec> {
@@ -43,6 +44,9 @@ impl Ctx<'_> {
             }
             let integrators = [
                 IntegratorKind::Newmark,
+                IntegratorKind::GeneralizedAlpha {
+                    rho_inf: DEFAULT_RHO_INF,
+                },
                 IntegratorKind::Momentum,
                 IntegratorKind::EnergyMomentum,
                 IntegratorKind::EnergyMomentumPaper,
@@ -63,6 +67,34 @@ impl Ctx<'_> {
                         int_s.get_ref()
                     ),
                 ));
+            };
+            let integrator = match (integrator, &s.rho_inf) {
+                (IntegratorKind::GeneralizedAlpha { .. }, Some(r)) => {
+                    let rho_inf = r.get_ref().0;
+                    if !(0.0..=1.0).contains(&rho_inf) {
+                        return Err(self.at(
+                            "solver.rho_inf",
+                            r,
+                            format!(
+                                "the spectral radius at infinite frequency must lie in [0, 1] \
+                                 (1: no numerical damping, 0: the most), found {rho_inf:?}"
+                            ),
+                        ));
+                    }
+                    IntegratorKind::GeneralizedAlpha { rho_inf }
+                }
+                (_, Some(r)) => {
+                    return Err(self.at(
+                        "solver.rho_inf",
+                        r,
+                        format!(
+                            "`rho_inf` belongs to integrator = \"generalized-alpha\", but this \
+                             run uses \"{}\"; remove `rho_inf` or change the integrator",
+                            integrator.name()
+                        ),
+                    ))
+                }
+                (integrator, None) => integrator,
             };
             let dt_s = self.need(
                 &s.dt,
@@ -107,6 +139,7 @@ impl Ctx<'_> {
                 ("dt", s.dt.as_ref().map(S::span)),
                 ("t_end", s.t_end.as_ref().map(S::span)),
                 ("integrator", s.integrator.as_ref().map(S::span)),
+                ("rho_inf", s.rho_inf.as_ref().map(S::span)),
             ];
             if let Some((key, span)) = dynamic_only.iter().find(|(_, sp)| sp.is_some()) {
                 let default = if s.analysis.is_none() {
