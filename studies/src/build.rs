@@ -64,6 +64,33 @@ fn initial_motion(model: &Model, built: &Built) -> Motion {
         }
     }
     motion.joint_rates = model.joints.iter().map(|j| j.rate).collect();
+    // Drivers written as expressions start at their exact rate f′(0): a
+    // driven joint's released rate (unless `rate` is given) and a
+    // prescribed DOF's velocity (a rotation DOF: the spin about its global
+    // axis, = W at t = 0 where R = I).
+    for p in &model.prescribed {
+        match p {
+            PrescribedSpec::JointAngle {
+                joint,
+                angle: f @ TimeFunction::Expression(_),
+            } if model.joints[*joint].rate == 0.0 => {
+                motion.joint_rates[*joint] = f.derivatives(0.0).1;
+            }
+            PrescribedSpec::NodeDof {
+                node,
+                dof,
+                value: f @ TimeFunction::Expression(_),
+            } => {
+                let n = built.node(*node);
+                let rate = f.derivatives(0.0).1;
+                match *dof {
+                    d @ 0..=2 => motion.v[n][d] = rate,
+                    d => motion.w[n][d - 3] = rate,
+                }
+            }
+            _ => {}
+        }
+    }
     motion
 }
 

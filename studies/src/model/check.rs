@@ -63,6 +63,7 @@ impl Checker<'_> {
     fn time(&self, key: &str, f: &TimeFunction) -> Res {
         match f {
             TimeFunction::Constant(c) => self.finite(key, &[*c]),
+            TimeFunction::Expression(_) => f.validate().map_err(|m| self.fail(key, m)),
             TimeFunction::Table(rows) => {
                 if rows.is_empty() {
                     return Err(self.fail(key, "the time table has no rows"));

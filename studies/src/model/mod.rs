@@ -20,6 +20,7 @@ use std::path::Path;
 
 mod check;
 pub mod error;
+pub mod expr;
 mod labels;
 mod locate;
 mod raw;
@@ -29,6 +30,7 @@ pub mod types;
 mod validate;
 
 pub use error::ModelError;
+pub use expr::{ExprError, Expression};
 pub use registry::{JointKind, JointRegistry, RegistryError};
 pub use types::*;
 

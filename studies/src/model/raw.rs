@@ -243,6 +243,7 @@ impl<'de> Deserialize<'de> for StrOrList {
 pub(crate) enum RawTimeFn {
     Constant(f64),
     Table(Vec<S<[Num; 2]>>),
+    Expr(String),
 }
 
 impl<'de> Deserialize<'de> for RawTimeFn {
@@ -260,7 +261,10 @@ impl<'de> Deserialize<'de> for RawTimeFn {
         impl<'de> Visitor<'de> for V {
             type Value = RawTimeFn;
             fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("a number or a table { table = [[t, value], ...] }")
+                f.write_str(
+                    "a number, a table { table = [[t, value], ...] } or an expression \
+                     { expr = \"...\" }",
+                )
             }
             fn visit_f64<E: de::Error>(self, v: f64) -> Result<RawTimeFn, E> {
                 V::constant(v)
@@ -272,21 +276,27 @@ impl<'de> Deserialize<'de> for RawTimeFn {
                 V::constant(v as f64)
             }
             fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<RawTimeFn, A::Error> {
-                let mut table = None;
+                let (mut table, mut expr) = (None, None);
                 while let Some(key) = map.next_key::<String>()? {
-                    if key == "table" {
-                        if table.is_some() {
-                            return Err(de::Error::duplicate_field("table"));
+                    match key.as_str() {
+                        "table" if table.is_some() => {
+                            return Err(de::Error::duplicate_field("table"))
                         }
-                        table = Some(map.next_value::<Vec<S<[Num; 2]>>>()?);
-                    } else {
-                        return Err(de::Error::unknown_field(&key, &["table"]));
+                        "table" => table = Some(map.next_value::<Vec<S<[Num; 2]>>>()?),
+                        "expr" if expr.is_some() => return Err(de::Error::duplicate_field("expr")),
+                        "expr" => expr = Some(map.next_value::<String>()?),
+                        _ => return Err(de::Error::unknown_field(&key, &["table", "expr"])),
                     }
                 }
-                match table {
-                    Some(rows) => Ok(RawTimeFn::Table(rows)),
-                    None => Err(de::Error::custom(
-                        "missing key `table`: write { table = [[t, value], ...] } or a number",
+                match (table, expr) {
+                    (Some(rows), None) => Ok(RawTimeFn::Table(rows)),
+                    (None, Some(text)) => Ok(RawTimeFn::Expr(text)),
+                    (Some(_), Some(_)) => {
+                        Err(de::Error::custom("give either `table` or `expr`, not both"))
+                    }
+                    (None, None) => Err(de::Error::custom(
+                        "missing key `table` or `expr`: write { table = [[t, value], ...] }, \
+                         { expr = \"...\" } or a number",
                     )),
                 }
             }

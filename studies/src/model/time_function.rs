@@ -17,6 +17,7 @@ impl TimeFunction {
     pub fn eval(&self, t: f64) -> f64 {
         match self {
             TimeFunction::Constant(c) => *c,
+            TimeFunction::Expression(e) => e.eval::<f64>(t),
             TimeFunction::Table(rows) => {
                 let (Some(first), Some(last)) = (rows.first(), rows.last()) else {
                     return 0.0;
@@ -40,11 +41,43 @@ impl TimeFunction {
         }
     }
 
+    /// The value and its first and second derivatives at `t`: exact for an
+    /// expression (second-order dual numbers), zero for a constant, and for
+    /// a table its slope on the segment that starts at `t` (the right
+    /// derivative; zero outside the table) and zero curvature.
+    pub fn derivatives(&self, t: f64) -> (f64, f64, f64) {
+        match self {
+            TimeFunction::Constant(c) => (*c, 0.0, 0.0),
+            TimeFunction::Expression(e) => e.derivatives(t),
+            TimeFunction::Table(rows) => {
+                let i = rows.partition_point(|&(ti, _)| ti <= t);
+                let slope = if i == 0 || i == rows.len() {
+                    0.0
+                } else {
+                    let ((t0, v0), (t1, v1)) = (rows[i - 1], rows[i]);
+                    (v1 - v0) / (t1 - t0)
+                };
+                (self.eval(t), slope, 0.0)
+            }
+        }
+    }
+
     /// Checks that the function is usable: every number finite; a table has at
-    /// least one row and strictly increasing times. The error says what is wrong
-    /// (rows are counted from 0).
+    /// least one row and strictly increasing times; an expression is finite
+    /// at t = 0. The error says what is wrong (rows are counted from 0).
     pub fn validate(&self) -> Result<(), String> {
         match self {
+            TimeFunction::Expression(e) => {
+                let v: f64 = e.eval(0.0);
+                if v.is_finite() {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "the expression \"{}\" is {v:?} at t = 0; it must give a finite number",
+                        e.text()
+                    ))
+                }
+            }
             TimeFunction::Constant(c) => {
                 if c.is_finite() {
                     Ok(())

@@ -22,6 +22,9 @@ pub enum TimeFunction {
     /// Piecewise-linear interpolation of `(t, value)` pairs sorted by `t`;
     /// constant extrapolation outside the table.
     Table(Vec<(f64, f64)>),
+    /// An expression of `t` (statics: of the load factor), `{ expr = "…" }`,
+    /// with exact derivatives.
+    Expression(crate::model::expr::Expression),
 }
 
 /// The section values of the builder, one vocabulary for model files and

@@ -5,6 +5,7 @@ use std::ops::Range;
 use std::path::Path;
 
 use super::error::ModelError;
+use super::expr::Expression;
 use super::labels::resolve_label;
 use super::locate::line_of;
 use super::raw::{v3, Num, RawModel, RawTimeFn, Vec3, S};
@@ -91,6 +92,9 @@ struct Ctx<'a> {
     text: &'a str,
     /// The joint kinds the file may name.
     registry: &'a JointRegistry,
+    /// Whether `[solver] analysis = "dynamic"` (time functions of `t`, not
+    /// of the load factor `lambda`).
+    dynamic: bool,
 }
 
 impl Ctx<'_> {
@@ -245,6 +249,26 @@ impl Ctx<'_> {
                     .map(|r| (r.get_ref()[0].0, r.get_ref()[1].0))
                     .collect(),
             ),
+            RawTimeFn::Expr(text) => {
+                let e = Expression::parse(text).map_err(|e| {
+                    self.at(
+                        key,
+                        v,
+                        format!("the expression \"{text}\" is not valid {e}"),
+                    )
+                })?;
+                if self.dynamic && e.uses_lambda() {
+                    return Err(self.at(
+                        key,
+                        v,
+                        format!(
+                            "the expression \"{text}\" names `lambda`, the load factor of a \
+                             static analysis; in a dynamic analysis write `t` (the time)"
+                        ),
+                    ));
+                }
+                TimeFunction::Expression(e)
+            }
         };
         if let Err(message) = f.validate() {
             // Point at the first row out of order when there is one.
@@ -253,7 +277,7 @@ impl Ctx<'_> {
                     .windows(2)
                     .find(|w| w[1].get_ref()[0].0 <= w[0].get_ref()[0].0)
                     .map_or_else(|| v.span(), |w| w[1].span()),
-                RawTimeFn::Constant(_) => v.span(),
+                RawTimeFn::Constant(_) | RawTimeFn::Expr(_) => v.span(),
             };
             return Err(self.err(key, Some(span), message));
         }
@@ -303,10 +327,16 @@ pub(crate) fn validate(
     file: &Path,
     registry: &JointRegistry,
 ) -> Result<Model, ModelError> {
+    let dynamic = raw
+        .solver
+        .as_ref()
+        .and_then(|s| s.get_ref().analysis.as_ref())
+        .is_some_and(|a| a.get_ref() == "dynamic");
     let cx = Ctx {
         file,
         text,
         registry,
+        dynamic,
     };
     let name = cx.model_name(&raw.name)?;
     let gravity = raw.gravity.as_ref().map_or([0.0; 3], |g| v3(g.get_ref()));

@@ -1,0 +1,581 @@
+//! Smooth time functions written as expressions, `{ expr = "…" }`: parsed
+//! once into a tree and evaluated over any dual number, so that a prescribed
+//! motion's velocity and acceleration are the exact derivatives of its
+//! position (second-order duals of num-dual), never finite differences.
+//!
+//! Grammar (usual precedence, `^` right-associative and above unary minus,
+//! so `-2^2 = -4`):
+//!
+//! ```text
+//! expr  := or
+//! or    := and ("||" and)*
+//! and   := cmp ("&&" cmp)*
+//! cmp   := sum (("<" | "<=" | ">" | ">=" | "==" | "!=") sum)?
+//! sum   := term (("+" | "-") term)*
+//! term  := unary (("*" | "/") unary)*
+//! unary := ("-" | "+" | "!") unary | power
+//! power := atom ("^" unary)?
+//! atom  := number | name | name "(" expr ("," expr)* ")" | "(" expr ")"
+//! ```
+//!
+//! Names: the variable `t` (in statics also `lambda`, the load factor), the
+//! constants `pi` and `e`; functions `sin cos tan asin acos atan sinh cosh
+//! tanh exp ln log sqrt abs` (one argument), `atan2 min max pow` (two) and
+//! `if(condition, a, b)` (a condition is true when non-zero; comparisons and
+//! `&&`, `||`, `!` give 1 or 0 and have zero derivative). `min`, `max`,
+//! `abs` and `if` take the derivative of the branch they choose.
+
+use num_dual::DualNum;
+use std::fmt;
+
+/// A parsed expression of one variable.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Expression {
+    text: String,
+    root: Node,
+    uses_lambda: bool,
+}
+
+/// Why an expression was refused: the 0-based character where it went
+/// wrong and what was expected.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExprError {
+    /// Character position in the text (0-based).
+    pub position: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for ExprError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "at character {}: {}", self.position + 1, self.message)
+    }
+}
+
+/// Functions of one argument.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Fn1 {
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Sinh,
+    Cosh,
+    Tanh,
+    Exp,
+    Ln,
+    Sqrt,
+    Abs,
+    Neg,
+    Not,
+}
+
+/// Functions and operators of two arguments.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Fn2 {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Pow,
+    Atan2,
+    Min,
+    Max,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Eq,
+    Ne,
+    And,
+    Or,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum Node {
+    Number(f64),
+    Var,
+    Call1(Fn1, Box<Node>),
+    Call2(Fn2, Box<Node>, Box<Node>),
+    If(Box<Node>, Box<Node>, Box<Node>),
+}
+
+const FUNCTIONS_1: [(&str, Fn1); 13] = [
+    ("sin", Fn1::Sin),
+    ("cos", Fn1::Cos),
+    ("tan", Fn1::Tan),
+    ("asin", Fn1::Asin),
+    ("acos", Fn1::Acos),
+    ("atan", Fn1::Atan),
+    ("sinh", Fn1::Sinh),
+    ("cosh", Fn1::Cosh),
+    ("tanh", Fn1::Tanh),
+    ("exp", Fn1::Exp),
+    ("ln", Fn1::Ln),
+    ("sqrt", Fn1::Sqrt),
+    ("abs", Fn1::Abs),
+];
+const FUNCTIONS_2: [(&str, Fn2); 4] = [
+    ("atan2", Fn2::Atan2),
+    ("min", Fn2::Min),
+    ("max", Fn2::Max),
+    ("pow", Fn2::Pow),
+];
+
+/// The names a user may write, for the "unknown name" message.
+const NAMES: &str = "t, lambda (statics), pi, e, sin, cos, tan, asin, acos, atan, atan2, sinh, \
+                     cosh, tanh, exp, ln, log, sqrt, abs, min, max, pow, if";
+
+impl Expression {
+    /// Parses `text`.
+    pub fn parse(text: &str) -> Result<Self, ExprError> {
+        let chars: Vec<char> = text.chars().collect();
+        let mut p = Parser {
+            chars: &chars,
+            at: 0,
+            uses_lambda: false,
+            depth: 0,
+            operators: 0,
+        };
+        let root = p.or()?;
+        p.skip_space();
+        if p.at < chars.len() {
+            return Err(p.error(format!(
+                "unexpected `{}` after a complete expression",
+                chars[p.at]
+            )));
+        }
+        Ok(Self {
+            text: text.to_string(),
+            root,
+            uses_lambda: p.uses_lambda,
+        })
+    }
+
+    /// The text it was parsed from.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// Whether it names `lambda` (a static analysis's load factor).
+    pub fn uses_lambda(&self) -> bool {
+        self.uses_lambda
+    }
+
+    /// The value at `t` (any dual number: its derivatives come along).
+    pub fn eval<T: DualNum<Primitive = f64> + Copy>(&self, t: T) -> T {
+        eval(&self.root, t)
+    }
+
+    /// The value and its first and second derivatives at `t`, exact (by
+    /// second-order dual numbers).
+    pub fn derivatives(&self, t: f64) -> (f64, f64, f64) {
+        num_dual::second_derivative(|x| self.eval(x), t)
+    }
+}
+
+fn truth<T: DualNum<Primitive = f64>>(b: bool) -> T {
+    T::from(if b { 1.0 } else { 0.0 })
+}
+
+fn eval<T: DualNum<Primitive = f64> + Copy>(node: &Node, t: T) -> T {
+    match node {
+        Node::Number(v) => T::from(*v),
+        Node::Var => t,
+        Node::Call1(f, a) => {
+            let a = eval(a, t);
+            match f {
+                Fn1::Sin => a.sin(),
+                Fn1::Cos => a.cos(),
+                Fn1::Tan => a.tan(),
+                Fn1::Asin => a.asin(),
+                Fn1::Acos => a.acos(),
+                Fn1::Atan => a.atan(),
+                Fn1::Sinh => a.sinh(),
+                Fn1::Cosh => a.cosh(),
+                Fn1::Tanh => a.tanh(),
+                Fn1::Exp => a.exp(),
+                Fn1::Ln => a.ln(),
+                Fn1::Sqrt => a.sqrt(),
+                Fn1::Abs => {
+                    if a.re() < 0.0 {
+                        -a
+                    } else {
+                        a
+                    }
+                }
+                Fn1::Neg => -a,
+                Fn1::Not => truth(a.re() == 0.0),
+            }
+        }
+        Node::Call2(Fn2::Pow, a, b) if !b.depends_on_t() => {
+            // A constant exponent: integer powers of negative bases stay
+            // defined (t^2 at t < 0), and no logarithm is taken.
+            let (a, n) = (eval(a, t), eval::<f64>(b, 0.0));
+            if n.fract() == 0.0 && n.abs() <= f64::from(i32::MAX) {
+                a.powi(n as i32)
+            } else {
+                a.powf(n)
+            }
+        }
+        Node::Call2(f, a, b) => {
+            let (a, b) = (eval(a, t), eval(b, t));
+            match f {
+                Fn2::Add => a + b,
+                Fn2::Sub => a - b,
+                Fn2::Mul => a * b,
+                Fn2::Div => a / b,
+                Fn2::Pow => a.powd(b),
+                Fn2::Atan2 => a.atan2(b),
+                Fn2::Min => {
+                    if b.re() < a.re() {
+                        b
+                    } else {
+                        a
+                    }
+                }
+                Fn2::Max => {
+                    if b.re() > a.re() {
+                        b
+                    } else {
+                        a
+                    }
+                }
+                Fn2::Lt => truth(a.re() < b.re()),
+                Fn2::Le => truth(a.re() <= b.re()),
+                Fn2::Gt => truth(a.re() > b.re()),
+                Fn2::Ge => truth(a.re() >= b.re()),
+                Fn2::Eq => truth(a.re() == b.re()),
+                Fn2::Ne => truth(a.re() != b.re()),
+                Fn2::And => truth(a.re() != 0.0 && b.re() != 0.0),
+                Fn2::Or => truth(a.re() != 0.0 || b.re() != 0.0),
+            }
+        }
+        Node::If(c, a, b) => {
+            if eval(c, t).re() != 0.0 {
+                eval(a, t)
+            } else {
+                eval(b, t)
+            }
+        }
+    }
+}
+
+impl Node {
+    /// Whether the value changes with `t`.
+    fn depends_on_t(&self) -> bool {
+        match self {
+            Node::Number(_) => false,
+            Node::Var => true,
+            Node::Call1(_, a) => a.depends_on_t(),
+            Node::Call2(_, a, b) => a.depends_on_t() || b.depends_on_t(),
+            Node::If(c, a, b) => c.depends_on_t() || a.depends_on_t() || b.depends_on_t(),
+        }
+    }
+}
+
+/// Deepest nesting of parentheses, calls and unary operators the parser
+/// follows (it recurses; a hostile file must not overflow the stack).
+const MAX_DEPTH: usize = 256;
+
+/// Most binary operators in one expression: with [`MAX_DEPTH`] it bounds
+/// the tree's depth, which evaluation recurses through.
+const MAX_OPERATORS: usize = 2_000;
+
+struct Parser<'a> {
+    chars: &'a [char],
+    at: usize,
+    uses_lambda: bool,
+    depth: usize,
+    operators: usize,
+}
+
+impl Parser<'_> {
+    fn error(&self, message: String) -> ExprError {
+        ExprError {
+            position: self.at,
+            message,
+        }
+    }
+
+    fn skip_space(&mut self) {
+        while self.at < self.chars.len() && self.chars[self.at].is_whitespace() {
+            self.at += 1;
+        }
+    }
+
+    /// Consumes `token` (after spaces) if it comes next.
+    fn eat(&mut self, token: &str) -> bool {
+        self.skip_space();
+        let t: Vec<char> = token.chars().collect();
+        if self.chars[self.at..].starts_with(&t) {
+            self.at += t.len();
+            true
+        } else {
+            false
+        }
+    }
+
+    /// A binary node, counted against [`MAX_OPERATORS`].
+    fn binary(&mut self, f: Fn2, a: Node, b: Node) -> Result<Node, ExprError> {
+        self.operators += 1;
+        if self.operators > MAX_OPERATORS {
+            return Err(self.error(format!(
+                "more than {MAX_OPERATORS} operators; simplify the expression"
+            )));
+        }
+        Ok(Node::Call2(f, Box::new(a), Box::new(b)))
+    }
+
+    fn or(&mut self) -> Result<Node, ExprError> {
+        let mut left = self.and()?;
+        while self.eat("||") {
+            let right = self.and()?;
+            left = self.binary(Fn2::Or, left, right)?;
+        }
+        Ok(left)
+    }
+
+    fn and(&mut self) -> Result<Node, ExprError> {
+        let mut left = self.cmp()?;
+        while self.eat("&&") {
+            let right = self.cmp()?;
+            left = self.binary(Fn2::And, left, right)?;
+        }
+        Ok(left)
+    }
+
+    fn cmp(&mut self) -> Result<Node, ExprError> {
+        let left = self.sum()?;
+        // Two-character operators first.
+        let ops = [
+            ("<=", Fn2::Le),
+            (">=", Fn2::Ge),
+            ("==", Fn2::Eq),
+            ("!=", Fn2::Ne),
+            ("<", Fn2::Lt),
+            (">", Fn2::Gt),
+        ];
+        for (token, op) in ops {
+            if self.eat(token) {
+                let right = self.sum()?;
+                return self.binary(op, left, right);
+            }
+        }
+        Ok(left)
+    }
+
+    fn sum(&mut self) -> Result<Node, ExprError> {
+        let mut left = self.term()?;
+        loop {
+            let op = if self.eat("+") {
+                Fn2::Add
+            } else if self.eat("-") {
+                Fn2::Sub
+            } else {
+                return Ok(left);
+            };
+            let right = self.term()?;
+            left = self.binary(op, left, right)?;
+        }
+    }
+
+    fn term(&mut self) -> Result<Node, ExprError> {
+        let mut left = self.unary()?;
+        loop {
+            let op = if self.eat("*") {
+                Fn2::Mul
+            } else if self.eat("/") {
+                Fn2::Div
+            } else {
+                return Ok(left);
+            };
+            let right = self.unary()?;
+            left = self.binary(op, left, right)?;
+        }
+    }
+
+    fn unary(&mut self) -> Result<Node, ExprError> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return Err(self.error(format!(
+                "nested more than {MAX_DEPTH} levels deep; simplify the expression"
+            )));
+        }
+        let node = self.unary_inner();
+        self.depth -= 1;
+        node
+    }
+
+    fn unary_inner(&mut self) -> Result<Node, ExprError> {
+        if self.eat("-") {
+            Ok(Node::Call1(Fn1::Neg, Box::new(self.unary()?)))
+        } else if self.eat("+") {
+            self.unary()
+        } else if self.peek_not() {
+            Ok(Node::Call1(Fn1::Not, Box::new(self.unary()?)))
+        } else {
+            self.power()
+        }
+    }
+
+    /// A `!` that is not the start of `!=`.
+    fn peek_not(&mut self) -> bool {
+        self.skip_space();
+        if self.chars.get(self.at) == Some(&'!') && self.chars.get(self.at + 1) != Some(&'=') {
+            self.at += 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    fn power(&mut self) -> Result<Node, ExprError> {
+        let base = self.atom()?;
+        if self.eat("^") {
+            let exponent = self.unary()?;
+            self.binary(Fn2::Pow, base, exponent)
+        } else {
+            Ok(base)
+        }
+    }
+
+    fn atom(&mut self) -> Result<Node, ExprError> {
+        self.skip_space();
+        let start = self.at;
+        let Some(&c) = self.chars.get(self.at) else {
+            return Err(self.error("the expression ends where a value is expected".into()));
+        };
+        if c == '(' {
+            self.at += 1;
+            let inner = self.or()?;
+            if !self.eat(")") {
+                return Err(self.error("expected `)`".into()));
+            }
+            return Ok(inner);
+        }
+        if c.is_ascii_digit() || c == '.' {
+            return self.number();
+        }
+        if c.is_alphabetic() || c == '_' {
+            while self
+                .chars
+                .get(self.at)
+                .is_some_and(|c| c.is_alphanumeric() || *c == '_')
+            {
+                self.at += 1;
+            }
+            let name: String = self.chars[start..self.at].iter().collect();
+            return self.named(&name, start);
+        }
+        Err(self.error(format!("unexpected `{c}` where a value is expected")))
+    }
+
+    fn number(&mut self) -> Result<Node, ExprError> {
+        let start = self.at;
+        let digits = |p: &mut Self| {
+            while p.chars.get(p.at).is_some_and(|c| c.is_ascii_digit()) {
+                p.at += 1;
+            }
+        };
+        digits(self);
+        if self.chars.get(self.at) == Some(&'.') {
+            self.at += 1;
+            digits(self);
+        }
+        if matches!(self.chars.get(self.at), Some('e' | 'E')) {
+            let save = self.at;
+            self.at += 1;
+            if matches!(self.chars.get(self.at), Some('+' | '-')) {
+                self.at += 1;
+            }
+            if self.chars.get(self.at).is_some_and(|c| c.is_ascii_digit()) {
+                digits(self);
+            } else {
+                self.at = save;
+            }
+        }
+        let s: String = self.chars[start..self.at].iter().collect();
+        s.parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .map(Node::Number)
+            .ok_or(ExprError {
+                position: start,
+                message: format!("`{s}` is not a finite number"),
+            })
+    }
+
+    fn named(&mut self, name: &str, start: usize) -> Result<Node, ExprError> {
+        let unknown = |what: &str| ExprError {
+            position: start,
+            message: format!("unknown {what} `{name}`; known names: {NAMES}"),
+        };
+        if !self.eat("(") {
+            return match name {
+                "t" => Ok(Node::Var),
+                "lambda" => {
+                    self.uses_lambda = true;
+                    Ok(Node::Var)
+                }
+                "pi" => Ok(Node::Number(std::f64::consts::PI)),
+                "e" => Ok(Node::Number(std::f64::consts::E)),
+                _ => Err(unknown("name")),
+            };
+        }
+        let mut args = vec![self.or()?];
+        while self.eat(",") {
+            args.push(self.or()?);
+        }
+        if !self.eat(")") {
+            return Err(self.error(format!("expected `,` or `)` in the arguments of `{name}`")));
+        }
+        let expect = |n: usize| {
+            if args.len() == n {
+                Ok(())
+            } else {
+                Err(ExprError {
+                    position: start,
+                    message: format!(
+                        "`{name}` takes {n} argument{}, found {}",
+                        if n == 1 { "" } else { "s" },
+                        args.len()
+                    ),
+                })
+            }
+        };
+        let one = if name == "log" {
+            Some(Fn1::Ln)
+        } else {
+            FUNCTIONS_1
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|&(_, f)| f)
+        };
+        if let Some(f) = one {
+            expect(1)?;
+            let mut args = args.into_iter();
+            return Ok(Node::Call1(f, Box::new(args.next().unwrap_or(Node::Var))));
+        }
+        if let Some(&(_, f)) = FUNCTIONS_2.iter().find(|(n, _)| *n == name) {
+            expect(2)?;
+            let mut args = args.into_iter().map(Box::new);
+            let (a, b) = (args.next(), args.next());
+            return match (a, b) {
+                (Some(a), Some(b)) => Ok(Node::Call2(f, a, b)),
+                _ => Err(unknown("function")),
+            };
+        }
+        if name == "if" {
+            expect(3)?;
+            let mut args = args.into_iter().map(Box::new);
+            return match (args.next(), args.next(), args.next()) {
+                (Some(c), Some(a), Some(b)) => Ok(Node::If(c, a, b)),
+                _ => Err(unknown("function")),
+            };
+        }
+        Err(unknown("function"))
+    }
+}
