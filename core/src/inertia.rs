@@ -102,6 +102,22 @@ impl Inertia {
         }
     }
 
+    /// Adds a rigid body whose centre of mass is `node`: mass `m` on the
+    /// node's translations and inertia `j` about its centre of mass (global
+    /// axes of the initial configuration, where every node's frame is the
+    /// identity) to its rotations — a point mass when `j = 0`.
+    pub fn add_body(&mut self, node: usize, m: f64, j: &Matrix3<f64>) {
+        match self
+            .mass
+            .binary_search_by_key(&(node, node), |&(a, b, _)| (a, b))
+        {
+            Ok(k) => self.mass[k].2 += m,
+            Err(k) => self.mass.insert(k, (node, node, m)),
+        }
+        self.row_mass[node] += m;
+        self.rotational[node] += j;
+    }
+
     /// `Σⱼ m_ij vⱼ` for every node (the mass matrix applied to velocities).
     pub fn apply_mass(&self, v: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
         let mut out = vec![Vector3::zeros(); v.len()];

@@ -37,7 +37,8 @@ use flexmech_joints::{JointMap, ReleasedState, MAX_RELEASED};
 use nalgebra::{Matrix3, Vector3};
 
 use crate::mechanism::{
-    nodal_weights, JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof, Schedule,
+    nodal_weights, JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof, RigidBody,
+    Schedule,
 };
 
 /// Relative distance (to the mechanism's size, at least 1) within which a
@@ -319,6 +320,14 @@ pub enum BuildError {
         /// Where relation (1) puts the slave.
         expected: [f64; 3],
     },
+    /// A rigid body's mass or inertia is not physical.
+    #[error("rigid body `{body}`: {why}")]
+    Body {
+        /// The body's name.
+        body: String,
+        /// What is wrong, with the values.
+        why: String,
+    },
     /// The slave is not where relation (1) puts it at ψ₀.
     #[error(
         "joint `{joint}`: the slave starts at {at:?} but the master plus the released \
@@ -365,6 +374,10 @@ impl Default for MechanismBuilder {
         Self::new()
     }
 }
+
+/// Relative asymmetry (and negative part) of an inertia tensor taken for
+/// round-off, against its largest entry.
+pub const BODY_SYMMETRY_TOLERANCE: f64 = 1e-12;
 
 fn finite<'a>(
     what: impl FnOnce() -> String,
@@ -550,6 +563,87 @@ impl MechanismBuilder {
         self.mech.gravity = g;
         self.mech.gravity_scale = scale;
         Ok(())
+    }
+
+    /// A rigid body carried by `node`: mass `mass`, inertia `inertia` about
+    /// its centre of mass, which lies at `offset` from the node — both in the
+    /// node's initial frame, which is the global one (every node starts at
+    /// the identity). A point mass has zero inertia and offset. With an offset
+    /// the centre of mass becomes a node of no element joined rigidly to
+    /// `node` (master–slave, eliminated exactly; its joint is named
+    /// `body.<name>`), so the body's kinetic energy, momenta and weight are
+    /// exact in every scheme. Returns the node at the centre of mass.
+    ///
+    /// Refused: a negative or non-finite mass; an inertia that is not
+    /// symmetric, has a negative principal value or breaks the triangle
+    /// inequality `J₁ ≤ J₂ + J₃` of a physical body.
+    pub fn rigid_body(
+        &mut self,
+        name: String,
+        node: NodeId,
+        mass: f64,
+        inertia: Matrix3<f64>,
+        offset: Vector3<f64>,
+    ) -> Result<NodeId, BuildError> {
+        let n = self.check(node)?;
+        finite(|| format!("rigid body `{name}`: mass"), &[mass])?;
+        finite(|| format!("rigid body `{name}`: inertia"), inertia.iter())?;
+        finite(|| format!("rigid body `{name}`: offset"), offset.iter())?;
+        let refuse = |why: String| BuildError::Body {
+            body: name.clone(),
+            why,
+        };
+        if mass < 0.0 {
+            return Err(refuse(format!("the mass must be >= 0, found {mass}")));
+        }
+        let scale = inertia.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if (inertia - inertia.transpose()).amax() > BODY_SYMMETRY_TOLERANCE * scale {
+            return Err(refuse(format!(
+                "the inertia tensor must be symmetric, found {:?}",
+                inertia.as_slice()
+            )));
+        }
+        let mut j = inertia.symmetric_eigenvalues().as_slice().to_vec();
+        j.sort_by(f64::total_cmp);
+        if j[0] < -BODY_SYMMETRY_TOLERANCE * scale {
+            return Err(refuse(format!(
+                "the principal moments of inertia must be >= 0, found {j:?}"
+            )));
+        }
+        if j[2] > (j[0] + j[1]) * (1.0 + BODY_SYMMETRY_TOLERANCE) + BODY_SYMMETRY_TOLERANCE * scale
+        {
+            return Err(refuse(format!(
+                "the principal moments of inertia {j:?} break J₁ ≤ J₂ + J₃, which every \
+                 body's do"
+            )));
+        }
+        let centre = if offset == Vector3::zeros() {
+            node
+        } else {
+            let x = self.mech.mesh.positions[n] + offset;
+            let c = NodeId(self.mech.mesh.add_node(x));
+            self.mech.fixed.push([false; 6]);
+            let joint = self.joint(JointDef {
+                name: format!("body.{name}"),
+                map: Arc::new(flexmech_joints::RigidLink { offset }),
+                master: node,
+                slave: c,
+                angle: 0.0,
+            });
+            if let Err(e) = joint {
+                self.mech.mesh.positions.pop();
+                self.mech.fixed.pop();
+                return Err(e);
+            }
+            c
+        };
+        self.mech.bodies.push(RigidBody {
+            name,
+            node: centre.0,
+            mass,
+            inertia,
+        });
+        Ok(centre)
     }
 
     /// Adds a joint after checking that its nodes differ, that an angle is

@@ -26,7 +26,9 @@ pub mod tolerances;
 
 pub use constraints::{MechanismState, Topology};
 pub use error::{NewtonFailure, SolveError};
-pub use mechanism::{JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof, Schedule};
+pub use mechanism::{
+    JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof, RigidBody, Schedule,
+};
 pub use newton::NewtonSettings;
 pub use record::{Energies, JointRecord, StepRecord};
 pub use statics::{solve_static, StaticOutcome, StaticSettings};

@@ -1,9 +1,9 @@
 //! The mechanism: a mesh with supports, loads and gravity — everything a solver
 //! is handed. Nothing here reads files; the model loader builds it.
 
-use flexmech_core::Mesh;
+use flexmech_core::{Inertia, MassKind, Mesh};
 use flexmech_joints::{JointMap, ReleasedState};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use std::fmt;
 use std::sync::Arc;
 
@@ -121,6 +121,23 @@ pub struct PrescribedDof {
     pub value: Schedule,
 }
 
+/// A rigid body (or point mass) whose centre of mass is a node: the mass
+/// on its translations, the inertia about the centre of mass on its
+/// rotations. An offset centre of mass is a node of its own joined rigidly
+/// to the carrying node (see
+/// [`MechanismBuilder::rigid_body`](crate::builder::MechanismBuilder::rigid_body)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigidBody {
+    /// Its name (results, messages).
+    pub name: String,
+    /// The node at its centre of mass.
+    pub node: usize,
+    /// Mass.
+    pub mass: f64,
+    /// Inertia tensor about the centre of mass, global axes at t = 0.
+    pub inertia: Matrix3<f64>,
+}
+
 /// Everything a solver needs about the mechanism.
 #[derive(Debug, Clone)]
 pub struct Mechanism {
@@ -140,6 +157,8 @@ pub struct Mechanism {
     pub joints: Vec<JointInstance>,
     /// Prescribed nodal DOFs.
     pub prescribed: Vec<PrescribedDof>,
+    /// Rigid bodies and point masses.
+    pub bodies: Vec<RigidBody>,
 }
 
 impl Mechanism {
@@ -155,7 +174,18 @@ impl Mechanism {
             gravity_scale: Schedule::constant(1.0),
             joints: Vec::new(),
             prescribed: Vec::new(),
+            bodies: Vec::new(),
         }
+    }
+
+    /// The mass and inertia of the beams (with `kind` of translational
+    /// mass) and of the rigid bodies.
+    pub fn inertia(&self, kind: MassKind) -> Inertia {
+        let mut inertia = Inertia::new(&self.mesh, kind);
+        for b in &self.bodies {
+            inertia.add_body(b.node, b.mass, &b.inertia);
+        }
+        inertia
     }
 
     /// The nodes held at one DOF at least (fixed or prescribed), ascending:
@@ -202,7 +232,8 @@ impl Mechanism {
 
     /// External nodal forces and moments at time `t` (6 per node:
     /// force, then spatial moment): the nodal loads, the users' load fields
-    /// and consistent nodal gravity forces `∫ρA g Iᵢ ds`.
+    /// and consistent nodal gravity forces `∫ρA g Iᵢ ds`, plus `m g` on each
+    /// rigid body.
     pub fn external_forces(&self, t: f64, out: &mut [f64]) {
         out.iter_mut().for_each(|v| *v = 0.0);
         for load in &self.loads {
@@ -223,6 +254,11 @@ impl Mechanism {
                     for c in 0..3 {
                         out[6 * n + c] += m * w * g[c];
                     }
+                }
+            }
+            for b in &self.bodies {
+                for c in 0..3 {
+                    out[6 * b.node + c] += b.mass * g[c];
                 }
             }
         }

@@ -4,7 +4,8 @@
 //! [`DependentJoint`] (one released rotation `ψ` about `t` and a released
 //! translation `r_R = f(ψ)`: revolute, screw, rack-and-pinion, cam, lobe, and
 //! any profile a user writes) or [`JointKinematics`] (rigid, spherical,
-//! prismatic, cylindrical). The shared mechanism in [`kinematics`] derives the
+//! prismatic, cylindrical, and the rigid link that carries a rigid body's
+//! centre of mass). The shared mechanism in [`kinematics`] derives the
 //! variational map `N`, its derivative and the exact placement of the slave by
 //! automatic differentiation; [`dependent`] derives `f′`, the secant `G` and
 //! the paper's incremental map `Ñ`; [`incremental`] gives every kind its exact
@@ -24,6 +25,7 @@ pub mod prismatic;
 pub mod rack_pinion;
 pub mod revolute;
 pub mod rigid;
+pub mod rigid_link;
 pub mod screw;
 pub mod spherical;
 
@@ -42,5 +44,6 @@ pub use prismatic::Prismatic;
 pub use rack_pinion::RackPinion;
 pub use revolute::Revolute;
 pub use rigid::Rigid;
+pub use rigid_link::RigidLink;
 pub use screw::Screw;
 pub use spherical::Spherical;

@@ -90,6 +90,7 @@ fn cantilever(ei: f64, force: f64) -> Model {
         distributed_loads: Vec::new(),
         prescribed: Vec::new(),
         initial_velocities: Vec::new(),
+        rigid_bodies: Vec::new(),
         solver: SolverSpec {
             analysis: Analysis::Static { load_steps: 1 },
             tolerance: 1e-10,

@@ -7,7 +7,7 @@ use crate::model::{
 use flexmech_integrators::builder::{BeamDef, BuildError, Dof, JointDef, MechanismBuilder, NodeId};
 use flexmech_integrators::dynamics::Motion;
 use flexmech_integrators::{Mechanism, Schedule};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 /// A mechanism with the numbering that relates it back to the model file.
 #[derive(Debug, Clone)]
@@ -24,6 +24,10 @@ pub struct Built {
     /// (nodes of no element, after the beams' nodes; labelled
     /// `ground.<joint name>`).
     pub ground_nodes: Vec<(usize, usize)>,
+    /// The centre-of-mass node of every rigid body with an offset:
+    /// `(body index, node)` (labelled `body.<body name>`; its rigid joint to
+    /// the carrying node is the joint `body.<body name>`, after the model's).
+    pub body_nodes: Vec<(usize, usize)>,
 }
 
 impl Built {
@@ -242,6 +246,23 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         })?;
         joints.push(id);
     }
+    let mut body_nodes = Vec::new();
+    for (i, body) in model.rigid_bodies.iter().enumerate() {
+        let carrier = node(body.node);
+        let inertia = Matrix3::from_fn(|r, c| body.inertia[r][c]);
+        let centre = b
+            .rigid_body(
+                body.name.clone(),
+                carrier,
+                body.mass,
+                inertia,
+                v(body.offset),
+            )
+            .map_err(|e| refused(model, format!("rigid_body[{i}]"), e))?;
+        if centre != carrier {
+            body_nodes.push((i, centre.index()));
+        }
+    }
     for (i, p) in model.prescribed.iter().enumerate() {
         match p {
             PrescribedSpec::JointAngle { joint, angle } => {
@@ -273,6 +294,7 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         beam_elements,
         motion: Motion::rest(0),
         ground_nodes,
+        body_nodes,
     };
     built.motion = initial_motion(model, &built);
     crate::initial_check::check(model, &built.mechanism, &built.beam_nodes, &built.motion)?;

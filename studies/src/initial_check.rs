@@ -83,6 +83,29 @@ pub(crate) fn check(
         }
         first += beam.elements;
     }
+    for (k, body) in model.rigid_bodies.iter().enumerate() {
+        let stepped = dt.map_or(1.0, |dt| 1.0 / (dt * dt));
+        let spin = body
+            .inertia
+            .as_flattened()
+            .iter()
+            .fold(0.0f64, |m, j| m.max(j.abs()));
+        let g = model.gravity.iter().fold(0.0f64, |m, g| m.max(g.abs()));
+        let products = [
+            body.mass * (1.0 + radius * radius) * stepped,
+            spin * stepped,
+            g * body.mass * radius,
+        ];
+        if products.iter().any(|p| !p.is_finite()) {
+            return fail(
+                format!("rigid_body[{k}]"),
+                format!(
+                    "rigid body `{}`: its mass or inertia (times size², 1/dt² and gravity)",
+                    body.name
+                ),
+            );
+        }
+    }
     for (k, load) in model.loads.iter().enumerate() {
         let f = Vector3::from(load.force).norm() * radius;
         let m = Vector3::from(load.moment).norm();
@@ -129,7 +152,7 @@ pub(crate) fn check(
     for (j, joint) in mech.joints.iter().enumerate() {
         let x = &mech.mesh.positions[joint.master];
         let n = joint.map.variation(x, &Matrix3::identity(), &joint.initial);
-        let rate = model.joints[j].rate.abs().max(1.0);
+        let rate = model.joints.get(j).map_or(0.0, |s| s.rate).abs().max(1.0);
         if n.iter().any(|v| !(v * rate).is_finite()) {
             return fail(
                 format!("joint[{j}]"),

@@ -301,7 +301,8 @@ fn run(
             .iter()
             .map(|(label, r)| (label.clone(), built.node(*r)))
             .collect(),
-        joint_names: model.joints.iter().map(|j| j.name.clone()).collect(),
+        // The model's joints, then the rigid bodies' joints (`body.<name>`).
+        joint_names: mech.joints.iter().map(|j| j.name.clone()).collect(),
         joint_angles: mech
             .joints
             .iter()
@@ -486,6 +487,9 @@ fn mesh_meta(model: &Model, built: &Built) -> MeshMeta {
     }
     for &(j, n) in &built.ground_nodes {
         node_labels[n] = format!("ground.{}", model.joints[j].name);
+    }
+    for &(b, n) in &built.body_nodes {
+        node_labels[n] = format!("body.{}", model.rigid_bodies[b].name);
     }
     MeshMeta {
         node_labels,

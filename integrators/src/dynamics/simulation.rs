@@ -40,7 +40,7 @@ use crate::rotation_guard::{as_step_failure, RotationGuard};
 use crate::step_control::StepControl;
 use crate::system::ReducedSystem;
 use crate::tolerances::TOLERANCES;
-use flexmech_core::{Configuration, Element, Inertia};
+use flexmech_core::{Configuration, Element};
 use nalgebra::Vector3;
 
 /// The time integrators.
@@ -124,7 +124,7 @@ impl<'m> Simulation<'m> {
         let mut state = initial_state(mech);
         let topo = Topology::new(mech, &state)?;
         topo.impose(mech, &mut state, 0.0);
-        let inertia = Inertia::new(&mech.mesh, settings.mass);
+        let inertia = mech.inertia(settings.mass);
         let mut asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
         let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
         let inner: Box<dyn Stepping + 'm> = match scheme {

@@ -214,6 +214,13 @@ impl Checker<'_> {
             self.finite(&k("angular"), &v.angular)?;
             self.finite(&k("origin"), &v.origin)?;
         }
+        for (i, b) in m.rigid_bodies.iter().enumerate() {
+            let k = |name: &str| format!("rigid_body[{i}].{name}");
+            self.node(&k("node"), b.node)?;
+            self.finite(&k("mass"), &[b.mass])?;
+            self.finite(&k("inertia"), b.inertia.as_flattened())?;
+            self.finite(&k("offset"), &b.offset)?;
+        }
         Ok(())
     }
 

@@ -60,6 +60,8 @@ pub(crate) struct RawModel {
     pub prescribed: Vec<S<RawPrescribed>>,
     #[serde(default)]
     pub initial_velocity: Vec<S<RawInitialVelocity>>,
+    #[serde(default)]
+    pub rigid_body: Vec<S<RawRigidBody>>,
     pub solver: Option<S<RawSolver>>,
     pub output: Option<S<RawOutput>>,
 }
@@ -180,6 +182,25 @@ pub(crate) struct RawInitialVelocity {
     pub linear: Option<S<Vec3>>,
     pub angular: Option<S<Vec3>>,
     pub origin: Option<S<Vec3>>,
+}
+
+/// `[[rigid_body]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawRigidBody {
+    pub name: Option<S<String>>,
+    pub node: Option<S<String>>,
+    pub mass: Option<S<Num>>,
+    pub inertia: Option<S<Vec<NumOrRow>>>,
+    pub offset: Option<S<Vec3>>,
+}
+
+/// An entry of `inertia`: a principal value or a row of the 3×3 tensor.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub(crate) enum NumOrRow {
+    Num(Num),
+    Row([Num; 3]),
 }
 
 /// `[solver]`.

@@ -164,6 +164,24 @@ pub struct InitialVelocitySpec {
     pub origin: [f64; 3],
 }
 
+/// A `[[rigid_body]]`: a rigid body (a point mass when its inertia and
+/// offset are zero) carried by a node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigidBodySpec {
+    /// Its name (its index `i` when the file gives none); the centre of
+    /// mass of an offset body is the node `body.<name>` in results.
+    pub name: String,
+    /// The carrying node.
+    pub node: NodeRef,
+    /// Mass.
+    pub mass: f64,
+    /// Inertia tensor about the centre of mass in the node's initial frame
+    /// (the global axes: every node starts at the identity).
+    pub inertia: [[f64; 3]; 3],
+    /// Centre of mass from the node, in the same frame.
+    pub offset: [f64; 3],
+}
+
 /// The time integrators: the solvers' own enum, one vocabulary for model
 /// files and Rust (`IntegratorKind::name` gives the model-file name).
 pub use flexmech_integrators::dynamics::Integrator as IntegratorKind;
@@ -247,6 +265,8 @@ pub struct Model {
     pub prescribed: Vec<PrescribedSpec>,
     /// `[[initial_velocity]]` entries, in file order.
     pub initial_velocities: Vec<InitialVelocitySpec>,
+    /// `[[rigid_body]]` entries (point masses included).
+    pub rigid_bodies: Vec<RigidBodySpec>,
     /// `[solver]`.
     pub solver: SolverSpec,
     /// `[output]`.

@@ -16,6 +16,7 @@ mod geometry;
 mod joints;
 pub mod limits;
 mod loading;
+mod rigid_bodies;
 mod solver;
 
 type Res<T> = Result<T, ModelError>;
@@ -349,6 +350,7 @@ pub(crate) fn validate(
     let distributed_loads = cx.distributed_loads(&raw.distributed_load, &beams)?;
     let prescribed = cx.prescribed(&raw.prescribed, &beams, &joints, &supports)?;
     let initial_velocities = cx.initial_velocities(&raw.initial_velocity, &beams)?;
+    let rigid_bodies = cx.rigid_bodies(&raw.rigid_body, &beams)?;
     let solver = cx.solver(raw.solver.as_ref())?;
     cx.massive(&raw.section, &sections, &beams, &solver)?;
     let output = cx.output(raw.output.as_ref(), &beams)?;
@@ -365,6 +367,7 @@ pub(crate) fn validate(
         distributed_loads,
         prescribed,
         initial_velocities,
+        rigid_bodies,
         solver,
         output,
     })
