@@ -37,8 +37,8 @@ use flexmech_joints::{JointMap, ReleasedState, MAX_RELEASED};
 use nalgebra::{Matrix3, Vector3};
 
 use crate::mechanism::{
-    nodal_weights, JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof, RigidBody,
-    Schedule,
+    nodal_weights, FollowerLoad, JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof,
+    RigidBody, Schedule,
 };
 
 /// Relative distance (to the mechanism's size, at least 1) within which a
@@ -514,6 +514,30 @@ impl MechanismBuilder {
         self.mech.load_fields.push(LoadField::new(f));
     }
 
+    /// A follower force and moment on `node`, given in the node's initial
+    /// frame (the global axes) and turning with the node's triad:
+    /// `f = s(t) R f₀`, `m = s(t) R m₀` (see [`FollowerLoad`]).
+    pub fn follower_load(
+        &mut self,
+        node: NodeId,
+        force: Vector3<f64>,
+        moment: Vector3<f64>,
+        scale: Schedule,
+    ) -> Result<(), BuildError> {
+        let n = self.check(node)?;
+        finite(
+            || format!("follower load on node {n}: force, moment"),
+            force.iter().chain(&moment),
+        )?;
+        self.mech.follower_loads.push(FollowerLoad {
+            node: n,
+            force,
+            moment,
+            scale,
+        });
+        Ok(())
+    }
+
     /// A dead force and a moment about fixed global axes per unit length on
     /// every element of `beam`, scaled by `scale(t)`: the consistent nodal
     /// loads `∫ q Nᵢ ds` — `qh/2` at each end of a 2-node element,
@@ -525,9 +549,50 @@ impl MechanismBuilder {
         moment: Vector3<f64>,
         scale: Schedule,
     ) -> Result<(), BuildError> {
+        for (node, share) in self.shares(beam, &force, &moment)? {
+            self.mech.loads.push(NodalLoad {
+                node,
+                force: force * share,
+                moment: moment * share,
+                scale: scale.clone(),
+            });
+        }
+        Ok(())
+    }
+
+    /// A follower force and moment per unit length on every element of
+    /// `beam` (given in the initial frame, turning with the beam): the
+    /// nodal shares of [`MechanismBuilder::distributed_load`], each turning
+    /// with its node's triad — the nodal quadrature of `∫ R(s) q₀ Nᵢ ds`.
+    pub fn follower_distributed_load(
+        &mut self,
+        beam: &Beam,
+        force: Vector3<f64>,
+        moment: Vector3<f64>,
+        scale: Schedule,
+    ) -> Result<(), BuildError> {
+        for (node, share) in self.shares(beam, &force, &moment)? {
+            self.mech.follower_loads.push(FollowerLoad {
+                node,
+                force: force * share,
+                moment: moment * share,
+                scale: scale.clone(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Each node's share `Σ w h` of a uniform load per unit length on
+    /// `beam` (the weights of gravity), after checking the load's numbers.
+    fn shares(
+        &self,
+        beam: &Beam,
+        force: &Vector3<f64>,
+        moment: &Vector3<f64>,
+    ) -> Result<Vec<(usize, f64)>, BuildError> {
         finite(
             || "distributed load: force, moment".into(),
-            force.iter().chain(&moment),
+            force.iter().chain(moment),
         )?;
         let count = self.mech.mesh.elements.len();
         if beam.elements.end > count {
@@ -546,15 +611,7 @@ impl MechanismBuilder {
                 }
             }
         }
-        for (node, share) in shares {
-            self.mech.loads.push(NodalLoad {
-                node,
-                force: force * share,
-                moment: moment * share,
-                scale: scale.clone(),
-            });
-        }
-        Ok(())
+        Ok(shares)
     }
 
     /// Gravity acceleration `g` (acting on ρA), scaled by `scale(t)`.

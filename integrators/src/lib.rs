@@ -27,7 +27,8 @@ pub mod tolerances;
 pub use constraints::{MechanismState, Topology};
 pub use error::{NewtonFailure, SolveError};
 pub use mechanism::{
-    JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof, RigidBody, Schedule,
+    FollowerLoad, JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof, RigidBody,
+    Schedule,
 };
 pub use newton::NewtonSettings;
 pub use record::{Energies, JointRecord, StepRecord};

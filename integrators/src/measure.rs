@@ -33,6 +33,39 @@ pub fn load_potential(mech: &Mechanism, config: &Configuration, fext: &[f64]) ->
         .sum::<f64>()
 }
 
+/// The work of the follower loads over a step from `(t₀, start)` to
+/// `(t₁, end)` by the trapezoidal rule: `½(f₀ + f₁)·Δx + ½(m₀ + m₁)·Δθ` per
+/// loaded node, `Δθ` the step's spatial rotation vector (exact for a
+/// constant load and a rotation about a fixed axis). Follower loads have no
+/// potential; the records count minus their work since t = 0 as their share
+/// of the potential, so that the total energy stays a balance.
+pub fn follower_work(
+    mech: &Mechanism,
+    (t0, start): (f64, &Configuration),
+    (t1, end): (f64, &Configuration),
+) -> f64 {
+    if mech.follower_loads.is_empty() {
+        return 0.0;
+    }
+    let n = start.x.len();
+    let (mut f0, mut f1) = (vec![0.0; 6 * n], vec![0.0; 6 * n]);
+    mech.add_follower_forces(t0, &start.rot, 1.0, &mut f0);
+    mech.add_follower_forces(t1, &end.rot, 1.0, &mut f1);
+    let mut nodes: Vec<usize> = mech.follower_loads.iter().map(|l| l.node).collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    let mut work = 0.0;
+    for i in nodes {
+        let dx = end.x[i] - start.x[i];
+        let dth = flexmech_core::rotation::log(&(end.rot[i] * start.rot[i].transpose()));
+        for c in 0..3 {
+            work += 0.5 * (f0[6 * i + c] + f1[6 * i + c]) * dx[c];
+            work += 0.5 * (f0[6 * i + 3 + c] + f1[6 * i + 3 + c]) * dth[c];
+        }
+    }
+    work
+}
+
 /// A record of `state` with its strain energy and load potential (no
 /// kinetic energy, no momenta: statics), after the Newton solve `report`
 /// (`None`: the initial state).

@@ -121,6 +121,24 @@ pub struct PrescribedDof {
     pub value: Schedule,
 }
 
+/// A follower load on a node: a force and a moment that turn with the
+/// node's triad, `f = s(t) R f₀`, `m = s(t) R m₀` (`f₀`, `m₀` in the node's
+/// initial frame, the global axes — every node starts at the identity).
+/// Not conservative: it has no potential, and its load stiffness
+/// `∂(−R f₀)/∂η = (R f₀)^` (for a spatial spin `η` of `R`) makes the tangent
+/// unsymmetric.
+#[derive(Debug, Clone)]
+pub struct FollowerLoad {
+    /// The loaded node.
+    pub node: usize,
+    /// Force in the node's initial frame.
+    pub force: Vector3<f64>,
+    /// Moment in the node's initial frame.
+    pub moment: Vector3<f64>,
+    /// Scale factor over time (statics: over the load factor).
+    pub scale: Schedule,
+}
+
 /// A rigid body (or point mass) whose centre of mass is a node: the mass
 /// on its translations, the inertia about the centre of mass on its
 /// rotations. An offset centre of mass is a node of its own joined rigidly
@@ -147,6 +165,8 @@ pub struct Mechanism {
     pub fixed: Vec<[bool; 6]>,
     /// Nodal loads.
     pub loads: Vec<NodalLoad>,
+    /// Follower loads (turning with their nodes).
+    pub follower_loads: Vec<FollowerLoad>,
     /// Users' load fields, added after the nodal loads.
     pub load_fields: Vec<LoadField>,
     /// Gravity acceleration (acts on `ρA`).
@@ -169,6 +189,7 @@ impl Mechanism {
             mesh,
             fixed: vec![[false; 6]; n],
             loads: Vec::new(),
+            follower_loads: Vec::new(),
             load_fields: Vec::new(),
             gravity: Vector3::zeros(),
             gravity_scale: Schedule::constant(1.0),
@@ -176,6 +197,16 @@ impl Mechanism {
             prescribed: Vec::new(),
             bodies: Vec::new(),
         }
+    }
+
+    /// Whether anything drives the mechanism: a driven joint coordinate or
+    /// a prescribed DOF (whose reactions do the drivers' work).
+    pub fn has_drivers(&self) -> bool {
+        !self.prescribed.is_empty()
+            || self
+                .joints
+                .iter()
+                .any(|j| j.driven.iter().any(Option::is_some))
     }
 
     /// The mass and inertia of the beams (with `kind` of translational
@@ -228,6 +259,19 @@ impl Mechanism {
             .map(|e| e.force_scale(radius).powi(2))
             .sum();
         4.0 * f64::EPSILON * sum.sqrt()
+    }
+
+    /// Adds `weight ×` the follower loads at time `t` with the nodes turned
+    /// by `rot` to `out` (6 per node, force then spatial moment).
+    pub fn add_follower_forces(&self, t: f64, rot: &[Matrix3<f64>], weight: f64, out: &mut [f64]) {
+        for l in &self.follower_loads {
+            let s = weight * l.scale.at(t);
+            let (f, m) = (rot[l.node] * l.force * s, rot[l.node] * l.moment * s);
+            for c in 0..3 {
+                out[6 * l.node + c] += f[c];
+                out[6 * l.node + 3 + c] += m[c];
+            }
+        }
     }
 
     /// External nodal forces and moments at time `t` (6 per node:

@@ -11,7 +11,7 @@ use crate::assembly::Assembler;
 use crate::constraints::{initial_state, MechanismState, Topology};
 use crate::error::{NewtonFailure, SolveError};
 use crate::linsolve::SparseLu;
-use crate::measure::static_record;
+use crate::measure::{follower_work, static_record};
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonSettings, NewtonSystem};
 use crate::record::StepRecord;
@@ -46,7 +46,7 @@ pub struct StaticOutcome {
 
 /// The static terms: the beams' internal forces at the iterate; no inertia;
 /// joints through `N`.
-struct StaticTerms;
+pub(crate) struct StaticTerms;
 
 impl StepTerms for StaticTerms {
     fn reduction(&self) -> Reduction {
@@ -82,16 +82,14 @@ pub fn solve_static(
     let mut control = StepControl::with(nominal, settings.max_halvings, GROW_AFTER);
     let mut guard = RotationGuard::new(mech, &prob.end);
     let (mut lambda, mut steps) = (0.0f64, 0usize);
+    // The follower loads' work along the load path.
+    let mut follower = 0.0;
     // Kinematically driven mechanisms start each step from the secant
     // prediction, which carries the rigid motion downstream of a driven joint;
     // under load control the last equilibrium is the better start (Newton's
     // first iteration is the tangent predictor, and extrapolating positions and
     // rotations separately would break their compatibility in slender beams).
-    let driven = !mech.prescribed.is_empty()
-        || mech
-            .joints
-            .iter()
-            .any(|j| j.driven.iter().any(Option::is_some));
+    let driven = mech.has_drivers();
     // The state before the last converged step and that step's size.
     let mut previous: Option<(MechanismState, f64)> = None;
     while lambda < 1.0 - TOLERANCES.end_of_run {
@@ -112,6 +110,7 @@ pub fn solve_static(
         }
         prob.topo.impose(mech, &mut prob.end, target);
         mech.external_forces(target, &mut prob.fext);
+        prob.load_time = target;
         match newton::solve(&mut prob, &mut lu, &settings.newton, &mut r, &mut dq) {
             Ok(report) => {
                 if let Err(objection) = guard.accept(mech, &prob.end, target) {
@@ -121,10 +120,19 @@ pub fn solve_static(
                 }
                 let dt = target - lambda;
                 previous = Some((prob.start.clone(), dt));
+                follower += follower_work(
+                    mech,
+                    (lambda, &prob.start.config),
+                    (target, &prob.end.config),
+                );
                 lambda = target;
                 steps += 1;
                 let mut step =
                     static_record(mech, &prob.end, &prob.fext, lambda, dt, Some(&report));
+                // Follower loads have no potential: minus their work along
+                // the load path stands for it.
+                step.energy.potential -= follower;
+                step.energy.total -= follower;
                 // The stability count is of the converged iterate's tangent.
                 prob.update_tangent(&mut r);
                 step.negative_pivots = inertia.negative_eigenvalues(&prob.asm.values);

@@ -26,6 +26,7 @@ use crate::linsolve::TangentRef;
 use crate::mechanism::Mechanism;
 use crate::newton::NewtonSystem;
 use crate::record::StepRecord;
+use flexmech_core::rotation::skew;
 use flexmech_core::Configuration;
 
 /// How the joints reduce the nodal residuals to the unknowns.
@@ -102,6 +103,9 @@ pub struct ReducedSystem<'m, T> {
     pub end: MechanismState,
     /// External nodal forces of the step (6 per node).
     pub fext: Vec<f64>,
+    /// The time at which the step takes its loads (`fext` and the follower
+    /// loads; statics: the load factor).
+    pub load_time: f64,
     /// Nodal residuals `g` (internal + inertial − external) at the last
     /// evaluation.
     pub nodal: Vec<f64>,
@@ -131,6 +135,7 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
             start: state.clone(),
             end: state,
             fext: vec![0.0; 6 * nodes],
+            load_time: 0.0,
             nodal: vec![0.0; 6 * nodes],
             abs: vec![0.0; 6 * nodes],
             scratch: vec![0.0; n_eq],
@@ -189,6 +194,9 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
         let blocks = tangent.then_some((&mut self.asm, &self.topo.dofs));
         self.terms
             .inertia(start, end, &mut self.nodal, &mut self.abs, blocks);
+        if !mech.follower_loads.is_empty() {
+            self.follower_terms(reduction, tangent);
+        }
         self.reduce(&self.nodal, r);
         if tangent && joints {
             let blocks = match reduction {
@@ -205,6 +213,44 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
         let dofs = &self.topo.dofs;
         let f_ext = dofs.reduced_norm(&self.fext, &mut self.scratch);
         f_ext.max(dofs.reduced_norm(&self.abs, &mut self.scratch))
+    }
+}
+
+impl<T: StepTerms> ReducedSystem<'_, T> {
+    /// The follower loads in the nodal residual (`g −= f`) and, with
+    /// `tangent`, their load stiffness: at the end of the step
+    /// (`f = s R₁ f₀`, [`Reduction::Variation`]) or as the mean of both ends
+    /// (`½ s (R₀ + R₁) f₀`, the midpoint schemes' [`Reduction::Incremental`]);
+    /// `∂(−R₁ f₀)/∂η = (R₁ f₀)^` for a spatial spin `η` of the end rotation.
+    fn follower_terms(&mut self, reduction: Reduction, tangent: bool) {
+        let (start, end) = (&self.start.config.rot, &self.end.config.rot);
+        let w_end = match reduction {
+            Reduction::Variation => 1.0,
+            Reduction::Incremental => 0.5,
+        };
+        for l in &self.mech.follower_loads {
+            let (n, s) = (l.node, l.scale.at(self.load_time));
+            let (f1, m1) = (
+                end[n] * l.force * (s * w_end),
+                end[n] * l.moment * (s * w_end),
+            );
+            let (mut f, mut m) = (f1, m1);
+            if reduction == Reduction::Incremental {
+                f += start[n] * l.force * (0.5 * s);
+                m += start[n] * l.moment * (0.5 * s);
+            }
+            for c in 0..3 {
+                self.nodal[6 * n + c] -= f[c];
+                self.nodal[6 * n + 3 + c] -= m[c];
+                self.abs[6 * n + c] += f[c].abs();
+                self.abs[6 * n + 3 + c] += m[c].abs();
+            }
+            if tangent {
+                let dofs = &self.topo.dofs;
+                self.asm.add_node_block(dofs, (n, 0), (n, 3), &skew(&f1));
+                self.asm.add_node_block(dofs, (n, 3), (n, 3), &skew(&m1));
+            }
+        }
     }
 }
 

@@ -86,6 +86,7 @@ fn cantilever(ei: f64, force: f64) -> Model {
             force: [0.0, 0.0, -force],
             moment: [0.0; 3],
             time: None,
+            follower: false,
         }],
         distributed_loads: Vec::new(),
         prescribed: Vec::new(),

@@ -190,21 +190,22 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
             .map_err(|e| refused(model, format!("support[{i}]"), e))?;
     }
     for (i, l) in model.loads.iter().enumerate() {
-        b.load(
-            node(l.node),
-            v(l.force),
-            v(l.moment),
-            schedule(&l.time, &model.solver.analysis),
-        )
+        let scale = schedule(&l.time, &model.solver.analysis);
+        if l.follower {
+            b.follower_load(node(l.node), v(l.force), v(l.moment), scale)
+        } else {
+            b.load(node(l.node), v(l.force), v(l.moment), scale)
+        }
         .map_err(|e| refused(model, format!("load[{i}]"), e))?;
     }
     for (i, l) in model.distributed_loads.iter().enumerate() {
-        b.distributed_load(
-            &beams[l.beam],
-            v(l.force),
-            v(l.moment),
-            schedule(&l.time, &model.solver.analysis),
-        )
+        let scale = schedule(&l.time, &model.solver.analysis);
+        let beam = &beams[l.beam];
+        if l.follower {
+            b.follower_distributed_load(beam, v(l.force), v(l.moment), scale)
+        } else {
+            b.distributed_load(beam, v(l.force), v(l.moment), scale)
+        }
         .map_err(|e| refused(model, format!("distributed_load[{i}]"), e))?;
     }
     b.gravity(v(model.gravity), schedule(&None, &model.solver.analysis))

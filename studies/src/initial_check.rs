@@ -109,7 +109,12 @@ pub(crate) fn check(
     for (k, load) in model.loads.iter().enumerate() {
         let f = Vector3::from(load.force).norm() * radius;
         let m = Vector3::from(load.moment).norm();
-        let scale = mech.loads[k].scale.at(0.0).abs().max(1.0);
+        let scale = load
+            .time
+            .as_ref()
+            .map_or(1.0, |f| f.eval(0.0))
+            .abs()
+            .max(1.0);
         if !(f * scale).is_finite() || !(m * scale).is_finite() {
             return fail(format!("load[{k}]"), "the load's work".into());
         }

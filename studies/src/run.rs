@@ -174,7 +174,14 @@ impl Sink<'_> {
 /// statement (see [`Stability`]): no applied nodal moment, no prescribed
 /// nodal rotation.
 fn conservative(model: &Model) -> bool {
-    model.loads.iter().all(|l| l.moment == [0.0; 3])
+    model
+        .loads
+        .iter()
+        .all(|l| l.moment == [0.0; 3] && !l.follower)
+        && model
+            .distributed_loads
+            .iter()
+            .all(|l| l.moment == [0.0; 3] && !l.follower)
         && model.prescribed.iter().all(|p| match p {
             crate::model::PrescribedSpec::NodeDof { dof, .. } => *dof < 3,
             crate::model::PrescribedSpec::JointAngle { .. } => true,

@@ -72,8 +72,12 @@ fn distributed_load_mistakes_name_the_key() {
         e.contains("distributed_load[0]") && e.contains("`force` and/or `moment`"),
         "{e}"
     );
-    let e = err(text.replace("# per unit length", "\nfollower = true"));
-    assert!(e.contains("distributed_load[0].follower"), "{e}");
+    // `follower = true` is a follower load now (data/statics/follower_tip_force.toml).
+    let follower = parse_model(
+        &text.replace("# per unit length", "\nfollower = true"),
+        &file(),
+    );
+    assert!(follower.unwrap().distributed_loads[0].follower);
     let e = err(text.replace("# per unit length", "\nweight = 2.0"));
     assert!(e.contains("weight"), "{e}");
 }

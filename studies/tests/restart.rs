@@ -234,3 +234,22 @@ fn a_static_result_cannot_be_continued() {
     let e = restart_model(&later, &file, dir.path()).unwrap_err();
     assert!(e.to_string().contains("overwrite"), "{e}");
 }
+
+#[test]
+fn a_follower_loaded_run_continues_bit_for_bit_with_its_load_work() {
+    // The follower loads' work since t = 0 stands in the records' total
+    // energy; the restart carries it (`/restart` attribute follower_work).
+    let base = replaced(
+        &replaced(
+            &text_of("statics/follower_tip_force.toml"),
+            "analysis = \"static\"\nload_steps = 6",
+            "analysis = \"dynamic\"\nintegrator = \"energy-momentum\"\ndt = 0.005\nt_end = T_END",
+        ),
+        "follower = true                      # turns with the tip",
+        "follower = true\ntime = { expr = \"min(t/0.05, 1)\" }",
+    );
+    let short = replaced(&base, "T_END", "0.05");
+    let long = replaced(&base, "T_END", "0.1");
+    let worst = continued_vs_uninterrupted(&short, &long, &STATE);
+    assert_eq!(worst, 0.0);
+}

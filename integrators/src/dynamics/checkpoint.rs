@@ -24,6 +24,9 @@ pub struct Checkpoint {
     pub last_dt: f64,
     /// The drivers' work since t = 0.
     pub driver_work: f64,
+    /// The follower loads' work since t = 0 (see
+    /// [`follower_work`](crate::measure::follower_work)).
+    pub follower_work: f64,
     /// Step control: the step in force and its halving level, and the easy
     /// steps counted towards growing it back.
     pub step: f64,
@@ -232,6 +235,7 @@ mod tests {
             time: 0.0,
             last_dt: 0.0,
             driver_work: 0.0,
+            follower_work: 0.0,
             step: 0.1,
             level: 0,
             easy: 0,

@@ -288,7 +288,13 @@ impl TimeScheme for MidpointTerms {
     /// for these schemes (`Σ pᵢ·gᵢ = ΔH − W_loads`).
     fn finish(sys: &mut ReducedSystem<'_, Self>, dt: f64) -> f64 {
         let (start, end) = (&sys.start, &sys.end);
-        let work = increment_work(&start.config, &end.config, &sys.nodal, true);
+        // Without drivers the sum would be the free equations' residual
+        // (at the Newton tolerance), not work: exactly zero then.
+        let work = if sys.mech.has_drivers() {
+            increment_work(&start.config, &end.config, &sys.nodal, true)
+        } else {
+            0.0
+        };
         let terms = &mut sys.terms;
         let (v1, w1) = end_motion(&start.config, &end.config, &terms.v_n, &terms.w_n, dt);
         for (j, rate) in terms.rates.iter_mut().enumerate() {

@@ -32,7 +32,7 @@ use crate::assembly::Assembler;
 use crate::constraints::{initial_state, MechanismState, Topology};
 use crate::error::SolveError;
 use crate::linsolve::SparseLu;
-use crate::measure::dynamic_record;
+use crate::measure::{dynamic_record, follower_work};
 use crate::mechanism::Mechanism;
 use crate::newton::NewtonReport;
 use crate::record::StepRecord;
@@ -283,6 +283,8 @@ struct Stepper<'m, S> {
     last_dt: f64,
     /// The drivers' work since t = 0.
     driver_work: f64,
+    /// The follower loads' work since t = 0.
+    follower_work: f64,
     /// Newton's scratch.
     r: Vec<f64>,
     dq: Vec<f64>,
@@ -304,6 +306,7 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
             t: 0.0,
             last_dt: 0.0,
             driver_work: 0.0,
+            follower_work: 0.0,
             r: vec![0.0; n_eq],
             dq: vec![0.0; n_eq],
             fext_now,
@@ -346,6 +349,9 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
             report,
         );
         rec.energy.driver_work = self.driver_work;
+        // Follower loads have no potential: minus their work stands for it.
+        rec.energy.potential -= self.follower_work;
+        rec.energy.total -= self.follower_work;
         if report.is_some() {
             // The converged iterate's residual, the last one Newton evaluated.
             sys.record_reactions(&mut rec);
@@ -363,7 +369,8 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
             self.predict(dt);
             let sys = &mut self.sys;
             let mech = sys.mech;
-            mech.external_forces(sys.terms.load_time(t, dt), &mut sys.fext);
+            sys.load_time = sys.terms.load_time(t, dt);
+            mech.external_forces(sys.load_time, &mut sys.fext);
             sys.floor = mech.round_off_floor_at(&sys.start.config.x)
                 + inertia_round_off_floor(mech, sys.terms.mass(), &sys.start.config.x, dt);
             let outcome = S::solve(
@@ -387,6 +394,8 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
                 continue;
             }
             self.driver_work += S::finish(sys, dt);
+            self.follower_work +=
+                follower_work(mech, (t, &sys.start.config), (t + dt, &sys.end.config));
             self.t = self.control.advance(t, dt);
             self.last_dt = dt;
             mech.external_forces(self.t, &mut self.fext_now);
@@ -424,6 +433,7 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
             time: self.t,
             last_dt: self.last_dt,
             driver_work: self.driver_work,
+            follower_work: self.follower_work,
             step,
             level,
             easy,
@@ -465,6 +475,7 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
         self.t = c.time;
         self.last_dt = c.last_dt;
         self.driver_work = c.driver_work;
+        self.follower_work = c.follower_work;
         self.guard = RotationGuard::new(mech, &self.sys.end);
         mech.external_forces(self.t, &mut self.fext_now);
         Ok(())

@@ -150,6 +150,7 @@ pub(crate) struct RawLoad {
     pub force: Option<S<Vec3>>,
     pub moment: Option<S<Vec3>>,
     pub time: Option<S<RawTimeFn>>,
+    pub follower: Option<S<bool>>,
 }
 
 /// `[[distributed_load]]`.

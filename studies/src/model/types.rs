@@ -100,17 +100,20 @@ pub struct JointSpec {
     pub rate: f64,
 }
 
-/// A `[[load]]`: a dead force and a fixed-axis moment on a node.
+/// A `[[load]]`: a dead force and a fixed-axis moment on a node, or with
+/// `follower` a force and moment that turn with the node's triad.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoadSpec {
     /// The loaded node.
     pub node: NodeRef,
-    /// Force, global components.
+    /// Force, global components (a follower load's at t = 0).
     pub force: [f64; 3],
-    /// Moment about fixed global axes.
+    /// Moment about fixed global axes (a follower load's at t = 0).
     pub moment: [f64; 3],
     /// `None` when the file gives no `time` table.
     pub time: Option<TimeFunction>,
+    /// `follower = true`: the load turns with the node.
+    pub follower: bool,
 }
 
 /// A `[[distributed_load]]`: a dead force and a fixed-axis moment per unit
@@ -126,6 +129,8 @@ pub struct DistributedLoadSpec {
     pub moment: [f64; 3],
     /// `None` when the file gives no `time` table (as for `[[load]]`).
     pub time: Option<TimeFunction>,
+    /// `follower = true`: the load turns with the beam's triads.
+    pub follower: bool,
 }
 
 /// A `[[prescribed]]` motion.

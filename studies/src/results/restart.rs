@@ -4,7 +4,7 @@
 //!
 //! | path | shape | content |
 //! |---|---|---|
-//! | `/restart` attributes | scalars | `integrator`, `time`, `last_dt`, `driver_work`, `step`, `level`, `easy` |
+//! | `/restart` attributes | scalars | `integrator`, `time`, `last_dt`, `driver_work`, `follower_work`, `step`, `level`, `easy` |
 //! | `/restart/initial_positions` | nodes×3 | the mechanism's nodes at t = 0 (to check MODEL describes the same mechanism) |
 //! | `/restart/positions` | nodes×3 | positions |
 //! | `/restart/rotations` | nodes×3×3 | rotation matrices `R[i][row][col]` |
@@ -76,6 +76,7 @@ pub(crate) fn write(
         ("time", c.time),
         ("last_dt", c.last_dt),
         ("driver_work", c.driver_work),
+        ("follower_work", c.follower_work),
         ("step", c.step),
         ("level", c.level as f64),
         ("easy", c.easy as f64),
@@ -206,6 +207,12 @@ pub fn read_checkpoint(path: &Path) -> Result<(Checkpoint, Vec<[f64; 3]>), Resta
         time: attr("time")?,
         last_dt: attr("last_dt")?,
         driver_work: attr("driver_work")?,
+        // Absent from files written before follower loads existed.
+        follower_work: if group.attr("follower_work").is_ok() {
+            attr("follower_work")?
+        } else {
+            0.0
+        },
         step: attr("step")?,
         level: count("level")?,
         easy: count("easy")?,

@@ -112,6 +112,7 @@ impl Ctx<'_> {
                 force: l.force.as_ref().map_or([0.0; 3], |f| v3(f.get_ref())),
                 moment: l.moment.as_ref().map_or([0.0; 3], |m| v3(m.get_ref())),
                 time,
+                follower: l.follower.as_ref().is_some_and(|f| *f.get_ref()),
             });
         }
         Ok(out)
@@ -154,15 +155,6 @@ impl Ctx<'_> {
                      force = [0.0, 0.0, -1.0]",
                 ));
             }
-            if let Some(f) = l.follower.as_ref().filter(|f| *f.get_ref()) {
-                return Err(self.at(
-                    k("follower"),
-                    f,
-                    "follower distributed loads (turning with the beam) are not available \
-                     yet; write follower = false (dead load, fixed global direction) or \
-                     leave the key out",
-                ));
-            }
             let time = match &l.time {
                 Some(t) => Some(self.time_fn(t, &k("time"))?),
                 None => None,
@@ -172,6 +164,7 @@ impl Ctx<'_> {
                 force: l.force.as_ref().map_or([0.0; 3], |f| v3(f.get_ref())),
                 moment: l.moment.as_ref().map_or([0.0; 3], |m| v3(m.get_ref())),
                 time,
+                follower: l.follower.as_ref().is_some_and(|f| *f.get_ref()),
             });
         }
         Ok(out)
