@@ -4,6 +4,7 @@
 
 #![warn(missing_docs)]
 
+pub mod arc_length;
 pub mod assembly;
 pub mod band_lu;
 pub mod builder;

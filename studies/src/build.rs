@@ -46,7 +46,7 @@ fn v(a: [f64; 3]) -> Vector3<f64> {
 fn schedule(time: &Option<TimeFunction>, analysis: &Analysis) -> Schedule {
     match (time, analysis) {
         (Some(f), _) => schedule_of(f),
-        (None, Analysis::Static { .. }) => Schedule::ramp(),
+        (None, Analysis::Static { .. } | Analysis::ArcLength { .. }) => Schedule::ramp(),
         (None, Analysis::Dynamic { .. }) => Schedule::constant(1.0),
     }
 }

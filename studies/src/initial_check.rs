@@ -40,7 +40,7 @@ pub(crate) fn check(
         .fold(1.0, f64::max);
     let dt = match model.solver.analysis {
         Analysis::Dynamic { dt, .. } => Some(dt),
-        Analysis::Static { .. } => None,
+        Analysis::Static { .. } | Analysis::ArcLength { .. } => None,
     };
     // Elements, beam by beam (elements are numbered in the beams' order).
     let mut first = 0;

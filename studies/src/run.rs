@@ -9,6 +9,7 @@ use crate::results::{
     layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultWriter,
     ResultantsMeta, RunMeta,
 };
+use flexmech_integrators::arc_length::{solve_arc_length, ArcLengthSettings};
 use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
 use flexmech_integrators::{
     solve_static, Mechanism, NewtonSettings, SolveError, StaticSettings, StepRecord,
@@ -293,7 +294,7 @@ fn run(
     let meta = RunMeta {
         model_text: model.source_text.clone(),
         integrator: match model.solver.analysis {
-            Analysis::Static { .. } => "static".to_string(),
+            Analysis::Static { .. } | Analysis::ArcLength { .. } => "static".to_string(),
             Analysis::Dynamic { integrator, .. } => integrator.name().to_string(),
         },
         initial_positions: mech
@@ -370,6 +371,27 @@ fn run(
                 max_halvings: model.solver.max_halvings,
             };
             solve_static(mech, &settings, |s| {
+                sink.push(s);
+            })
+            .map(|_| ())
+        }
+        Analysis::ArcLength {
+            load_steps,
+            max_steps,
+            branch_switch,
+        } => {
+            let settings = ArcLengthSettings {
+                load_steps,
+                newton: NewtonSettings {
+                    tolerance: model.solver.tolerance,
+                    max_iterations: model.solver.max_iterations,
+                    modified: false,
+                },
+                max_halvings: model.solver.max_halvings,
+                max_steps,
+                branch_switch,
+            };
+            solve_arc_length(mech, &settings, |s| {
                 sink.push(s);
             })
             .map(|_| ())

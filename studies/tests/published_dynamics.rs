@@ -187,7 +187,7 @@ impl Run {
 fn model_integrator(model: &Model) -> &'static str {
     match model.solver.analysis {
         Analysis::Dynamic { integrator, .. } => integrator.name(),
-        Analysis::Static { .. } => "static",
+        Analysis::Static { .. } | Analysis::ArcLength { .. } => "static",
     }
 }
 

@@ -82,6 +82,7 @@ const WORDS: &[&str] = &[
     "spherical",
     "newmark",
     "generalized-alpha",
+    "arc-length",
     "energy-momentum-paper",
     "static",
     "dynamic",

@@ -235,6 +235,18 @@ impl Checker<'_> {
                 return Err(self.fail("solver.load_steps", "must be at least 1"));
             }
             Analysis::Static { .. } => {}
+            Analysis::ArcLength {
+                load_steps,
+                max_steps,
+                ..
+            } => {
+                if load_steps == 0 || max_steps == 0 {
+                    return Err(self.fail(
+                        "solver.load_steps",
+                        "arc-length control needs load_steps and max_arc_steps of at least 1",
+                    ));
+                }
+            }
             Analysis::Dynamic { dt, t_end, .. } => {
                 self.positive("solver.dt", &[dt])?;
                 self.positive("solver.t_end", &[t_end])?;

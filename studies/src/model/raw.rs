@@ -219,6 +219,9 @@ pub(crate) struct RawSolver {
     pub mass: Option<S<String>>,
     pub newton: Option<S<String>>,
     pub rho_inf: Option<S<Num>>,
+    pub control: Option<S<String>>,
+    pub max_arc_steps: Option<S<i64>>,
+    pub branch_switch: Option<S<bool>>,
 }
 
 /// `[output]`.

@@ -202,6 +202,19 @@ pub enum Analysis {
         /// Number of equal load steps.
         load_steps: usize,
     },
+    /// The static path by Crisfield's arc-length method
+    /// (`[solver] control = "arc-length"`): past limit points, the load
+    /// factor an unknown, until it reaches 1.
+    ArcLength {
+        /// The first step's load increment is `1/load_steps`; its arc
+        /// length is the path's step.
+        load_steps: usize,
+        /// Most steps before the path must reach λ = 1.
+        max_steps: usize,
+        /// `branch_switch = true`: at the first bifurcation, leave the
+        /// fundamental path along the critical mode.
+        branch_switch: bool,
+    },
     /// Time integration from 0 to `t_end`.
     Dynamic {
         /// The scheme.

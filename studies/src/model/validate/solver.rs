@@ -5,6 +5,9 @@ use crate::model::raw::{RawOutput, RawSolver, S};
 use crate::model::types::*;
 use flexmech_integrators::dynamics::generalized_alpha::DEFAULT_RHO_INF;
 
+/// `max_arc_steps` when the file gives none: this many per `load_steps`.
+const DEFAULT_ARC_STEPS_PER_LOAD_STEP: usize = 100;
+
 impl Ctx<'_> {
     pub(super) fn solver(&self, raw: Option<&S<RawSolver>>) -> Res<SolverSpec> {
         let Some(entry) = raw else {
@@ -41,6 +44,22 @@ impl Ctx<'_> {
                     "`load_steps` belongs to a static analysis, but analysis = \"dynamic\"; a \
                      dynamic analysis steps with `dt` up to `t_end`: remove `load_steps`",
                 ));
+            }
+            for (key, v) in [
+                ("control", s.control.as_ref().map(S::span)),
+                ("max_arc_steps", s.max_arc_steps.as_ref().map(S::span)),
+                ("branch_switch", s.branch_switch.as_ref().map(S::span)),
+            ] {
+                if let Some(span) = v {
+                    return Err(self.err(
+                        format!("solver.{key}"),
+                        Some(span),
+                        format!(
+                            "`{key}` belongs to a static analysis (load or arc-length control), \
+                             but analysis = \"dynamic\"; remove `{key}`"
+                        ),
+                    ));
+                }
             }
             let integrators = [
                 IntegratorKind::Newmark,
@@ -160,7 +179,52 @@ impl Ctx<'_> {
                 Some(l) => self.int_in(l, "solver.load_steps", 1, limits::MAX_LOAD_STEPS)?,
                 None => 10,
             };
-            Analysis::Static { load_steps }
+            let arc_length = match &s.control {
+                None => false,
+                Some(c) => match c.get_ref().as_str() {
+                    "load" => false,
+                    "arc-length" => true,
+                    other => {
+                        return Err(self.at(
+                            "solver.control",
+                            c,
+                            format!("expected \"load\" or \"arc-length\", found \"{other}\""),
+                        ))
+                    }
+                },
+            };
+            let branch_switch = match (&s.branch_switch, arc_length) {
+                (Some(b), false) => {
+                    return Err(self.at(
+                        "solver.branch_switch",
+                        b,
+                        "`branch_switch` belongs to control = \"arc-length\"; set it, or \
+                         remove `branch_switch`",
+                    ))
+                }
+                (b, _) => b.as_ref().is_some_and(|b| *b.get_ref()),
+            };
+            match (&s.max_arc_steps, arc_length) {
+                (Some(m), true) => Analysis::ArcLength {
+                    load_steps,
+                    max_steps: self.int_in(m, "solver.max_arc_steps", 1, limits::MAX_LOAD_STEPS)?,
+                    branch_switch,
+                },
+                (None, true) => Analysis::ArcLength {
+                    load_steps,
+                    max_steps: DEFAULT_ARC_STEPS_PER_LOAD_STEP * load_steps,
+                    branch_switch,
+                },
+                (Some(m), false) => {
+                    return Err(self.at(
+                        "solver.max_arc_steps",
+                        m,
+                        "`max_arc_steps` belongs to control = \"arc-length\"; set it, or \
+                         remove `max_arc_steps`",
+                    ))
+                }
+                (None, false) => Analysis::Static { load_steps },
+            }
         };
         let tolerance = match &s.tolerance {
             Some(t) => self.positive(t, "solver.tolerance")?,
@@ -188,42 +252,43 @@ impl Ctx<'_> {
                 }
             },
         };
-        let modified_newton =
-            match &s.newton {
-                None => false,
-                Some(m) => {
-                    match m.get_ref().as_str() {
-                        "full" => false,
-                        "modified" => match &analysis {
-                            Analysis::Static { .. } => return Err(self.at(
-                                "solver.newton",
-                                m,
-                                "modified Newton is for dynamic analyses (a static path checks \
+        let modified_newton = match &s.newton {
+            None => false,
+            Some(m) => match m.get_ref().as_str() {
+                "full" => false,
+                "modified" => match &analysis {
+                    Analysis::Static { .. } | Analysis::ArcLength { .. } => {
+                        return Err(self.at(
+                            "solver.newton",
+                            m,
+                            "modified Newton is for dynamic analyses (a static path checks \
                              the stability of every converged state with its exact tangent); \
                              remove `newton` or set it to \"full\"",
-                            )),
-                            Analysis::Dynamic {
-                                integrator: IntegratorKind::EnergyMomentumPaper,
-                                ..
-                            } => return Err(self.at(
-                                "solver.newton",
-                                m,
-                                "the paper's energy-momentum scheme solves a bordered system with \
+                        ))
+                    }
+                    Analysis::Dynamic {
+                        integrator: IntegratorKind::EnergyMomentumPaper,
+                        ..
+                    } => {
+                        return Err(self.at(
+                            "solver.newton",
+                            m,
+                            "the paper's energy-momentum scheme solves a bordered system with \
                              the exact tangent at every iterate; use newton = \"full\", or \
                              integrator = \"energy-momentum\"",
-                            )),
-                            Analysis::Dynamic { .. } => true,
-                        },
-                        other => {
-                            return Err(self.at(
-                                "solver.newton",
-                                m,
-                                format!("expected \"full\" or \"modified\", found \"{other}\""),
-                            ))
-                        }
+                        ))
                     }
+                    Analysis::Dynamic { .. } => true,
+                },
+                other => {
+                    return Err(self.at(
+                        "solver.newton",
+                        m,
+                        format!("expected \"full\" or \"modified\", found \"{other}\""),
+                    ))
                 }
-            };
+            },
+        };
         Ok(SolverSpec {
             analysis,
             tolerance,
