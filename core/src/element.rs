@@ -193,7 +193,49 @@ impl<const N: usize> BeamElement<N> {
         x: &[Vector3<f64>; N],
         rot: &[Matrix3<f64>; N],
     ) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
-        assert_eq!(D, 6 * N, "residual_tangent_ad: D must be 6N");
+        self.gradient_hessian_ad(x, rot, |xd, rd| self.energy(xd, rd))
+    }
+
+    /// Kelvin–Voigt damping of a step, as a pseudo-potential of the end
+    /// configuration: `ψ = Σ_g w_g (L/2) ½ c (ΔΓ·C_N ΔΓ + ΔK·C_M ΔK)` with
+    /// `Δ` the change of the strains from `start` (the step's first
+    /// configuration) and `c = η/Δt` (`η` the section's damping time). Its
+    /// gradient is the damping force `Bᵀ η C (Δε/Δt)` — the resultants
+    /// `η C ε̇` with the step's strain rate `Δε/Δt` — and `2ψ` the energy
+    /// the damping dissipates over the step (FORMULATION §4.7).
+    pub fn damping_potential<T: Scalar>(
+        &self,
+        x: &[Vector3<T>; N],
+        rot: &[Matrix3<T>; N],
+        start: &[Strains<f64>; 2],
+        c: f64,
+    ) -> T {
+        let cn = self.section.c_n.map(cst::<T>);
+        let cm = self.section.c_m.map(cst::<T>);
+        let s = self.strains(x, rot);
+        let mut e = T::zero();
+        for (g, &(_, w)) in reduced_gauss(N).iter().enumerate() {
+            let dg = s[g].0 - start[g].0.map(cst::<T>);
+            let dk = s[g].1 - start[g].1.map(cst::<T>);
+            e += (dg.component_mul(&cn).dot(&dg) + dk.component_mul(&cm).dot(&dk))
+                * cst::<T>(0.25 * w * self.length * c);
+        }
+        e
+    }
+
+    /// Gradient and Hessian of a scalar function `f` of the element's nodes
+    /// under spatial increments, with hyper-dual numbers (see
+    /// [`Self::residual_tangent_ad`]).
+    pub fn gradient_hessian_ad<const D: usize>(
+        &self,
+        x: &[Vector3<f64>; N],
+        rot: &[Matrix3<f64>; N],
+        f: impl Fn(
+            &[Vector3<HyperDualSVec64<D, D>>; N],
+            &[Matrix3<HyperDualSVec64<D, D>>; N],
+        ) -> HyperDualSVec64<D, D>,
+    ) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
+        assert_eq!(D, 6 * N, "gradient_hessian_ad: D must be 6N");
         type H<const D: usize> = HyperDualSVec64<D, D>;
         let e1 = |k: usize| H::<D>::from_re(0.0).derivative1(k);
         let e2 = |k: usize| H::<D>::from_re(0.0).derivative2(k);
@@ -203,7 +245,7 @@ impl<const N: usize> BeamElement<N> {
         let rd: [Matrix3<H<D>>; N] = std::array::from_fn(|i| {
             exp(&v(&e1, 6 * i + 3)) * exp(&v(&e2, 6 * i + 3)) * rot[i].map(H::<D>::from_re)
         });
-        let e = self.energy(&xd, &rd);
+        let e = f(&xd, &rd);
         (
             e.eps1.unwrap_generic(Const::<D>, U1),
             e.eps1eps2.unwrap_generic(Const::<D>, Const::<D>),

@@ -183,6 +183,25 @@ impl Element {
         }
     }
 
+    /// Kelvin–Voigt damping over a step from `start` to `end` (global
+    /// configurations) with `c = η/Δt`: the damping force (`6N`) into `r`,
+    /// its tangent under the end configuration's increments (`6N × 6N`,
+    /// column-major) into `k`; returns the energy dissipated over the step,
+    /// `2ψ` (see [`BeamElement::damping_potential`]).
+    pub fn damping_residual_tangent(
+        &self,
+        start: (&[Vector3<f64>], &[Matrix3<f64>]),
+        end: (&[Vector3<f64>], &[Matrix3<f64>]),
+        c: f64,
+        r: &mut [f64],
+        k: &mut [f64],
+    ) -> f64 {
+        match self {
+            Element::Linear(e) => damping_of(e, start, end, c, r, k),
+            Element::Quadratic(e) => damping_of(e, start, end, c, r, k),
+        }
+    }
+
     /// Residual (internal force, `6N`) and tangent (`6N × 6N`, column-major)
     /// in a global configuration, written into `r` and `k`.
     pub fn residual_tangent(
@@ -207,6 +226,39 @@ impl Element {
             }
         }
     }
+}
+
+/// [`Element::damping_residual_tangent`] for an element of `N` nodes
+/// (`6N` = 12 or 18 hyper-dual lanes).
+fn damping_of<const N: usize>(
+    e: &BeamElement<N>,
+    start: (&[Vector3<f64>], &[Matrix3<f64>]),
+    end: (&[Vector3<f64>], &[Matrix3<f64>]),
+    c: f64,
+    r: &mut [f64],
+    k: &mut [f64],
+) -> f64 {
+    let (xs, rs) = gather(&e.nodes, start.0, start.1);
+    let strains0 = e.strains(&xs, &rs);
+    let (xe, re) = gather(&e.nodes, end.0, end.1);
+    let psi: f64 = e.damping_potential(&xe, &re, &strains0, c);
+    match N {
+        2 => {
+            let (g, h) = e.gradient_hessian_ad::<12>(&xe, &re, |x, q| {
+                e.damping_potential(x, q, &strains0, c)
+            });
+            r.copy_from_slice(g.as_slice());
+            k.copy_from_slice(h.as_slice());
+        }
+        _ => {
+            let (g, h) = e.gradient_hessian_ad::<18>(&xe, &re, |x, q| {
+                e.damping_potential(x, q, &strains0, c)
+            });
+            r.copy_from_slice(g.as_slice());
+            k.copy_from_slice(h.as_slice());
+        }
+    }
+    2.0 * psi
 }
 
 fn gather<const N: usize>(

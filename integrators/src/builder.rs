@@ -614,6 +614,30 @@ impl MechanismBuilder {
         Ok(shares)
     }
 
+    /// Kelvin–Voigt structural damping on every element of `beam`: stress
+    /// resultants `C(ε + η ε̇)` with the damping time `eta` (seconds; 0:
+    /// undamped). Newmark and generalized-α take it; the midpoint schemes
+    /// refuse it.
+    pub fn damping(&mut self, beam: &Beam, eta: f64) -> Result<(), BuildError> {
+        finite(|| "damping time".into(), &[eta])?;
+        if eta < 0.0 {
+            return Err(BuildError::NotFinite {
+                what: "damping time (must be >= 0)".into(),
+                value: eta,
+            });
+        }
+        let count = self.mech.mesh.elements.len();
+        if self.mech.damping.len() < count {
+            self.mech.damping.resize(count, 0.0);
+        }
+        for e in beam.elements.clone() {
+            if let Some(d) = self.mech.damping.get_mut(e) {
+                *d = eta;
+            }
+        }
+        Ok(())
+    }
+
     /// Gravity acceleration `g` (acting on ρA), scaled by `scale(t)`.
     pub fn gravity(&mut self, g: Vector3<f64>, scale: Schedule) -> Result<(), BuildError> {
         finite(|| "gravity".into(), &g)?;

@@ -94,6 +94,7 @@ pub fn static_record(
             potential,
             total: strain + potential,
             driver_work: 0.0,
+            dissipated: 0.0,
         },
         negative_pivots: None,
         momentum_linear: [0.0; 3],

@@ -179,6 +179,10 @@ pub struct Mechanism {
     pub prescribed: Vec<PrescribedDof>,
     /// Rigid bodies and point masses.
     pub bodies: Vec<RigidBody>,
+    /// Kelvin–Voigt damping time `η` of each element (resultants
+    /// `C(ε + η ε̇)`; missing entries and 0: undamped). Newmark and
+    /// generalized-α take it (FORMULATION §4.7).
+    pub damping: Vec<f64>,
 }
 
 impl Mechanism {
@@ -196,7 +200,18 @@ impl Mechanism {
             joints: Vec::new(),
             prescribed: Vec::new(),
             bodies: Vec::new(),
+            damping: Vec::new(),
         }
+    }
+
+    /// The damped elements: `(element index, η)` for every `η > 0`.
+    pub fn damped_elements(&self) -> Vec<(usize, f64)> {
+        self.damping
+            .iter()
+            .enumerate()
+            .filter(|(e, &eta)| eta > 0.0 && *e < self.mesh.elements.len())
+            .map(|(e, &eta)| (e, eta))
+            .collect()
     }
 
     /// Whether anything drives the mechanism: a driven joint coordinate or

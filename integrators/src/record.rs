@@ -8,7 +8,9 @@ pub struct Energies {
     pub kinetic: f64,
     /// Strain energy `Π = ½∫(Γ·C_N Γ + K·C_M K) ds`.
     pub strain: f64,
-    /// Potential of gravity and of dead external loads (`−Σ f·u`).
+    /// Potential of gravity and of dead external loads (`−Σ f·u`); minus
+    /// the follower loads' work and plus the damping's dissipation since
+    /// t = 0 stand for the potential those forces do not have.
     pub potential: f64,
     /// `kinetic + strain + potential`.
     pub total: f64,
@@ -17,6 +19,9 @@ pub struct Energies {
     /// reactions' work). With drivers `total − driver_work` is the conserved
     /// quantity of a conservative system. Zero in statics.
     pub driver_work: f64,
+    /// Energy dissipated by structural damping since t = 0 (included in
+    /// `potential` and `total`).
+    pub dissipated: f64,
 }
 
 /// State of one joint at the end of a step.

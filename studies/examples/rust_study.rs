@@ -64,6 +64,7 @@ fn cantilever(ei: f64, force: f64) -> Model {
                 rho_a: 0.0,
                 rho_j: [0.0; 3],
             },
+            damping: 0.0,
         }],
         beams: vec![BeamSpec {
             name: "beam".into(),

@@ -177,6 +177,29 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
                 section: s.values,
             })
             .map_err(|e| refused(model, format!("beam[{i}]"), e))?;
+        if s.damping > 0.0 {
+            if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
+                if !matches!(
+                    integrator,
+                    IntegratorKind::Newmark | IntegratorKind::GeneralizedAlpha { .. }
+                ) {
+                    return Err(ModelError::new(
+                        &model.path,
+                        format!("section[{}].damping", beam.section),
+                        None,
+                        format!(
+                            "structural damping runs with integrator = \"newmark\" or \
+                             \"generalized-alpha\", not \"{}\" (the midpoint schemes' \
+                             conservation statements have no place for it); change the \
+                             integrator or remove `damping`",
+                            integrator.name()
+                        ),
+                    ));
+                }
+            }
+            b.damping(&nodes, s.damping)
+                .map_err(|e| refused(model, format!("section[{}].damping", beam.section), e))?;
+        }
         beam_nodes.push(nodes.nodes().to_vec());
         beams.push(nodes);
     }

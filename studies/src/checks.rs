@@ -73,7 +73,7 @@ impl Balance {
             }
         }
         let e = &s.energy;
-        let b = e.kinetic + e.strain - self.load_work - e.driver_work;
+        let b = e.kinetic + e.strain - self.load_work - e.driver_work + e.dissipated;
         let b0 = *self.first.get_or_insert(b);
         let off = if self.dissipative {
             (b - b0).max(0.0)

@@ -368,6 +368,7 @@ fn record(step: usize) -> StepRecord {
             potential: -10.0 * t,
             total: 50.0 * t * t - 10.0 * t,
             driver_work: 0.0,
+            dissipated: 0.0,
         },
         momentum_linear: [0.0; 3],
         momentum_angular: [0.0; 3],

@@ -253,3 +253,23 @@ fn a_follower_loaded_run_continues_bit_for_bit_with_its_load_work() {
     let worst = continued_vs_uninterrupted(&short, &long, &STATE);
     assert_eq!(worst, 0.0);
 }
+
+#[test]
+fn a_damped_run_continues_bit_for_bit_with_its_dissipation() {
+    // The energy dissipated so far is part of the generalized-α scheme's
+    // saved values and of the records' total energy.
+    let base = replaced(
+        &replaced(
+            &text_of("dynamics/damped_oscillator.toml"),
+            "integrator = \"newmark\"",
+            "integrator = \"generalized-alpha\"",
+        ),
+        "t_end = 1.0",
+        "t_end = T_END",
+    );
+    let short = replaced(&base, "T_END", "0.05");
+    let long = replaced(&base, "T_END", "0.1");
+    let mut sets = STATE.to_vec();
+    sets.push("/energy/dissipated");
+    assert_eq!(continued_vs_uninterrupted(&short, &long, &sets), 0.0);
+}

@@ -125,6 +125,7 @@ fn record(step: usize) -> StepRecord {
             potential: -k,
             total: 11.0 + k,
             driver_work: 0.25 * k,
+            dissipated: 0.0,
         },
         momentum_linear: [k, 2.0 * k, 3.0 * k],
         momentum_angular: [-k, 0.5, k * k],

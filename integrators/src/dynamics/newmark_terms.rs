@@ -16,7 +16,7 @@ use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::system::{ReducedSystem, Reduction, StepTerms};
 use flexmech_core::rotation::log;
-use flexmech_core::{Configuration, Inertia};
+use flexmech_core::{Configuration, Element, Inertia};
 use nalgebra::{Matrix3, Vector3};
 
 /// The coefficients of a Newmark-family scheme: Newmark's `β`, `γ` and the
@@ -150,6 +150,10 @@ fn inertial_moment<T: flexmech_core::Scalar>(
 /// `Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁)` with their tangents, joints through `N`.
 pub(crate) struct NewmarkTerms {
     coefficients: Coefficients,
+    /// The damped elements and their damping times `η`.
+    damped: Vec<(Element, f64)>,
+    /// Energy dissipated by damping since t = 0.
+    dissipated: f64,
     inertia: Inertia,
     slots: MassSlots,
     /// Velocities and accelerations at the start of the step.
@@ -182,8 +186,15 @@ impl NewmarkTerms {
         let residual: Vec<f64> = asm.nodal.iter().zip(&fext).map(|(a, b)| a - b).collect();
         let (v, w) = slave_velocities(mech, topo, state, initial);
         let (a, alpha) = initial_accelerations(mech, topo, &inertia, asm, lu, state, &residual);
+        let damped = mech
+            .damped_elements()
+            .into_iter()
+            .map(|(e, eta)| (mech.mesh.elements[e].clone(), eta))
+            .collect();
         Self {
             coefficients,
+            damped,
+            dissipated: 0.0,
             inertia,
             slots,
             prev: Kinematics {
@@ -196,6 +207,51 @@ impl NewmarkTerms {
             },
             dt: f64::NAN,
             reactions: None,
+        }
+    }
+}
+
+impl NewmarkTerms {
+    /// The Kelvin–Voigt damping forces of the step `start → end` in the
+    /// nodal residual `g` (magnitudes in `abs`) and, with `tangent`, their
+    /// element tangents through the node maps.
+    fn add_damping(
+        &self,
+        start: &Configuration,
+        end: &Configuration,
+        g: &mut [f64],
+        abs: &mut [f64],
+        mut tangent: Option<(&mut Assembler, &DofMap)>,
+    ) {
+        for (e, eta) in &self.damped {
+            let nodes = e.nodes();
+            let n = 6 * nodes.len();
+            let (mut r, mut k) = (vec![0.0; n], vec![0.0; n * n]);
+            e.damping_residual_tangent(
+                (&start.x, &start.rot),
+                (&end.x, &end.rot),
+                eta / self.dt,
+                &mut r,
+                &mut k,
+            );
+            for (a, &na) in nodes.iter().enumerate() {
+                for c in 0..6 {
+                    g[6 * na + c] += r[6 * a + c];
+                    abs[6 * na + c] += r[6 * a + c].abs();
+                }
+            }
+            if let Some((asm, dofs)) = tangent.as_mut() {
+                for (a, &na) in nodes.iter().enumerate() {
+                    for (b, &nb) in nodes.iter().enumerate() {
+                        for (ra, cb) in [(0, 0), (0, 3), (3, 0), (3, 3)] {
+                            // Column-major n × n: entry (row, col) at col·n + row.
+                            let block =
+                                Matrix3::from_fn(|i, j| k[(6 * b + cb + j) * n + 6 * a + ra + i]);
+                            asm.add_node_block(dofs, (na, ra), (nb, cb), &block);
+                        }
+                    }
+                }
+            }
         }
     }
 }
@@ -214,6 +270,11 @@ impl StepTerms for NewmarkTerms {
         tangent: Option<(&mut Assembler, &DofMap)>,
     ) {
         let (dt, prev, k) = (self.dt, &self.prev, &self.coefficients);
+        let mut tangent = tangent;
+        if !self.damped.is_empty() {
+            let blocks = tangent.as_mut().map(|(asm, dofs)| (&mut **asm, *dofs));
+            self.add_damping(start, end, g, abs, blocks);
+        }
         // Translational inertia M q̈ₙ₊₁ from the pseudo-acceleration
         // aₙ₊₁ = (u − Δt vₙ − Δt²(½−β)aₙ)/(βΔt²); rotational
         // Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), its tangent by AD in a spin of Rₙ₊₁.
@@ -260,6 +321,10 @@ impl TimeScheme for NewmarkTerms {
         &self.inertia
     }
 
+    fn dissipated(&self) -> f64 {
+        self.dissipated
+    }
+
     /// `v, a, W, A`, the step size, and the drivers' reactions at the last
     /// accepted state (flag 1 and per joint then prescribed, or flag 0); the
     /// generalized-α scheme then adds `ρ∞` and the accelerations `q̈`, `Ȧ`
@@ -284,6 +349,9 @@ impl TimeScheme for NewmarkTerms {
             tape.put(rho_inf);
             tape.put_vectors(&self.prev.acc);
             tape.put_vectors(&self.prev.ang_acc);
+        }
+        if !self.damped.is_empty() {
+            tape.put(self.dissipated);
         }
     }
 
@@ -326,6 +394,9 @@ impl TimeScheme for NewmarkTerms {
             acc,
             ang_acc,
         };
+        if !self.damped.is_empty() {
+            self.dissipated = tape.take()?;
+        }
         tape.done()
     }
 
@@ -338,6 +409,23 @@ impl TimeScheme for NewmarkTerms {
         let work = driver_increment_work(sys.mech, &sys.start, &sys.end, &r_start, &r_end);
         sys.terms.reactions = Some(r_end);
         let (start, end) = (&sys.start.config, &sys.end.config);
+        let damping: f64 = sys
+            .terms
+            .damped
+            .iter()
+            .map(|(e, eta)| {
+                let n = 6 * e.nodes().len();
+                let (mut r, mut kk) = (vec![0.0; n], vec![0.0; n * n]);
+                e.damping_residual_tangent(
+                    (&start.x, &start.rot),
+                    (&end.x, &end.rot),
+                    eta / dt,
+                    &mut r,
+                    &mut kk,
+                )
+            })
+            .sum();
+        sys.terms.dissipated += damping;
         let (kin, k) = (&mut sys.terms.prev, &sys.terms.coefficients);
         for i in 0..start.x.len() {
             let a1 = pseudo_acceleration(k, end.x[i] - start.x[i], &kin.v[i], &kin.a[i], dt);

@@ -96,6 +96,13 @@ impl<'m> Simulation<'m> {
                 "dt and t_end must be positive".into(),
             ));
         }
+        if scheme_refuses_damping(integrator) && !mech.damped_elements().is_empty() {
+            return Err(SolveError::InvalidMechanism(format!(
+                "structural damping runs with integrator \"newmark\" or \"generalized-alpha\", \
+                 not \"{}\"",
+                integrator.name()
+            )));
+        }
         let scheme = match integrator {
             Integrator::Newmark => None,
             Integrator::GeneralizedAlpha { rho_inf } => {
@@ -244,6 +251,15 @@ impl<'m> Simulation<'m> {
     }
 }
 
+/// Whether `integrator` cannot take structural damping (the midpoint
+/// schemes: their conservation statements have no place for it yet).
+fn scheme_refuses_damping(integrator: Integrator) -> bool {
+    !matches!(
+        integrator,
+        Integrator::Newmark | Integrator::GeneralizedAlpha { .. }
+    )
+}
+
 /// Runs `integrator` from `initial` to `t_end`, reporting the record at
 /// t = 0 and after every converged step; returns the final configuration.
 pub fn solve(
@@ -349,9 +365,12 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
             report,
         );
         rec.energy.driver_work = self.driver_work;
-        // Follower loads have no potential: minus their work stands for it.
-        rec.energy.potential -= self.follower_work;
-        rec.energy.total -= self.follower_work;
+        // Follower loads and damping have no potential: minus the follower
+        // work and plus the dissipated energy stand for it.
+        let dissipated = sys.terms.dissipated();
+        rec.energy.dissipated = dissipated;
+        rec.energy.potential += dissipated - self.follower_work;
+        rec.energy.total += dissipated - self.follower_work;
         if report.is_some() {
             // The converged iterate's residual, the last one Newton evaluated.
             sys.record_reactions(&mut rec);

@@ -34,6 +34,12 @@ pub(crate) trait TimeScheme: StepTerms + Sized {
     /// The mechanism's mass.
     fn mass(&self) -> &Inertia;
 
+    /// Energy dissipated by structural damping since t = 0 (schemes that
+    /// take damping).
+    fn dissipated(&self) -> f64 {
+        0.0
+    }
+
     /// Solves the step from the predicted iterate `sys.end`; returns the
     /// Newton report and the record's `beta` (NaN: none). `r` and `dq` are
     /// scratch of length `n_eq`.

@@ -84,6 +84,11 @@ impl Checker<'_> {
 
     fn sections_and_beams(&self) -> Res {
         for (i, s) in self.model.sections.iter().enumerate() {
+            let key = format!("section[{i}].damping");
+            self.finite(&key, &[s.damping])?;
+            if s.damping < 0.0 {
+                return Err(self.fail(key, format!("must be >= 0, found {}", s.damping)));
+            }
             // The builder's own check of the values, named by the model key.
             if let Err((what, value)) = s.values.section() {
                 let key = match what {

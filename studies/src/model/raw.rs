@@ -95,6 +95,7 @@ pub(crate) struct RawSection {
     pub rho_a: Option<S<Num>>,
     #[serde(rename = "rhoJ")]
     pub rho_j: Option<S<Vec3>>,
+    pub damping: Option<S<Num>>,
 }
 
 /// `[[beam]]`.

@@ -38,6 +38,8 @@ pub struct SectionSpec {
     pub name: String,
     /// Its values (`rho_a` 0 allowed in statics).
     pub values: SectionValues,
+    /// Kelvin–Voigt damping time `η` (`damping`, seconds; 0: undamped).
+    pub damping: f64,
 }
 
 /// Initial geometry of a beam: the builder's [`BeamShape`](flexmech_integrators::builder::BeamShape),

@@ -114,6 +114,9 @@ pub const ENERGY_POTENTIAL: &str = "/energy/potential";
 pub const ENERGY_TOTAL: &str = "/energy/total";
 /// T: work done by driven joint coordinates and prescribed DOFs since t = 0.
 pub const ENERGY_DRIVER_WORK: &str = "/energy/driver_work";
+/// T: energy dissipated by structural damping since t = 0 (zero without
+/// damping; included in `/energy/potential` and `/energy/total`).
+pub const ENERGY_DISSIPATED: &str = "/energy/dissipated";
 
 /// Group of the momentum datasets.
 pub const MOMENTUM: &str = "/momentum";

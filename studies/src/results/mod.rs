@@ -19,6 +19,7 @@
 //! | `/time` | T | time of each step (statics: load factor) |
 //! | `/energy/kinetic`, `/energy/strain`, `/energy/potential`, `/energy/total` | T | energies |
 //! | `/energy/driver_work` | T | work done by driven joint coordinates and prescribed DOFs since t = 0 (extension) |
+//! | `/energy/dissipated` | T | energy dissipated by structural damping since t = 0, included in potential and total (extension) |
 //! | `/momentum/linear`, `/momentum/angular` | T×3 | total momenta (angular about the origin) |
 //! | `/solver/iterations` | T, `u64` | Newton iterations of the step |
 //! | `/solver/factorizations` | T, `u64` | *extension:* tangent factorisations of the step (fewer than the iterations with `newton = "modified"`) |

@@ -355,6 +355,7 @@ struct Datasets {
     potential: Series,
     total: Series,
     driver_work: Series,
+    dissipated: Series,
     momentum_linear: Series,
     momentum_angular: Series,
     iterations: Series,
@@ -569,6 +570,11 @@ impl ResultWriter {
             names::ENERGY_DRIVER_WORK,
             &[],
             "work done by driven joint coordinates and prescribed DOFs since t = 0",
+        )?;
+        let dissipated = f64s(
+            names::ENERGY_DISSIPATED,
+            &[],
+            "energy dissipated by structural damping since t = 0 (in potential and total)",
         )?;
         let momentum_linear = f64s(names::MOMENTUM_LINEAR, &[3], "total linear momentum")?;
         let momentum_angular = f64s(
@@ -822,6 +828,7 @@ impl ResultWriter {
             potential,
             total,
             driver_work,
+            dissipated,
             momentum_linear,
             momentum_angular,
             iterations,
@@ -923,6 +930,7 @@ impl ResultWriter {
         s.total.push_scalar(t, step.energy.total, path)?;
         s.driver_work
             .push_scalar(t, step.energy.driver_work, path)?;
+        s.dissipated.push_scalar(t, step.energy.dissipated, path)?;
         s.momentum_linear.push_row(t, step.momentum_linear, path)?;
         s.momentum_angular
             .push_row(t, step.momentum_angular, path)?;

@@ -64,6 +64,10 @@ impl Ctx<'_> {
                     rho_a,
                     rho_j,
                 },
+                damping: match &s.damping {
+                    Some(v) => self.non_negative(v, &k("damping"))?,
+                    None => 0.0,
+                },
             });
         }
         Ok(out)
