@@ -493,11 +493,7 @@ impl MechanismBuilder {
         moment: Vector3<f64>,
         scale: Schedule,
     ) -> Result<(), BuildError> {
-        let n = self.check(node)?;
-        finite(
-            || format!("load on node {n}: force, moment"),
-            force.iter().chain(&moment),
-        )?;
+        let n = self.checked_load(node, "load", &force, &moment)?;
         self.mech.loads.push(NodalLoad {
             node: n,
             force,
@@ -505,6 +501,22 @@ impl MechanismBuilder {
             scale,
         });
         Ok(())
+    }
+
+    /// The node of a `what` load, after checking it and the load's numbers.
+    fn checked_load(
+        &self,
+        node: NodeId,
+        what: &str,
+        force: &Vector3<f64>,
+        moment: &Vector3<f64>,
+    ) -> Result<usize, BuildError> {
+        let n = self.check(node)?;
+        finite(
+            || format!("{what} on node {n}: force, moment"),
+            force.iter().chain(moment),
+        )?;
+        Ok(n)
     }
 
     /// A load field of the user's: `f(t, out)` adds nodal forces and
@@ -524,11 +536,7 @@ impl MechanismBuilder {
         moment: Vector3<f64>,
         scale: Schedule,
     ) -> Result<(), BuildError> {
-        let n = self.check(node)?;
-        finite(
-            || format!("follower load on node {n}: force, moment"),
-            force.iter().chain(&moment),
-        )?;
+        let n = self.checked_load(node, "follower load", &force, &moment)?;
         self.mech.follower_loads.push(FollowerLoad {
             node: n,
             force,

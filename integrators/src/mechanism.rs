@@ -259,14 +259,7 @@ impl Mechanism {
     /// loads: long meshes of short, axially stiff elements far from the
     /// origin have the highest floors.
     pub fn round_off_floor_at(&self, positions: &[Vector3<f64>]) -> f64 {
-        let radius = 2.0
-            * self
-                .mesh
-                .positions
-                .iter()
-                .chain(positions)
-                .map(|x| x.norm())
-                .fold(0.0, f64::max);
+        let radius = self.size_at(positions);
         let sum: f64 = self
             .mesh
             .elements
@@ -287,6 +280,18 @@ impl Mechanism {
                 out[6 * l.node + 3 + c] += m[c];
             }
         }
+    }
+
+    /// The mechanism's size for round-off estimates: twice the largest
+    /// distance from the origin of a node, initially or at `positions`.
+    pub fn size_at(&self, positions: &[Vector3<f64>]) -> f64 {
+        2.0 * self
+            .mesh
+            .positions
+            .iter()
+            .chain(positions)
+            .map(|x| x.norm())
+            .fold(0.0, f64::max)
     }
 
     /// External nodal forces and moments at time `t` (6 per node:

@@ -122,14 +122,7 @@ pub(crate) fn inertia_round_off_floor(
     positions: &[Vector3<f64>],
     dt: f64,
 ) -> f64 {
-    let radius = 2.0
-        * mech
-            .mesh
-            .positions
-            .iter()
-            .chain(positions)
-            .map(|x| x.norm())
-            .fold(0.0, f64::max);
+    let radius = mech.size_at(positions);
     let translational: f64 =
         inertia.mass.iter().map(|&(_, _, m)| m * m).sum::<f64>() * radius * radius;
     let rotational: f64 = inertia.rotational.iter().map(|j| j.norm_squared()).sum();
