@@ -163,8 +163,9 @@ impl Stability {
                 "stability: the equilibrium is unstable from load factor {lambda:.4} on (up to \
                  {most} negative eigenvalue(s) of the tangent, /solver/negative_pivots): the \
                  path followed is past a bifurcation or limit point, where the real structure \
-                 would buckle or snap; add a small imperfection (a load or geometry \
-                 perturbation) to follow the buckled branch"
+                 would buckle or snap; to follow the buckled branch use control = \
+                 \"arc-length\" with branch_switch = true, or add a small imperfection (a load \
+                 or geometry perturbation)"
             ));
         }
         self.undefined.map(|lambda| {
