@@ -202,6 +202,21 @@ impl Element {
         }
     }
 
+    /// The energy Kelvin–Voigt damping dissipates over a step from `start`
+    /// to `end` with `c = η/Δt`: `2ψ` of [`BeamElement::damping_potential`]
+    /// (the value alone, no derivatives).
+    pub fn damping_dissipation(
+        &self,
+        start: (&[Vector3<f64>], &[Matrix3<f64>]),
+        end: (&[Vector3<f64>], &[Matrix3<f64>]),
+        c: f64,
+    ) -> f64 {
+        match self {
+            Element::Linear(e) => dissipation_of(e, start, end, c),
+            Element::Quadratic(e) => dissipation_of(e, start, end, c),
+        }
+    }
+
     /// Residual (internal force, `6N`) and tangent (`6N × 6N`, column-major)
     /// in a global configuration, written into `r` and `k`.
     pub fn residual_tangent(
@@ -258,6 +273,19 @@ fn damping_of<const N: usize>(
             k.copy_from_slice(h.as_slice());
         }
     }
+    2.0 * psi
+}
+
+/// [`Element::damping_dissipation`] for an element of `N` nodes.
+fn dissipation_of<const N: usize>(
+    e: &BeamElement<N>,
+    start: (&[Vector3<f64>], &[Matrix3<f64>]),
+    end: (&[Vector3<f64>], &[Matrix3<f64>]),
+    c: f64,
+) -> f64 {
+    let (xs, rs) = gather(&e.nodes, start.0, start.1);
+    let (xe, re) = gather(&e.nodes, end.0, end.1);
+    let psi: f64 = e.damping_potential(&xe, &re, &e.strains(&xs, &rs), c);
     2.0 * psi
 }
 

@@ -189,6 +189,16 @@ fn conservative(model: &Model) -> bool {
         })
 }
 
+/// Full Newton with the model's tolerance and iteration limit (statics
+/// checks the stability of every converged state with its exact tangent).
+fn static_newton(model: &Model) -> NewtonSettings {
+    NewtonSettings {
+        tolerance: model.solver.tolerance,
+        max_iterations: model.solver.max_iterations,
+        modified: false,
+    }
+}
+
 /// Runs `model` and writes `out_dir/<name>.h5`.
 pub fn run_model(model: &Model, out_dir: &Path) -> Result<RunSummary, RunError> {
     run_model_to(model, &out_dir.join(format!("{}.h5", model.name)))
@@ -363,11 +373,7 @@ fn run(
         Analysis::Static { load_steps } => {
             let settings = StaticSettings {
                 load_steps,
-                newton: NewtonSettings {
-                    tolerance: model.solver.tolerance,
-                    max_iterations: model.solver.max_iterations,
-                    modified: false,
-                },
+                newton: static_newton(model),
                 max_halvings: model.solver.max_halvings,
             };
             solve_static(mech, &settings, |s| {
@@ -382,11 +388,7 @@ fn run(
         } => {
             let settings = ArcLengthSettings {
                 load_steps,
-                newton: NewtonSettings {
-                    tolerance: model.solver.tolerance,
-                    max_iterations: model.solver.max_iterations,
-                    modified: false,
-                },
+                newton: static_newton(model),
                 max_halvings: model.solver.max_halvings,
                 max_steps,
                 branch_switch,

@@ -414,15 +414,7 @@ impl TimeScheme for NewmarkTerms {
             .damped
             .iter()
             .map(|(e, eta)| {
-                let n = 6 * e.nodes().len();
-                let (mut r, mut kk) = (vec![0.0; n], vec![0.0; n * n]);
-                e.damping_residual_tangent(
-                    (&start.x, &start.rot),
-                    (&end.x, &end.rot),
-                    eta / dt,
-                    &mut r,
-                    &mut kk,
-                )
+                e.damping_dissipation((&start.x, &start.rot), (&end.x, &end.rot), eta / dt)
             })
             .sum();
         sys.terms.dissipated += damping;
