@@ -79,7 +79,7 @@ pub(crate) fn series<T: Scalar>(x: T, c: &[f64]) -> T {
 }
 
 /// Coefficients `(sin ψ/ψ, (1 − cos ψ)/ψ², (ψ − sin ψ)/ψ³)` as functions of `ψ² = |ψ|²`.
-fn rodrigues_coefficients<T: Scalar>(t2: T) -> (T, T, T) {
+pub(crate) fn rodrigues_coefficients<T: Scalar>(t2: T) -> (T, T, T) {
     if t2.value() < SERIES_LIMIT {
         let a = series(
             t2,
