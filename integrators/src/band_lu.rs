@@ -174,15 +174,19 @@ impl BandLu {
                 }
             }
             let pivot = ab[col];
-            for i in 1..=km {
-                ab[col + i] /= pivot;
-            }
+            ab[col + 1..=col + km].iter_mut().for_each(|v| *v /= pivot);
+            // Rank-one update of columns j+1..=ju, on slices (vectorised):
+            // the multipliers live in column j, before the split.
+            let (left, right) = ab.split_at_mut((j + 1) * ld);
+            let multipliers = &left[col + 1..=col + km];
             for c in j + 1..=ju {
-                let base = c * ld + kv;
-                let u = ab[base + j - c];
+                // Row j of column c, relative to `right`.
+                let top = (c - j - 1) * ld + kv + j - c;
+                let u = right[top];
                 if u != 0.0 {
-                    for i in 1..=km {
-                        ab[base + j + i - c] -= ab[col + i] * u;
+                    let target = &mut right[top + 1..=top + km];
+                    for (t, &l) in target.iter_mut().zip(multipliers) {
+                        *t -= l * u;
                     }
                 }
             }
@@ -207,8 +211,9 @@ impl BandLu {
             let km = kl.min(n - 1 - j);
             let col = j * ld + kv;
             let bj = b[j];
-            for i in 1..=km {
-                b[j + i] -= self.ab[col + i] * bj;
+            let multipliers = &self.ab[col + 1..=col + km];
+            for (bi, &l) in b[j + 1..=j + km].iter_mut().zip(multipliers) {
+                *bi -= l * bj;
             }
         }
         // U: upper bandwidth kl + ku after the interchanges.

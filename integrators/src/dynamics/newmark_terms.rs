@@ -5,7 +5,7 @@
 //! the trapezoidal rule bit for bit when `α_m = α_f = 0`.
 
 use super::checkpoint::{CheckpointMismatch, Tape};
-use super::mass_slots::{spin_derivative, MassSlots};
+use super::mass_slots::MassSlots;
 use super::slave_velocities;
 use super::time_scheme::TimeScheme;
 use super::Motion;
@@ -15,7 +15,7 @@ use crate::dofs::DofMap;
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::system::{ReducedSystem, Reduction, StepTerms};
-use flexmech_core::rotation::log;
+use flexmech_core::rotation::{log, tangent_inverse};
 use flexmech_core::{Configuration, Element, Inertia};
 use nalgebra::{Matrix3, Vector3};
 
@@ -143,6 +143,37 @@ fn inertial_moment<T: flexmech_core::Scalar>(
     let acc1 = k.acceleration(a1, &prev.alpha[i], &prev.ang_acc[i]);
     let jd = j0.map(c);
     *r1 * (jd * acc1 + w1.cross(&(jd * w1)))
+}
+
+/// [`inertial_moment`] and its derivative under a spatial spin of the end
+/// rotation (`R₁ ← exp(η̂)R₁`), in closed form: with `ω = log(R₁Rₙᵀ)`,
+/// `δω = H⁻¹(ω)η`, so `δaₙ₊₁ = RₙᵀH⁻¹(ω)η/(βΔt²)`, `δWₙ₊₁ = γΔt δaₙ₊₁`,
+/// `δȦₙ₊₁ = (1 − α_m)/(1 − α_f) δaₙ₊₁`, and with `v = J₀Ȧ + W × J₀W`,
+///
+/// ```text
+/// ∂m/∂η = −m̂ + R₁ [ (1 − α_m)/(1 − α_f) J₀ + γΔt (ŴJ₀ − (J₀W)^) ] RₙᵀH⁻¹(ω)/(βΔt²)
+/// ```
+///
+/// equal to forward AD of [`inertial_moment`] to round-off (tested).
+fn inertial_moment_tangent(
+    k: &Coefficients,
+    j0: &Matrix3<f64>,
+    r_n: &Matrix3<f64>,
+    r1: &Matrix3<f64>,
+    prev: &Kinematics,
+    i: usize,
+    dt: f64,
+) -> (Vector3<f64>, Matrix3<f64>) {
+    let omega = log(&(r1 * r_n.transpose()));
+    let a1 = angular_acceleration(k, r_n, r1, &prev.w[i], &prev.alpha[i], dt);
+    let w1 = prev.w[i] + prev.alpha[i] * (dt * (1.0 - k.gamma)) + a1 * (dt * k.gamma);
+    let acc1 = k.acceleration(a1, &prev.alpha[i], &prev.ang_acc[i]);
+    let jw = j0 * w1;
+    let m = r1 * (j0 * acc1 + w1.cross(&jw));
+    let dv_da = j0 * ((1.0 - k.alpha_m) / (1.0 - k.alpha_f))
+        + (w1.cross_matrix() * j0 - jw.cross_matrix()) * (k.gamma * dt);
+    let da_deta = r_n.transpose() * tangent_inverse(&omega) / (k.beta * dt * dt);
+    (m, -m.cross_matrix() + r1 * dv_da * da_deta)
 }
 
 /// The Newmark family's terms of the reduced system: the beams' internal
@@ -289,12 +320,12 @@ impl StepTerms for NewmarkTerms {
             },
             |m| k.stiffness(m, dt),
             |i, j0, tangent| {
-                spin_derivative(
-                    &end.rot[i],
-                    tangent,
-                    |r1| inertial_moment(k, j0, &start.rot[i], r1, prev, i, dt),
-                    |r1| inertial_moment(k, j0, &start.rot[i], r1, prev, i, dt),
-                )
+                if tangent {
+                    inertial_moment_tangent(k, j0, &start.rot[i], &end.rot[i], prev, i, dt)
+                } else {
+                    let m = inertial_moment(k, j0, &start.rot[i], &end.rot[i], prev, i, dt);
+                    (m, Matrix3::zeros())
+                }
             },
         );
     }
@@ -501,4 +532,51 @@ fn driver_increment_work(
         w += 0.5 * (r0.1[k] + r1.1[k]) * dv;
     }
     w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::mass_slots::spin_derivative;
+    use flexmech_core::rotation::exp;
+
+    /// Both sides are exact: only round-off separates them.
+    const ORACLE_TOL: f64 = 1e-10;
+
+    #[test]
+    fn closed_form_inertial_tangent_equals_forward_ad() {
+        let v = |a: f64, b: f64, c: f64| Vector3::new(a, b, c);
+        let prev = Kinematics {
+            v: vec![],
+            a: vec![],
+            w: vec![v(0.3, -1.2, 2.0)],
+            alpha: vec![v(-4.0, 1.5, 0.7)],
+            acc: vec![],
+            ang_acc: vec![v(2.0, -0.5, 3.0)],
+        };
+        let j0 = Matrix3::new(2.0, 0.1, -0.2, 0.1, 1.5, 0.05, -0.2, 0.05, 0.8);
+        let r_n = exp(&v(0.4, -1.1, 2.0));
+        for (coefficients, dt) in [
+            (Coefficients::TRAPEZOIDAL, 1e-3),
+            (Coefficients::generalized_alpha(0.6), 0.05),
+        ] {
+            for incr in [v(1e-4, 2e-4, -1e-4), v(0.3, -0.5, 0.2), v(-1.2, 0.9, 1.4)] {
+                let r1 = exp(&incr) * r_n;
+                let (m, k) = inertial_moment_tangent(&coefficients, &j0, &r_n, &r1, &prev, 0, dt);
+                let (m_ad, k_ad) = spin_derivative(
+                    &r1,
+                    true,
+                    |r| inertial_moment(&coefficients, &j0, &r_n, r, &prev, 0, dt),
+                    |r| inertial_moment(&coefficients, &j0, &r_n, r, &prev, 0, dt),
+                );
+                let size = k_ad.norm().max(1.0);
+                assert!((m - m_ad).norm() <= ORACLE_TOL * m_ad.norm().max(1.0));
+                assert!(
+                    (k - k_ad).norm() <= ORACLE_TOL * size,
+                    "{:e}",
+                    (k - k_ad).norm() / size
+                );
+            }
+        }
+    }
 }
