@@ -52,6 +52,15 @@ impl Element {
         }
     }
 
+    /// The initial triads `Λ₀ᵢ` at the element's nodes (columns: the
+    /// directors `e₁` along the beam, `e₂`, `e₃` of the section).
+    pub fn initial_triads(&self) -> &[Matrix3<f64>] {
+        match self {
+            Element::Linear(e) => &e.lambda0,
+            Element::Quadratic(e) => &e.lambda0,
+        }
+    }
+
     /// Number of element unknowns `6N`.
     pub fn dofs(&self) -> usize {
         6 * self.nodes().len()

@@ -105,6 +105,7 @@ fn cantilever(ei: f64, force: f64) -> Model {
             every: 1,
             track: vec![("beam.end".into(), tip)],
             resultants: false,
+            vtk: false,
         },
     }
 }

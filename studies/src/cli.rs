@@ -64,7 +64,9 @@ enum Command {
     },
     /// Reproduce the paper's examples (data/paper) with all three integrators.
     ///
-    /// Writes `<out>/<model>/<integrator>.h5` for every run, the charts
+    /// Writes `<out>/<model>/<integrator>.h5` for every run with its
+    /// ParaView series `<out>/<model>/<integrator>.pvd`, an animation per
+    /// example in `<out>/animations/<model>.gif`, the charts
     /// (PNG and SVG) into `<out>/charts/`, and `<out>/summary.csv` and
     /// `<out>/summary.md` with each run's outcome, energy drift and step
     /// halvings. A run that fails (Newmark in `screw_free`) is a result, not
@@ -97,6 +99,58 @@ enum Command {
         /// Logarithmic y axis (non-positive values are left out).
         #[arg(long)]
         log: bool,
+    },
+    /// Write a result file as a ParaView time series.
+    ///
+    /// Writes `<vtk>/<stem>.pvd` (open it in ParaView) and one `.vtu` file
+    /// per stored step under `<vtk>/<stem>/`: beams as ribbons whose width
+    /// follows the section's e2 director (twist is visible), 3-node elements
+    /// as quadratic cells, joints as points with their coordinates; times
+    /// from /time.
+    Export {
+        /// Result file written by `flexmech run`.
+        result: PathBuf,
+        /// Output directory of the ParaView series.
+        #[arg(long, value_name = "DIR")]
+        vtk: PathBuf,
+        /// Ribbon width in model units (default: 2 % of the mechanism's
+        /// initial bounding-box diagonal).
+        #[arg(long)]
+        width: Option<f64>,
+    },
+    /// Draw the mechanism moving: an animated GIF (or MP4 with ffmpeg, or a
+    /// PNG of one frame).
+    Animate {
+        /// Result file written by `flexmech run`.
+        result: PathBuf,
+        /// Output file: .gif, .mp4 (needs ffmpeg) or .png (one frame).
+        #[arg(long, short)]
+        out: PathBuf,
+        /// Camera: auto (normal to the plane of the motion), xy, xz, yz or
+        /// iso; or give --azimuth and --elevation.
+        #[arg(long, default_value = "auto")]
+        view: String,
+        /// Camera azimuth about z from x, degrees (with --elevation).
+        #[arg(long, requires = "elevation")]
+        azimuth: Option<f64>,
+        /// Camera elevation above the xy plane, degrees (with --azimuth).
+        #[arg(long, requires = "azimuth")]
+        elevation: Option<f64>,
+        /// Image size in pixels, WIDTHxHEIGHT.
+        #[arg(long, default_value = "800x600")]
+        size: String,
+        /// Frames per second.
+        #[arg(long, default_value_t = 25.0)]
+        fps: f64,
+        /// At most this many frames (stored steps are thinned evenly).
+        #[arg(long, default_value_t = 250)]
+        max_frames: usize,
+        /// Nodes drawn with the trail of their positions (labels, e.g. arm.end).
+        #[arg(long)]
+        track: Vec<String>,
+        /// For a .png: the time of the frame (default: the last step).
+        #[arg(long)]
+        time: Option<f64>,
     },
     /// Time steps of the yardstick cantilever (2 m, tip force, dt = 1e-3)
     /// at several mesh sizes with each integrator, modified Newton and
@@ -303,6 +357,11 @@ fn execute(cli: Cli) -> ExitCode {
                         rep.summary.0.display(),
                         rep.summary.1.display()
                     );
+                    println!(
+                        "ParaView series (open the .pvd): {}/<model>/<integrator>.pvd; animations: {}",
+                        options.out.display(),
+                        options.out.join("animations").display()
+                    );
                     ExitCode::SUCCESS
                 }
                 Err(e) => {
@@ -328,6 +387,67 @@ fn execute(cli: Cli) -> ExitCode {
                 ExitCode::FAILURE
             }
         },
+        Command::Export { result, vtk, width } => {
+            match crate::export::export_vtk(&result, &vtk, width) {
+                Ok(pvd) => {
+                    println!("{}", pvd.display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Command::Animate {
+            result,
+            out,
+            view,
+            azimuth,
+            elevation,
+            size,
+            fps,
+            max_frames,
+            track,
+            time,
+        } => {
+            use crate::export::animation::{animate, AnimationOptions, View};
+            let view = match (azimuth, elevation) {
+                (Some(azimuth), Some(elevation)) => Some(View::Angles { azimuth, elevation }),
+                _ => View::parse(&view),
+            };
+            let Some(view) = view else {
+                eprintln!(
+                    "error: --view: use auto, xy, xz, yz or iso (or --azimuth and --elevation)"
+                );
+                return ExitCode::FAILURE;
+            };
+            let size = size
+                .split_once(['x', 'X'])
+                .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
+            let Some(size) = size else {
+                eprintln!("error: --size: give WIDTHxHEIGHT in pixels, e.g. 800x600");
+                return ExitCode::FAILURE;
+            };
+            let opts = AnimationOptions {
+                view,
+                size,
+                fps,
+                max_frames,
+                track,
+                time,
+            };
+            match animate(&result, &out, &opts) {
+                Ok(file) => {
+                    println!("{}", file.display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
         Command::Bench {
             elements,
             steps,

@@ -8,6 +8,7 @@ pub mod build;
 pub mod charts;
 mod checks;
 pub mod cli;
+pub mod export;
 pub mod fuzz;
 mod initial_check;
 pub mod model;

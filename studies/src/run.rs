@@ -54,6 +54,10 @@ pub enum RunError {
     /// The result file to continue cannot be read.
     #[error(transparent)]
     Restart(#[from] RestartError),
+    /// The ParaView series of `[output] vtk = true` could not be written
+    /// (the result file is complete).
+    #[error(transparent)]
+    Export(#[from] crate::export::ExportError),
     /// The result file to continue is not a run of this model.
     #[error(
         "{}: cannot continue {} with this model: {why}",
@@ -91,6 +95,8 @@ pub enum RunError {
 pub struct RunSummary {
     /// The result file.
     pub file: PathBuf,
+    /// The ParaView series (`.pvd`) written with `[output] vtk = true`.
+    pub vtk: Option<PathBuf>,
     /// Converged steps.
     pub steps: usize,
     /// Steps written (every `output.every`-th and the last).
@@ -326,6 +332,7 @@ fn run(
             .iter()
             .map(|j| j.map.reported_angle(&j.initial).is_some())
             .collect(),
+        joint_nodes: mech.joints.iter().map(|j| [j.master, j.slave]).collect(),
         command_line: command_line(),
         supports,
         mesh: Some(mesh),
@@ -469,8 +476,14 @@ fn run(
                 sink.writer.warn(&warnings.join("; "))?;
             }
             let file = sink.writer.finish(layout::STATUS_COMPLETED, wall)?;
+            let vtk = if model.output.vtk {
+                Some(crate::export::export_vtk(&file, out_dir, None)?)
+            } else {
+                None
+            };
             Ok(RunSummary {
                 file,
+                vtk,
                 steps: sink.count,
                 written,
                 iterations: sink.iterations,
@@ -522,8 +535,15 @@ fn mesh_meta(model: &Model, built: &Built) -> MeshMeta {
     for &(b, n) in &built.body_nodes {
         node_labels[n] = format!("body.{}", model.rigid_bodies[b].name);
     }
+    let mut node_directors = vec![[[0.0; 3]; 3]; mesh.node_count()];
+    for e in &mesh.elements {
+        for (&n, l0) in e.nodes().iter().zip(e.initial_triads()) {
+            node_directors[n] = std::array::from_fn(|k| [l0[(0, k)], l0[(1, k)], l0[(2, k)]]);
+        }
+    }
     MeshMeta {
         node_labels,
+        node_directors,
         elements: mesh.elements.iter().map(|e| e.nodes().to_vec()).collect(),
         beams: model
             .beams

@@ -232,6 +232,7 @@ pub(crate) struct RawOutput {
     pub every: Option<S<i64>>,
     pub track: Option<S<Vec<S<String>>>>,
     pub resultants: Option<S<bool>>,
+    pub vtk: Option<S<bool>>,
 }
 
 /// A string or a list of strings (`fixed`, `nodes`).

@@ -256,6 +256,9 @@ pub struct OutputSpec {
     /// `resultants = true`: write the stress resultants at every Gauss
     /// point (`/resultants`).
     pub resultants: bool,
+    /// `vtk = true`: after the run, write its ParaView time series next to
+    /// the result file (`<name>.pvd`, as `flexmech export --vtk` does).
+    pub vtk: bool,
 }
 
 /// A validated model file.

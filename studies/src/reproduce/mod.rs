@@ -7,9 +7,10 @@
 //! energy–momentum schemes also run [`CONSISTENCY_MODEL`] at half the step
 //! (`DIR/<model>/<integrator>-half-dt.h5`) for the consistency chart. A run that fails (Newmark's energy blow-up
 //! in `screw_free`, paper §5.1) keeps its steps and is part of the result.
-//! Then [`charts`] draws the figures into `DIR/charts/` and [`summary`]
+//! Then [`charts`] draws the figures into `DIR/charts/`, [`summary`]
 //! writes the figures of merit (failure time, energy drift, step halvings)
-//! to `DIR/summary.csv` and `DIR/summary.md`.
+//! to `DIR/summary.csv` and `DIR/summary.md`, and [`views`] writes a
+//! ParaView series per run and an animation per example.
 //!
 //! The model files are compiled into the program, so the command works from
 //! any directory; they are the files of `data/paper/`, byte for byte.
@@ -17,6 +18,7 @@
 pub mod charts;
 pub mod runs;
 pub mod summary;
+pub mod views;
 
 use std::path::{Path, PathBuf};
 
@@ -150,6 +152,9 @@ pub struct Reproduction {
     pub charts: Vec<PathBuf>,
     /// `DIR/summary.csv` and `DIR/summary.md`.
     pub summary: (PathBuf, PathBuf),
+    /// The ParaView series of every run (`DIR/<model>/<integrator>.pvd`)
+    /// and each example's animation (`DIR/animations/<model>.gif`).
+    pub views: Vec<PathBuf>,
 }
 
 /// Runs the selected examples with every integrator, draws the charts and
@@ -176,11 +181,13 @@ pub fn reproduce(options: &ReproduceOptions) -> Result<Reproduction, ReproduceEr
     let mut charts = charts::draw_all(&runs, &options.out)?;
     charts.extend(charts::draw_consistency(&runs, &half_step, &options.out)?);
     let summary = summary::write(&runs, &options.out)?;
+    let views = views::write_all(&runs, &options.out)?;
     Ok(Reproduction {
         runs,
         half_step,
         charts,
         summary,
+        views,
     })
 }
 

@@ -76,6 +76,16 @@ pub const MESH_BEAM_NODES: &str = "/mesh/beam_nodes";
 /// beams + 1 (u64): beam `b` has nodes `beam_nodes[offsets[b]..offsets[b+1]]`.
 pub const MESH_BEAM_OFFSETS: &str = "/mesh/beam_offsets";
 
+/// nodes × 3 × 3 (extension): each node's initial triad `Λ₀`, row `k` the
+/// director `e₍ₖ₊₁₎` (`e₁` along the beam, `e₂`, `e₃` spanning the section);
+/// zeros for nodes on no beam. The current triad is `R Λ₀`, `R` from
+/// `/configuration/quaternion`.
+pub const MESH_NODE_DIRECTORS: &str = "/mesh/node_directors";
+
+/// nodes × 3 (extension): each node's initial position, from which
+/// displacements are measured.
+pub const MESH_INITIAL_POSITION: &str = "/mesh/initial_position";
+
 /// Root attribute of a continued run: the result file it continues.
 pub const ATTR_RESTARTED_FROM: &str = "restarted_from";
 /// Root attribute of a continued run: the time it continues from.
@@ -86,6 +96,12 @@ pub const ATTR_DESCRIPTION: &str = "description";
 pub const ATTR_NODE_INDEX: &str = "node_index";
 /// Attribute on `/joints/<name>` (extension): the joint index in model order.
 pub const ATTR_JOINT_INDEX: &str = "joint_index";
+/// Attribute on `/joints/<name>` (extension): the joint's master node, an
+/// index into `/configuration` (absent in files written before it).
+pub const ATTR_JOINT_MASTER_NODE: &str = "master_node";
+/// Attribute on `/joints/<name>` (extension): the joint's slave node, an
+/// index into `/configuration` (absent in files written before it).
+pub const ATTR_JOINT_SLAVE_NODE: &str = "slave_node";
 
 /// `status` while the run is in progress (and after a crash).
 pub const STATUS_RUNNING: &str = "running";

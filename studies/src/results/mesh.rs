@@ -16,11 +16,14 @@ pub struct MeshMeta {
     pub elements: Vec<Vec<usize>>,
     /// Every beam's name and its nodes in order along it.
     pub beams: Vec<(String, Vec<usize>)>,
+    /// Each node's initial directors `[e₁, e₂, e₃]` (zeros for nodes on no
+    /// beam): `/mesh/node_directors`, omitted when empty.
+    pub node_directors: Vec<[[f64; 3]; 3]>,
 }
 
 /// Writes `/mesh`: labels, and elements and beams as flattened lists with
 /// offsets (the compressed-row layout VTK and ParaView use).
-pub(crate) fn write(file: &File, mesh: &MeshMeta) -> hdf5::Result<()> {
+pub(crate) fn write(file: &File, mesh: &MeshMeta, initial: &[[f64; 3]]) -> hdf5::Result<()> {
     file.create_group(names::MESH)?;
     let strings = |name: &str, values: &[String]| -> hdf5::Result<()> {
         let v: Vec<VarLenUnicode> = values
@@ -60,7 +63,26 @@ pub(crate) fn write(file: &File, mesh: &MeshMeta) -> hdf5::Result<()> {
     let beam_names: Vec<String> = mesh.beams.iter().map(|(n, _)| n.clone()).collect();
     strings(names::MESH_BEAM_NAMES, &beam_names)?;
     let beams: Vec<&[usize]> = mesh.beams.iter().map(|(_, n)| n.as_slice()).collect();
-    lists(names::MESH_BEAM_NODES, names::MESH_BEAM_OFFSETS, &beams)
+    lists(names::MESH_BEAM_NODES, names::MESH_BEAM_OFFSETS, &beams)?;
+    if !mesh.node_directors.is_empty() {
+        let flat: Vec<f64> = mesh
+            .node_directors
+            .iter()
+            .flat_map(|d| d.iter().flatten().copied())
+            .collect();
+        file.new_dataset::<f64>()
+            .shape([mesh.node_directors.len(), 3, 3])
+            .create(names::MESH_NODE_DIRECTORS)?
+            .write_raw(&flat)?;
+    }
+    if !initial.is_empty() {
+        let flat: Vec<f64> = initial.iter().flatten().copied().collect();
+        file.new_dataset::<f64>()
+            .shape([initial.len(), 3])
+            .create(names::MESH_INITIAL_POSITION)?
+            .write_raw(&flat)?;
+    }
+    Ok(())
 }
 
 /// The current UTC time as `YYYY-MM-DDThh:mm:ssZ`.

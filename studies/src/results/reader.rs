@@ -251,7 +251,11 @@ impl ResultReader {
     /// `<beam>.<k>`, `<beam>.start`, `<beam>.end`, and `ground.<joint>` for
     /// the ground node of a joint to the ground).
     pub fn mesh_node_labels(&self) -> Result<Vec<String>, ReadError> {
-        let name = layout::MESH_NODE_LABELS;
+        self.strings(layout::MESH_NODE_LABELS)
+    }
+
+    /// A dataset of strings (`/mesh/beam_names`, ...).
+    pub fn strings(&self, name: &str) -> Result<Vec<String>, ReadError> {
         Ok(self
             .dataset(name)?
             .read_raw::<VarLenUnicode>()
@@ -259,6 +263,17 @@ impl ResultReader {
             .into_iter()
             .map(|s| s.as_str().to_owned())
             .collect())
+    }
+
+    /// A scalar unsigned attribute of the group `group` (None when absent).
+    pub fn group_u64_attr(&self, group: &str, attr: &str) -> Option<u64> {
+        self.file
+            .group(group)
+            .ok()?
+            .attr(attr)
+            .ok()?
+            .read_scalar::<u64>()
+            .ok()
     }
 
     /// The beams of `/resultants`: names and their Gauss points' offsets

@@ -43,6 +43,10 @@ pub struct RunMeta {
     /// Per joint, whether it has a released angle (`/joints/<name>/angle`
     /// is written only then); joints past the end of the list have one.
     pub joint_angles: Vec<bool>,
+    /// Per joint, its master and slave node (indices into
+    /// `/configuration`): attributes `master_node`, `slave_node` of
+    /// `/joints/<name>` (omitted for joints past the end of the list).
+    pub joint_nodes: Vec<[usize; 2]>,
     /// The command line that made the run; root attribute `command_line`
     /// (omitted when empty).
     pub command_line: String,
@@ -524,7 +528,8 @@ impl ResultWriter {
                 .ctx(path, || format!("writing root attribute {name}"))?;
         }
         if let Some(mesh) = &meta.mesh {
-            super::mesh::write(&file, mesh).ctx(path, || "writing /mesh".to_owned())?;
+            super::mesh::write(&file, mesh, &meta.initial_positions)
+                .ctx(path, || "writing /mesh".to_owned())?;
         }
 
         let groups = [
@@ -690,6 +695,18 @@ impl ResultWriter {
                 .ctx(path, || {
                     format!("writing {group} attribute {}", names::ATTR_JOINT_INDEX)
                 })?;
+            if let Some(nodes) = meta.joint_nodes.get(index) {
+                for (attr, node) in [
+                    (names::ATTR_JOINT_MASTER_NODE, nodes[0]),
+                    (names::ATTR_JOINT_SLAVE_NODE, nodes[1]),
+                ] {
+                    g.new_attr::<u64>()
+                        .shape(())
+                        .create(attr)
+                        .and_then(|a| a.as_writer().write_scalar(&(node as u64)))
+                        .ctx(path, || format!("writing {group} attribute {attr}"))?;
+                }
+            }
             let has_angle = meta.joint_angles.get(index).copied().unwrap_or(true);
             joints.push(JointSets {
                 angle: if has_angle {

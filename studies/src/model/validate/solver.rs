@@ -305,6 +305,7 @@ impl Ctx<'_> {
                 every: 1,
                 track: Vec::new(),
                 resultants: false,
+                vtk: false,
             });
         };
         let o = entry.get_ref();
@@ -327,6 +328,7 @@ impl Ctx<'_> {
             every,
             track,
             resultants: o.resultants.as_ref().is_some_and(|r| *r.get_ref()),
+            vtk: o.vtk.as_ref().is_some_and(|r| *r.get_ref()),
         })
     }
 }

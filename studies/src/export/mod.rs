@@ -1,0 +1,11 @@
+//! Views of a result file beyond line charts: the ParaView time series
+//! ([`paraview`], `flexmech export --vtk`) and animations ([`animation`],
+//! `flexmech animate`), both drawn from the same [`Frames`].
+
+pub mod animation;
+pub mod frames;
+pub mod paraview;
+pub mod vtu;
+
+pub use frames::Frames;
+pub use paraview::{export_vtk, ExportError};
