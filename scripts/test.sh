@@ -12,6 +12,18 @@ if python3 -c "import vtk, h5py, numpy" 2>/dev/null ||
 else
   echo "flexmech tests: Python's vtk/h5py could not be installed: the VTK read-back checks are skipped" >&2
 fi
+# pdflatex compiles the charts' PGFPlots copies in the tests (TeX Live from
+# the distribution's packages; skipped with a message where it cannot be had).
+if ! command -v pdflatex >/dev/null 2>&1 && command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" -eq 0 ]; then
+  echo "flexmech tests: installing pdflatex and pgfplots (apt-get: texlive-latex-base texlive-pictures texlive-latex-recommended)..." >&2
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+    texlive-latex-base texlive-pictures texlive-latex-recommended >/dev/null 2>&1 || true
+fi
+if command -v pdflatex >/dev/null 2>&1 && kpsewhich pgfplots.sty >/dev/null 2>&1; then
+  export FLEXMECH_REQUIRE_PDFLATEX=1
+else
+  echo "flexmech tests: pdflatex with pgfplots is not available: the PGFPlots compile checks are skipped" >&2
+fi
 cargo test --workspace --all-targets
 cargo test --workspace --doc
 cargo fmt --all -- --check

@@ -581,3 +581,97 @@ fn flexmech_plot_command() {
     assert!(out.join("energy_total.png").is_file());
     assert!(out.join("energy_total.svg").is_file());
 }
+
+/// The CSV next to a chart: `x<i>`, `y<i>` columns, `nan` for missing values.
+fn read_csv(path: &Path) -> Vec<Vec<f64>> {
+    let text = std::fs::read_to_string(path).expect("the CSV exists");
+    let mut lines = text.lines();
+    let columns = lines.next().expect("a header").split(',').count();
+    let mut cols = vec![Vec::new(); columns];
+    for line in lines {
+        for (c, v) in line.split(',').enumerate() {
+            cols[c].push(v.parse::<f64>().expect("a number or nan"));
+        }
+    }
+    cols
+}
+
+/// `pdflatex` on `tex` in its directory: Ok(false) when it is not installed
+/// and the environment does not require it.
+fn compiles(tex: &Path) -> bool {
+    let required = std::env::var_os("FLEXMECH_REQUIRE_PDFLATEX").is_some();
+    let out = Command::new("pdflatex")
+        .args(["-interaction=nonstopmode", "-halt-on-error"])
+        .arg(tex.file_name().expect("a file"))
+        .current_dir(tex.parent().expect("a directory"))
+        .output();
+    let Ok(out) = out else {
+        assert!(
+            !required,
+            "pdflatex is required (FLEXMECH_REQUIRE_PDFLATEX is set)"
+        );
+        eprintln!("skipped: pdflatex is not installed; the PGFPlots files were not compiled");
+        return false;
+    };
+    assert!(
+        out.status.success(),
+        "{} does not compile:\n{}",
+        tex.display(),
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let pdf = tex.with_extension("pdf");
+    assert!(
+        std::fs::metadata(&pdf)
+            .map(|m| m.len() > 1000)
+            .unwrap_or(false),
+        "no PDF"
+    );
+    true
+}
+
+#[test]
+fn every_chart_gets_its_data_as_csv_and_a_pgfplots_file_that_compiles() {
+    let dir = tempfile::tempdir().unwrap();
+    let k: Vec<f64> = (0..8).map(f64::from).collect();
+    let log = LineChart {
+        title: String::new(),
+        x_label: "Δt (s)".into(),
+        y_label: "|E − E₀| / E_ref".into(),
+        log_y: true,
+        series: vec![
+            Series::new(
+                "energy–momentum (β)",
+                k.clone(),
+                k.iter().map(|k| 10f64.powf(-k)).collect(),
+            ),
+            Series::new("two points", vec![0.0, 7.0], vec![1e-3, -1.0]),
+        ],
+        markers: vec![],
+    };
+    for (chart, stem) in [(three_series_chart(), "linear"), (log, "log")] {
+        let (png, _) = chart.render(&dir.path().join(stem)).expect("render");
+        let csv = read_csv(&png.with_extension("csv"));
+        assert_eq!(csv.len(), 2 * chart.series.len());
+        for (i, s) in chart.series.iter().enumerate() {
+            for (r, (&x, &y)) in s.x.iter().zip(&s.y).enumerate() {
+                assert_eq!(csv[2 * i][r], x, "{stem}: x{i} row {r}");
+                let drawn = if chart.log_y && y <= 0.0 { f64::NAN } else { y };
+                let same =
+                    csv[2 * i + 1][r] == drawn || (drawn.is_nan() && csv[2 * i + 1][r].is_nan());
+                assert!(
+                    same,
+                    "{stem}: y{i} row {r}: {} vs {drawn}",
+                    csv[2 * i + 1][r]
+                );
+            }
+            assert!(
+                csv[2 * i][s.x.len()..].iter().all(|v| v.is_nan()),
+                "padding"
+            );
+        }
+        let tex = png.with_extension("tex");
+        let text = std::fs::read_to_string(&tex).expect("the .tex exists");
+        assert_eq!(text.matches("\\addplot[").count(), chart.series.len());
+        compiles(&tex);
+    }
+}

@@ -171,8 +171,9 @@ impl LineChart {
         }
     }
 
-    /// Draws the chart into `<stem>.png` (1600×1000 px) and `<stem>.svg` and
-    /// returns both paths. The extensions are appended, so a stem may contain
+    /// Draws the chart into `<stem>.png` (1600×1000 px) and `<stem>.svg`,
+    /// writes its editable copies `<stem>.csv` and `<stem>.tex` (PGFPlots,
+    /// [`super::pgfplots`]) and returns the PNG and SVG paths. The extensions are appended, so a stem may contain
     /// dots (`out/nodes_arm.end_position`). Missing parent directories are
     /// created. Nothing is written when the data are unusable.
     pub fn render(&self, stem: &Path) -> Result<(PathBuf, PathBuf), ChartError> {
@@ -190,6 +191,9 @@ impl LineChart {
         }
         write_png(&figure, &png)?;
         write_svg(&figure, &svg)?;
+        let csv = with_suffix(stem, ".csv");
+        super::pgfplots::write(self, &csv, &with_suffix(stem, ".tex"))
+            .map_err(|source| ChartError::Io { path: csv, source })?;
         Ok((png, svg))
     }
 }

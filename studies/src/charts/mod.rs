@@ -10,6 +10,7 @@
 
 pub mod font;
 mod line;
+pub mod pgfplots;
 mod plot;
 
 pub use line::{ChartError, LineChart, Series, HEIGHT, WIDTH};

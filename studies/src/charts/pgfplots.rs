@@ -4,7 +4,8 @@
 //!
 //! `<stem>.csv` has two columns per curve, `x<i>` and `y<i>` in legend order,
 //! padded with `nan` where a curve is shorter (PGFPlots then breaks the line,
-//! `unbounded coords=jump`; non-finite values are written as `nan` too).
+//! `unbounded coords=jump`; non-finite values, and non-positive ones on a
+//! logarithmic axis, are written as `nan` too: the points the chart leaves out).
 //! `<stem>.tex` compiles on its own with `pdflatex` (packages `pgfplots` and
 //! `geometry` only) to one page holding the figure; the `tikzpicture` inside
 //! is what a paper copies. Labels are the chart's, with Greek letters, sub-
@@ -52,15 +53,25 @@ pub fn csv(chart: &LineChart) -> String {
         .collect();
     out.push_str(&header.join(","));
     out.push('\n');
-    let rows = chart.series.iter().map(|s| s.x.len().min(s.y.len())).max().unwrap_or(0);
+    let rows = chart
+        .series
+        .iter()
+        .map(|s| s.x.len().min(s.y.len()))
+        .max()
+        .unwrap_or(0);
     for r in 0..rows {
         let cells: Vec<String> = chart
             .series
             .iter()
             .flat_map(|s: &Series| {
-                let at = |v: &[f64]| v.get(r).map_or_else(|| "nan".to_owned(), |&x| number(x));
                 if r < s.x.len().min(s.y.len()) {
-                    [at(&s.x), at(&s.y)]
+                    // A logarithmic axis leaves non-positive values out, as the PNG does.
+                    let y = if chart.log_y && s.y[r] <= 0.0 {
+                        f64::NAN
+                    } else {
+                        s.y[r]
+                    };
+                    [number(s.x[r]), number(y)]
                 } else {
                     ["nan".to_owned(), "nan".to_owned()]
                 }
@@ -109,6 +120,7 @@ fn latex_char(c: char) -> Option<&'static str> {
         '{' => "\\{",
         '}' => "\\}",
         '~' => "\\textasciitilde{}",
+        '_' => "\\_",
         '^' => "\\textasciicircum{}",
         _ => return None,
     })
@@ -123,12 +135,15 @@ fn script(c: char) -> Option<(bool, char)> {
     if let Some(i) = SUB.chars().position(|s| s == c) {
         return plain(i).map(|p| (false, p));
     }
-    SUP.chars().position(|s| s == c).and_then(|i| plain(i).map(|p| (true, p)))
+    SUP.chars()
+        .position(|s| s == c)
+        .and_then(|i| plain(i).map(|p| (true, p)))
 }
 
 /// A chart label as LaTeX text: special characters escaped, Greek letters
 /// and signs as math, runs of sub-/superscript characters as `$_{..}$` /
-/// `$^{..}$`, and an ASCII subscript `E_ref` as `$E_{\mathrm{ref}}$`.
+/// `$^{..}$`, an ASCII subscript of a one-letter symbol `E_ref` as
+/// `E$_{\mathrm{ref}}$`, any other underscore (`screw_free`) as `\_`.
 pub fn latex(text: &str) -> String {
     let chars: Vec<char> = text.chars().collect();
     let mut out = String::new();
@@ -147,8 +162,10 @@ pub fn latex(text: &str) -> String {
             let _ = write!(out, "${}{{{run}}}$", if sup { "^" } else { "_" });
             continue;
         }
-        if c == '_' {
-            // An ASCII subscript: the letters that follow.
+        let single_letter =
+            i >= 1 && chars[i - 1].is_alphabetic() && (i < 2 || !chars[i - 2].is_alphanumeric());
+        if c == '_' && single_letter {
+            // An ASCII subscript of a one-letter symbol (`E_ref`, `u_z`).
             let mut run = String::new();
             i += 1;
             while let Some(&c) = chars.get(i).filter(|c| c.is_ascii_alphanumeric()) {
@@ -174,7 +191,7 @@ pub fn tex(chart: &LineChart, csv_name: &str) -> String {
         "% Made by flexmech: the chart's data are in the CSV file next to this one.\n\
          % Compile with pdflatex; copy the tikzpicture into a paper to restyle it.\n\
          \\documentclass{article}\n\
-         \\usepackage[paperwidth=15cm,paperheight=10cm,margin=0.3cm]{geometry}\n\
+         \\usepackage[paperwidth=15cm,paperheight=11cm,margin=0.3cm]{geometry}\n\
          \\usepackage{pgfplots}\n\
          \\pgfplotsset{compat=1.16}\n\\pagestyle{empty}\n",
     );
@@ -183,8 +200,8 @@ pub fn tex(chart: &LineChart, csv_name: &str) -> String {
     }
     t.push_str("\\begin{document}\n\\begin{tikzpicture}\n\\begin{axis}[\n");
     t.push_str("  width=13.5cm, height=8.5cm, grid=major, grid style={gray!25},\n");
-    t.push_str("  unbounded coords=jump, legend cell align=left, legend pos=outer north east,\n");
-    t.push_str("  legend style={font=\\small, draw=gray!60},\n");
+    t.push_str("  unbounded coords=jump, legend cell align=left, legend columns=2,\n");
+    t.push_str("  legend style={font=\\small, draw=gray!60, at={(0.5,-0.2)}, anchor=north},\n");
     let _ = writeln!(t, "  xlabel={{{}}},", latex(&chart.x_label));
     let _ = writeln!(t, "  ylabel={{{}}},", latex(&chart.y_label));
     if !chart.title.is_empty() {
@@ -199,8 +216,16 @@ pub fn tex(chart: &LineChart, csv_name: &str) -> String {
     t.push_str("]\n");
     for (i, s) in chart.series.iter().enumerate() {
         let (color, _) = COLORS[i % COLORS.len()];
-        let points = s.x.iter().zip(&s.y).filter(|(x, y)| x.is_finite() && y.is_finite()).count();
-        let marks = if points <= MARKER_POINTS { "mark=*, mark size=1.5pt" } else { "no markers" };
+        let points =
+            s.x.iter()
+                .zip(&s.y)
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .count();
+        let marks = if points <= MARKER_POINTS {
+            "mark=*, mark size=1.5pt"
+        } else {
+            "no markers"
+        };
         let _ = writeln!(
             t,
             "\\addplot[{color}, {}, thick, {marks}] table[x=x{i}, y=y{i}, col sep=comma] {{{csv_name}}};",
@@ -241,16 +266,27 @@ mod tests {
     #[test]
     fn labels_become_latex() {
         assert_eq!(latex("Δt (s)"), "$\\Delta$t (s)");
-        assert_eq!(latex("|E − E₀| / E_ref"), "$|$E $-$ E$_{0}$$|$ / E$_{\\mathrm{ref}}$");
+        assert_eq!(
+            latex("|E − E₀| / E_ref"),
+            "$|$E $-$ E$_{0}$$|$ / E$_{\\mathrm{ref}}$"
+        );
         assert_eq!(latex("×10⁻³"), "$\\times$10$^{-3}$");
         assert_eq!(latex("50% & $"), "50\\% \\& \\$");
+        assert_eq!(latex("screw_free: u_z"), "screw\\_free: u$_{\\mathrm{z}}$");
     }
 
     #[test]
     fn csv_pads_short_curves_with_nan() {
         let mut c = LineChart::new("", "x", "y");
-        c.series.push(Series::new("a", vec![0.0, 1.0, 2.0], vec![1.0, f64::NAN, 3.0]));
+        c.series.push(Series::new(
+            "a",
+            vec![0.0, 1.0, 2.0],
+            vec![1.0, f64::NAN, 3.0],
+        ));
         c.series.push(Series::new("b", vec![0.5], vec![-1.0]));
-        assert_eq!(csv(&c), "x0,y0,x1,y1\n0e0,1e0,5e-1,-1e0\n1e0,nan,nan,nan\n2e0,3e0,nan,nan\n");
+        assert_eq!(
+            csv(&c),
+            "x0,y0,x1,y1\n0e0,1e0,5e-1,-1e0\n1e0,nan,nan,nan\n2e0,3e0,nan,nan\n"
+        );
     }
 }
