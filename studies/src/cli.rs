@@ -17,7 +17,7 @@
 //! }
 //! ```
 
-use crate::charts::plot_datasets;
+use crate::charts::{plot_with, PlotOptions};
 use crate::model::{load_model, JointRegistry};
 use crate::reproduce::{reproduce, ReproduceOptions};
 use crate::{build, restart_model, run_model, RunError};
@@ -81,11 +81,16 @@ enum Command {
         /// Factor on every model's end time (e.g. 0.2 for a quick look).
         #[arg(long, default_value_t = 1.0)]
         time_scale: f64,
+        /// Charts without titles (for papers whose captions carry them).
+        #[arg(long)]
+        no_titles: bool,
     },
-    /// Draw line charts (PNG and SVG) of result datasets over /time.
+    /// Draw line charts (PNG and SVG) of result datasets over /time (or
+    /// over another dataset with --x), overlaying other files with --with.
     ///
-    /// Writes `<out>/<dataset path with / as _>.png` (1600x1000 px) and `.svg`
-    /// per dataset, e.g. `plots/nodes_arm.end_displacement.png`.
+    /// Writes `<out>/<dataset path with / as _>.png` (1600x1000 px), `.svg`,
+    /// and the editable `.csv` and PGFPlots `.tex` per dataset, e.g.
+    /// `plots/nodes_arm.end_displacement.png`.
     Plot {
         /// Result file written by `flexmech run`.
         result: PathBuf,
@@ -99,6 +104,23 @@ enum Command {
         /// Logarithmic y axis (non-positive values are left out).
         #[arg(long)]
         log: bool,
+        /// Plot against this dataset instead of /time (T, or DATASET[k] for
+        /// component k of a T x 3 one), e.g. --x /joints/screw/angle.
+        #[arg(long, value_name = "DATASET")]
+        x: Option<String>,
+        /// Label of the x axis.
+        #[arg(long)]
+        xlabel: Option<String>,
+        /// Label of the y axis (default: the dataset's description and unit).
+        #[arg(long)]
+        ylabel: Option<String>,
+        /// Title ("" for none; default: file and description).
+        #[arg(long)]
+        title: Option<String>,
+        /// Another result file whose same datasets are drawn in the same
+        /// charts (repeat for more); curves are named by file.
+        #[arg(long = "with", value_name = "RESULT.h5")]
+        with: Vec<PathBuf>,
     },
     /// Write a result file as a ParaView time series.
     ///
@@ -327,11 +349,13 @@ fn execute(cli: Cli) -> ExitCode {
             out,
             models,
             time_scale,
+            no_titles,
         } => {
             let options = ReproduceOptions {
                 out,
                 models,
                 time_scale,
+                titles: !no_titles,
             };
             match reproduce(&options) {
                 Ok(rep) => {
@@ -375,7 +399,24 @@ fn execute(cli: Cli) -> ExitCode {
             datasets,
             out,
             log,
-        } => match plot_datasets(&result, &datasets, &out, log) {
+            x,
+            xlabel,
+            ylabel,
+            title,
+            with,
+        } => match plot_with(
+            &result,
+            &datasets,
+            &out,
+            &PlotOptions {
+                log_y: log,
+                x,
+                x_label: xlabel,
+                y_label: ylabel,
+                title,
+                overlay: with,
+            },
+        ) {
             Ok(files) => {
                 for f in files {
                     println!("{}", f.display());

@@ -7,7 +7,9 @@ use std::process::Command;
 use std::sync::{Mutex, MutexGuard};
 
 use flexmech_integrators::record::{Energies, StepRecord};
-use flexmech_studies::charts::{plot_datasets, ChartError, LineChart, PlotError, Series};
+use flexmech_studies::charts::{
+    plot_datasets, plot_with, ChartError, LineChart, PlotError, PlotOptions, Series,
+};
 use flexmech_studies::results::{layout, ReadError, ResultWriter, RunMeta};
 
 /// HDF5 opens files without close-on-exec and locks them: the CLI test's child
@@ -434,11 +436,12 @@ fn plot_draws_scalar_and_vector_datasets_over_time() {
     }
 
     let strain = text_elements(&svg_text(&names[1]));
+    // Axis labels in words with units, not dataset paths.
+    assert!(strain.iter().any(|t| t == "load factor"), "{strain:?}");
     assert!(
-        strain.iter().any(|t| t == "time (load factor in statics)"),
+        strain.iter().any(|t| t == "strain energy (J)"),
         "{strain:?}"
     );
-    assert!(strain.iter().any(|t| t == "/energy/strain"), "{strain:?}");
     assert!(strain.iter().any(|t| t == "strain"), "legend: {strain:?}");
     assert!(
         strain.iter().any(|t| t.starts_with("bend.h5")),
@@ -447,9 +450,10 @@ fn plot_draws_scalar_and_vector_datasets_over_time() {
 
     let displacement = svg_text(&names[3]);
     let texts = text_elements(&displacement);
-    for wanted in ["/nodes/bend.end/displacement", "x", "y", "z"] {
+    for wanted in ["x", "y", "z"] {
         assert!(texts.iter().any(|t| t == wanted), "{wanted}: {texts:?}");
     }
+    assert!(texts.iter().any(|t| t.ends_with("(m)")), "unit: {texts:?}");
     // y (all zero) and z components are drawn: three colours of curves.
     for color in ["#0072B2", "#D55E00", "#009E73"] {
         assert!(polylines_in(&displacement, color) >= 2, "{color}");
@@ -674,4 +678,64 @@ fn every_chart_gets_its_data_as_csv_and_a_pgfplots_file_that_compiles() {
         assert_eq!(text.matches("\\addplot[").count(), chart.series.len());
         compiles(&tex);
     }
+}
+
+#[test]
+fn plot_labels_units_draws_x_y_plots_and_overlays_files() {
+    let _guard = serial();
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("first.h5"), dir.path().join("second.h5"));
+    write_result(&a, layout::STATUS_COMPLETED);
+    write_result(&b, layout::STATUS_COMPLETED);
+    let out = dir.path().join("plots");
+    // Default labels: the description with its unit, and the load factor.
+    plot_datasets(
+        &a,
+        &["/nodes/bend.end/displacement".to_owned()],
+        &out,
+        false,
+    )
+    .expect("plot");
+    let tex = std::fs::read_to_string(out.join("nodes_bend.end_displacement.tex")).unwrap();
+    assert!(
+        tex.contains("(m)}") && tex.contains("xlabel={load factor}"),
+        "{tex}"
+    );
+    // x–y: the tip's z displacement over its x position, two files, no title.
+    let options = PlotOptions {
+        x: Some("/nodes/bend.end/position[0]".into()),
+        y_label: Some("tip deflection (m)".into()),
+        title: Some(String::new()),
+        overlay: vec![b.clone()],
+        ..PlotOptions::default()
+    };
+    let written = plot_with(
+        &a,
+        &["/nodes/bend.end/displacement".to_owned()],
+        &out,
+        &options,
+    )
+    .expect("x-y plot");
+    let csv = read_csv(&written[0].with_extension("csv"));
+    assert_eq!(csv.len(), 2 * 6, "three components of two files");
+    assert_eq!(csv[0].len(), STEPS);
+    for (k, ((&x, &z), &z2)) in csv[0].iter().zip(&csv[5]).zip(&csv[11]).enumerate() {
+        let t = 0.1 * (k + 1) as f64;
+        assert_eq!(x, 1.0 - 0.1 * t * t, "x is the position's first component");
+        assert_eq!(z, 0.4 * t, "z displacement of the first file");
+        assert_eq!(z2, z, "the second file's z");
+    }
+    let tex = std::fs::read_to_string(written[0].with_extension("tex")).unwrap();
+    assert!(
+        tex.contains("addlegendentry{second: z}") && !tex.contains("title="),
+        "{tex}"
+    );
+    assert!(tex.contains("ylabel={tip deflection (m)}"), "{tex}");
+    // A T×3 abscissa needs its component.
+    let bad = PlotOptions {
+        x: Some("/nodes/bend.end/position".into()),
+        ..PlotOptions::default()
+    };
+    let err = plot_with(&a, &[layout::ENERGY_STRAIN.to_owned()], &out, &bad).unwrap_err();
+    assert!(err.to_string().contains("[0]"), "{err}");
 }

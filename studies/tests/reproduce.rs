@@ -27,6 +27,7 @@ fn screw_free_shows_the_papers_claims() {
         out: dir.path().to_path_buf(),
         models: vec!["screw_free".into()],
         time_scale: 1.0,
+        titles: true,
     };
     let rep = reproduce(&options).unwrap();
     assert_eq!(rep.runs.len(), 4);
@@ -173,6 +174,7 @@ fn driven_examples_run_and_balance_their_energy() {
             "lobe".into(),
         ],
         time_scale: 0.2,
+        titles: false,
     };
     let rep = reproduce(&options).unwrap();
     assert_eq!(rep.runs.len(), 4 * INTEGRATORS.len());

@@ -246,6 +246,28 @@ fn animation_options_are_refused_by_name() {
         panic!("unknown format accepted")
     };
     assert!(e.to_string().contains(".gif, .mp4 or .png"), "{e}");
+    // MP4 through ffmpeg where it is installed; refused by name where not.
+    let small = AnimationOptions {
+        size: (200, 150),
+        max_frames: 5,
+        ..Default::default()
+    };
+    let mp4 = dir.path().join("a.mp4");
+    let ffmpeg = Command::new("ffmpeg")
+        .arg("-version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    match animate(&summary.file, &mp4, &small) {
+        Ok(_) => assert!(ffmpeg && std::fs::metadata(&mp4).is_ok_and(|m| m.len() > 0)),
+        Err(e) => assert!(
+            !ffmpeg && e.to_string().contains("ffmpeg is not installed"),
+            "{e}"
+        ),
+    }
+    assert!(
+        !dir.path().join("a.frames").exists(),
+        "the scratch frames are removed"
+    );
 }
 
 #[test]

@@ -15,6 +15,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+use super::clip::clip_polyline;
 use super::font;
 
 /// Width of the PNG (and of the SVG's canvas) in pixels.
@@ -33,7 +34,15 @@ pub struct Series {
     pub x: Vec<f64>,
     /// Ordinates, as many as `x`.
     pub y: Vec<f64>,
+    /// A marker on every `mark_every`-th point (0: none, unless the curve
+    /// has at most [`AUTO_MARKERS`] points, which are then all marked), so
+    /// curves that lie on each other stay visible and short ones are not
+    /// mistaken for lines through data.
+    pub mark_every: usize,
 }
+
+/// Curves with at most this many points get a marker on every point.
+pub const AUTO_MARKERS: usize = 12;
 
 impl Series {
     /// A series from its label and values.
@@ -42,7 +51,14 @@ impl Series {
             label: label.into(),
             x,
             y,
+            mark_every: 0,
         }
+    }
+
+    /// The series with a marker on every `k`-th point.
+    pub fn with_markers(mut self, k: usize) -> Self {
+        self.mark_every = k;
+        self
     }
 }
 
@@ -255,10 +271,17 @@ fn write_svg(figure: &Figure, svg: &Path) -> Result<(), ChartError> {
             .and_then(|()| root.present())
             .map_err(|e| draw_error(svg, e))?;
     }
-    let text = text.replace(
+    let mut text = text.replace(
         &format!("font-family=\"{}\"", font::FAMILY),
         &format!("font-family=\"{}\"", font::SVG_FAMILY),
     );
+    // The face itself, right after the opening <svg ...> tag.
+    if let Some(end) = text
+        .find("<svg")
+        .and_then(|s| text[s..].find('>').map(|e| s + e + 1))
+    {
+        text.insert_str(end, &font::svg_font_face());
+    }
     std::fs::write(svg, text).map_err(|source| ChartError::Io {
         path: svg.to_path_buf(),
         source,
@@ -286,18 +309,21 @@ fn draw_error<E: std::error::Error + Send + Sync>(
 // ---------------------------------------------------------------------------
 
 const MARGIN: f64 = 28.0;
-const TITLE_FONT: f64 = 48.0;
-const DESC_FONT: f64 = 40.0;
-const TICK_FONT: f64 = 36.0;
-const LEGEND_FONT: f64 = 36.0;
-const NOTE_FONT: f64 = 32.0;
+const TITLE_FONT: f64 = 52.0;
+const DESC_FONT: f64 = 46.0;
+const TICK_FONT: f64 = 44.0;
+const LEGEND_FONT: f64 = 40.0;
+const NOTE_FONT: f64 = 36.0;
 const TICK_LEN: f64 = 12.0;
 const LINE_WIDTH: f64 = 4.0;
+/// Radius of the data markers ([`Series::mark_every`]).
+const MARKER_RADIUS: f64 = 7.0;
 const AXIS_WIDTH: f64 = 2.0;
 const LEGEND_PAD: f64 = 16.0;
 const LEGEND_SAMPLE: f64 = 84.0;
 const LEGEND_GAP: f64 = 14.0;
 const LEGEND_INSET: f64 = 18.0;
+const LEGEND_COLUMN_GAP: f64 = 36.0;
 const LEGEND_ROW: f64 = LEGEND_FONT * 1.3;
 const NOTE_ROW: f64 = NOTE_FONT * 1.35;
 
@@ -611,6 +637,8 @@ struct Curve {
     color: RGBColor,
     dash: &'static [f64],
     runs: Vec<Vec<(f64, f64)>>,
+    /// Marker on every k-th drawn point (0: none).
+    mark_every: usize,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -619,7 +647,7 @@ enum Corner {
     UpperLeft,
     LowerRight,
     LowerLeft,
-    /// Right of the plot, top-aligned (the plot is narrowed to make room).
+    /// Below the plot, left-aligned with it (the plot is shortened to make room).
     Outside,
 }
 
@@ -632,6 +660,9 @@ struct Layout {
     y: Axis,
     top: f64,
     right_margin: f64,
+    /// Below the x axis' label: the margin, and the legend when it is
+    /// outside the plot.
+    bottom_margin: f64,
     x_area: f64,
     y_area: f64,
     /// Plot rectangle: left, top, right, bottom.
@@ -652,6 +683,8 @@ struct Figure {
     x_range: (f64, f64),
     y_range: (f64, f64),
     legend: Option<Corner>,
+    /// Legend columns (more than one only below the plot).
+    legend_columns: usize,
 }
 
 impl Figure {
@@ -703,11 +736,16 @@ impl Figure {
                 });
             }
             let (color, dash) = series_style(i);
+            let points: usize = runs.iter().map(Vec::len).sum();
             curves.push(Curve {
                 label: s.label.clone(),
                 color,
                 dash,
                 runs,
+                mark_every: match s.mark_every {
+                    0 if points <= AUTO_MARKERS => 1,
+                    k => k,
+                },
             });
         }
         for (x, label) in &chart.markers {
@@ -751,6 +789,7 @@ impl Figure {
             x_range: (x_lo, x_hi),
             y_range,
             legend: None,
+            legend_columns: 1,
         };
         if figure.legend_lines() == 0 {
             return Ok(figure);
@@ -783,7 +822,12 @@ impl Figure {
             figure.y_range = (lo, d_hi + f / (1.0 - f) * (d_hi - lo));
             figure.legend = Some(Corner::UpperRight);
         } else {
+            // Below the plot: as many columns (up to three) as its width holds.
             figure.legend = Some(Corner::Outside);
+            let (l, _, r, _) = layout.plot;
+            let entry = figure.legend_entry_width(1.0) + LEGEND_COLUMN_GAP;
+            let fit = ((r - l - 2.0 * LEGEND_PAD + LEGEND_COLUMN_GAP) / entry).floor() as usize;
+            figure.legend_columns = fit.clamp(1, 3).min(figure.legend_lines());
         }
         Ok(figure)
     }
@@ -796,16 +840,25 @@ impl Figure {
         self.curves.iter().filter(|c| !c.label.is_empty()).count()
     }
 
-    fn legend_size(&self, scale: f64) -> (f64, f64) {
+    /// Width of one legend entry (sample, gap, longest label).
+    fn legend_entry_width(&self, scale: f64) -> f64 {
         let text = self
             .curves
             .iter()
             .filter(|c| !c.label.is_empty())
             .map(|c| text_width(&c.label, LEGEND_FONT * scale))
             .fold(0.0, f64::max);
-        let rows = self.legend_lines() as f64;
+        (LEGEND_SAMPLE + LEGEND_GAP) * scale + text
+    }
+
+    fn legend_size(&self, scale: f64) -> (f64, f64) {
+        let cols = self.legend_columns.max(1);
+        let rows = self.legend_lines().div_ceil(cols) as f64;
+        let entry = self.legend_entry_width(scale);
         (
-            (2.0 * LEGEND_PAD + LEGEND_SAMPLE + LEGEND_GAP) * scale + text,
+            2.0 * LEGEND_PAD * scale
+                + cols as f64 * entry
+                + (cols - 1) as f64 * LEGEND_COLUMN_GAP * scale,
             (2.0 * LEGEND_PAD + rows * LEGEND_ROW) * scale,
         )
     }
@@ -818,10 +871,11 @@ impl Figure {
         let left = match corner {
             Corner::UpperLeft | Corner::LowerLeft => l + LEGEND_INSET * s,
             Corner::UpperRight | Corner::LowerRight => r - LEGEND_INSET * s - w,
-            Corner::Outside => f64::from(WIDTH) * s - MARGIN * s - w,
+            Corner::Outside => l,
         };
         let top = match corner {
-            Corner::UpperLeft | Corner::UpperRight | Corner::Outside => t + LEGEND_INSET * s,
+            Corner::UpperLeft | Corner::UpperRight => t + LEGEND_INSET * s,
+            Corner::Outside => f64::from(HEIGHT) * s - MARGIN * s - h,
             Corner::LowerLeft | Corner::LowerRight => b - LEGEND_INSET * s - h,
         };
         (left, top, left + w, top + h)
@@ -874,7 +928,7 @@ impl Figure {
         root.fill(&WHITE)?;
         let mut chart = ChartBuilder::on(root)
             .margin_top(px(lay.top))
-            .margin_bottom(px(MARGIN * s))
+            .margin_bottom(px(lay.bottom_margin))
             .margin_left(px(MARGIN * s))
             .margin_right(px(lay.right_margin))
             .x_label_area_size(px(lay.x_area))
@@ -919,19 +973,44 @@ impl Figure {
             }
         }
 
+        // Curves clipped to the plot frame.
+        let frame = (
+            f64::from(px0),
+            f64::from(py1),
+            f64::from(px1),
+            f64::from(py0),
+        );
         let line_width = px(LINE_WIDTH * s);
+        let mark =
+            |c: (f64, f64)| c.0 >= frame.0 && c.0 <= frame.2 && c.1 >= frame.1 && c.1 <= frame.3;
         for curve in &self.curves {
             let style = curve.color.stroke_width(line_width as u32);
             let dash = scaled(curve.dash);
+            let mut index = 0usize;
             for run in &curve.runs {
                 let pts: Vec<(f64, f64)> = run.iter().map(|&p| to_px(p)).collect();
-                if pts.len() == 1 {
-                    let c = pixels(&pts)[0];
-                    root.draw(&Circle::new(c, line_width, curve.color.filled()))?;
-                    continue;
+                for inside in clip_polyline(&pts, frame) {
+                    if inside.len() == 1 {
+                        let c = pixels(&inside)[0];
+                        root.draw(&Circle::new(c, line_width, curve.color.filled()))?;
+                        continue;
+                    }
+                    for piece in dashed(&inside, &dash) {
+                        root.draw(&PathElement::new(pixels(&piece), style))?;
+                    }
                 }
-                for piece in dashed(&pts, &dash) {
-                    root.draw(&PathElement::new(pixels(&piece), style))?;
+                if curve.mark_every > 0 {
+                    for &p in &pts {
+                        if index.is_multiple_of(curve.mark_every) && mark(p) {
+                            let c = (px(p.0), px(p.1));
+                            root.draw(&Circle::new(
+                                c,
+                                px(MARKER_RADIUS * s),
+                                curve.color.filled(),
+                            ))?;
+                        }
+                        index += 1;
+                    }
                 }
             }
         }
@@ -1014,9 +1093,12 @@ impl Figure {
             BLACK.mix(0.6).stroke_width(px(AXIS_WIDTH * s) as u32),
         ))?;
         let labelled = self.curves.iter().filter(|c| !c.label.is_empty());
-        for (row, curve) in labelled.enumerate() {
+        let cols = self.legend_columns.max(1);
+        let column_step = self.legend_entry_width(s) + LEGEND_COLUMN_GAP * s;
+        for (i, curve) in labelled.enumerate() {
+            let (row, col) = (i / cols, i % cols);
             let y = t + (LEGEND_PAD + (row as f64 + 0.5) * LEGEND_ROW) * s;
-            let x0 = l + LEGEND_PAD * s;
+            let x0 = l + LEGEND_PAD * s + col as f64 * column_step;
             let sample = [(x0, y), (x0 + LEGEND_SAMPLE * s, y)];
             let dash: Vec<f64> = curve.dash.iter().map(|d| d * s).collect();
             for piece in dashed(&sample, &dash) {
@@ -1024,6 +1106,10 @@ impl Figure {
                     pixels(&piece),
                     curve.color.stroke_width(px(LINE_WIDTH * s) as u32),
                 ))?;
+            }
+            if curve.mark_every > 0 {
+                let c = (px(x0 + 0.5 * LEGEND_SAMPLE * s), px(y));
+                root.draw(&Circle::new(c, px(MARKER_RADIUS * s), curve.color.filled()))?;
             }
             root.draw(&Text::new(
                 curve.label.clone(),
@@ -1052,10 +1138,13 @@ impl Layout {
             .last()
             .map(|l| text_width(l, TICK_FONT * s))
             .unwrap_or(0.0);
-        let mut right_margin = (MARGIN * s).max(last_x_label / 2.0 + 8.0 * s);
+        let right_margin = (MARGIN * s).max(last_x_label / 2.0 + 8.0 * s);
+        // A legend that fits no corner goes below the plot, across its width
+        // (beside it, it would take half the figure's width).
+        let mut bottom_margin = MARGIN * s;
         if figure.legend == Some(Corner::Outside) {
-            let (legend_w, _) = figure.legend_size(s);
-            right_margin = MARGIN * s + legend_w + (24.0 * s).max(last_x_label / 2.0 + 8.0 * s);
+            let (_, legend_h) = figure.legend_size(s);
+            bottom_margin += legend_h + LEGEND_INSET * s;
         }
         let left = MARGIN * s + y_area;
         let right = f64::from(WIDTH) * s - right_margin;
@@ -1101,13 +1190,14 @@ impl Layout {
             TITLE_FONT + 18.0
         };
         let top = (MARGIN + title_h + used_rows * NOTE_ROW + TICK_FONT / 2.0 + 6.0) * s;
-        let bottom = f64::from(HEIGHT) * s - MARGIN * s - x_area;
+        let bottom = f64::from(HEIGHT) * s - bottom_margin - x_area;
         Self {
             scale,
             x,
             y,
             top,
             right_margin,
+            bottom_margin,
             x_area,
             y_area,
             plot: (left, top, right, bottom),

@@ -8,10 +8,11 @@
 //! system font. [`plot_datasets`] is the `flexmech plot` command: charts of
 //! HDF5 result datasets over `/time`.
 
+mod clip;
 pub mod font;
 mod line;
 pub mod pgfplots;
 mod plot;
 
-pub use line::{ChartError, LineChart, Series, HEIGHT, WIDTH};
-pub use plot::{plot_datasets, PlotError};
+pub use line::{ChartError, LineChart, Series, AUTO_MARKERS, HEIGHT, WIDTH};
+pub use plot::{plot_datasets, plot_with, unit_of, PlotError, PlotOptions};

@@ -14,7 +14,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::line::{LineChart, Series};
+use super::line::{LineChart, Series, AUTO_MARKERS};
 
 /// The curves' colours (Okabe–Ito, as the PNG) and dash patterns.
 const COLORS: [(&str, &str); 6] = [
@@ -33,9 +33,6 @@ const DASHES: [&str; 6] = [
     "densely dashed",
     "loosely dotted",
 ];
-
-/// Curves with at most this many points are drawn with markers.
-const MARKER_POINTS: usize = 12;
 
 fn number(v: f64) -> String {
     if v.is_finite() {
@@ -221,10 +218,10 @@ pub fn tex(chart: &LineChart, csv_name: &str) -> String {
                 .zip(&s.y)
                 .filter(|(x, y)| x.is_finite() && y.is_finite())
                 .count();
-        let marks = if points <= MARKER_POINTS {
-            "mark=*, mark size=1.5pt"
-        } else {
-            "no markers"
+        let marks = match s.mark_every {
+            0 if points <= AUTO_MARKERS => "mark=*, mark size=1.5pt".to_owned(),
+            0 => "no markers".to_owned(),
+            k => format!("mark=*, mark size=1.5pt, mark repeat={k}"),
         };
         let _ = writeln!(
             t,

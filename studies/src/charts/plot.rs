@@ -4,10 +4,13 @@
 //!
 //! A dataset of shape T (one value per stored step) gives one curve, a T×3
 //! dataset three (its x, y and z components). The y axis is labelled with the
-//! dataset's path, the x axis "time", or "time (load factor in statics)" when
-//! the root attribute `integrator` is `"static"`. A run that stopped early
-//! (`status` `"failed: …"` or still `"running"`) gets a marker line at its
-//! last stored time.
+//! dataset's description and its unit ([`unit_of`]: SI names of the model's
+//! consistent units), the x axis "time (s)", or "load factor" in statics.
+//! [`PlotOptions`] give other labels, no title, an x–y plot against another
+//! dataset (`--x /joints/screw/angle`, or a component `DATASET[k]`), and
+//! other result files whose same datasets are overlaid (curves named by
+//! file). A run that stopped early (`status` `"failed: …"` or still
+//! `"running"`) gets a marker line at its last stored time.
 
 use std::path::{Path, PathBuf};
 
@@ -69,6 +72,70 @@ fn shape_text(shape: &[usize]) -> String {
     dims.join("×")
 }
 
+/// What `flexmech plot` can change about its charts.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PlotOptions {
+    /// Logarithmic y axis.
+    pub log_y: bool,
+    /// The x axis: another dataset (T, or `DATASET[k]` for component `k`
+    /// of a T×3 one) instead of `/time`.
+    pub x: Option<String>,
+    /// Label of the x axis (default: `/time`'s or the x dataset's).
+    pub x_label: Option<String>,
+    /// Label of the y axis (default: the dataset's description and unit).
+    pub y_label: Option<String>,
+    /// Title (default: file and description; `Some("")`: none).
+    pub title: Option<String>,
+    /// Other result files whose same datasets are drawn in the same charts.
+    pub overlay: Vec<PathBuf>,
+}
+
+/// The unit of a dataset's values by its name (SI names for the model's
+/// consistent units: a model in mm, t, s gives mm where this says m).
+pub fn unit_of(dataset: &str) -> Option<&'static str> {
+    let leaf = dataset.rsplit('/').next().unwrap_or(dataset);
+    Some(match leaf {
+        "position" | "displacement" | "released_translation" | "arc_length" => "m",
+        "rotation" | "angle" | "rotation_vector" => "rad",
+        "velocity" => "m/s",
+        "angular_velocity" => "rad/s",
+        "reaction_force" | "force" => "N",
+        "reaction_moment" | "moment" => "N·m",
+        "dt" | "time" => "s",
+        "linear" if dataset.starts_with("/momentum") => "N·s",
+        "angular" if dataset.starts_with("/momentum") => "N·m·s",
+        _ if dataset.starts_with("/energy") => "J",
+        _ => return None,
+    })
+}
+
+/// A label from a dataset's description (or its last path element) and unit.
+fn label_of(r: &ResultReader, name: &str) -> String {
+    let text = match r.description(name) {
+        Some(d) if !d.is_empty() => d,
+        _ => name.rsplit('/').next().unwrap_or(name).replace('_', " "),
+    };
+    match unit_of(name) {
+        Some(u) => format!("{text} ({u})"),
+        None => text,
+    }
+}
+
+/// `DATASET` or `DATASET[k]`: the path (leading `/` added) and component.
+fn split_component(spec: &str) -> (String, Option<usize>) {
+    let spec = spec.trim();
+    let name = |s: &str| format!("/{}", s.trim_start_matches('/'));
+    if let Some(open) = spec.rfind('[') {
+        if let Some(k) = spec[open + 1..]
+            .strip_suffix(']')
+            .and_then(|k| k.trim().parse().ok())
+        {
+            return (name(&spec[..open]), Some(k));
+        }
+    }
+    (name(spec), None)
+}
+
 /// Draws `<out_dir>/<stem>.png` and `.svg` for each dataset path in
 /// `datasets` (leading `/` optional), where the stem is the path with `/`
 /// replaced by `_` (`/nodes/arm.end/displacement` →
@@ -81,69 +148,175 @@ pub fn plot_datasets(
     out_dir: &Path,
     log_y: bool,
 ) -> Result<Vec<PathBuf>, PlotError> {
+    let options = PlotOptions {
+        log_y,
+        ..PlotOptions::default()
+    };
+    plot_with(file, datasets, out_dir, &options)
+}
+
+/// One file's curves of dataset `name` (shape T or T×3) over `x`.
+fn curves(
+    r: &ResultReader,
+    file: &Path,
+    name: &str,
+    x: &[f64],
+    prefix: &str,
+) -> Result<Vec<Series>, PlotError> {
+    let steps = x.len();
+    let shape = r.shape(name)?;
+    let values = match shape.as_slice() {
+        [n] | [n, 3] if *n == steps => r.values(name)?,
+        _ => {
+            return Err(PlotError::BadShape {
+                path: file.to_path_buf(),
+                dataset: name.to_owned(),
+                shape,
+                steps,
+            })
+        }
+    };
+    let named = |label: &str| {
+        if prefix.is_empty() {
+            label.to_owned()
+        } else if label.is_empty() {
+            prefix.to_owned()
+        } else {
+            format!("{prefix}: {label}")
+        }
+    };
+    Ok(if shape.len() == 1 {
+        let label = if prefix.is_empty() {
+            name.rsplit('/').next().unwrap_or(name).replace('_', " ")
+        } else {
+            String::new()
+        };
+        vec![Series::new(named(&label), x.to_vec(), values)]
+    } else {
+        ["x", "y", "z"]
+            .iter()
+            .enumerate()
+            .map(|(c, label)| {
+                let y = values.iter().skip(c).step_by(3).copied().collect();
+                Series::new(named(label), x.to_vec(), y)
+            })
+            .collect()
+    })
+}
+
+/// The abscissae of a file: `/time`, or the `--x` dataset (a component of
+/// a T×3 one), with its label.
+fn abscissae(
+    r: &ResultReader,
+    file: &Path,
+    x: Option<&str>,
+) -> Result<(Vec<f64>, String), PlotError> {
+    let time = r.time()?;
+    let Some(spec) = x else {
+        let label = if r.integrator().as_deref() == Some("static") {
+            "load factor"
+        } else {
+            "time (s)"
+        };
+        return Ok((time, label.to_owned()));
+    };
+    let (name, component) = split_component(spec);
+    let shape = r.shape(&name)?;
+    let values = r.values(&name)?;
+    let bad = || PlotError::BadShape {
+        path: file.to_path_buf(),
+        dataset: format!("{name} (--x; a T×3 dataset needs a component, e.g. {name}[0])"),
+        shape: shape.clone(),
+        steps: time.len(),
+    };
+    let xs = match (shape.as_slice(), component) {
+        ([n], None) if *n == time.len() => values,
+        ([n, 3], Some(k)) if *n == time.len() && k < 3 => {
+            values.iter().skip(k).step_by(3).copied().collect()
+        }
+        _ => return Err(bad()),
+    };
+    let mut label = label_of(r, &name);
+    if let Some(k) = component {
+        label = format!("{label}, component {k}");
+    }
+    Ok((xs, label))
+}
+
+fn stem_of(file: &Path) -> String {
+    file.file_stem()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| file.display().to_string())
+}
+
+/// [`plot_datasets`] with [`PlotOptions`].
+pub fn plot_with(
+    file: &Path,
+    datasets: &[String],
+    out_dir: &Path,
+    options: &PlotOptions,
+) -> Result<Vec<PathBuf>, PlotError> {
     let r = ResultReader::open(file)?;
     let time = r.time()?;
-    let steps = time.len();
-
-    let x_label = if r.integrator().as_deref() == Some("static") {
-        "time (load factor in statics)"
+    let (x, x_label) = abscissae(&r, file, options.x.as_deref())?;
+    let x_label = options.x_label.clone().unwrap_or(x_label);
+    let markers = if options.x.is_none() {
+        stop_marker(r.string_attr(layout::ATTR_STATUS), &time)
     } else {
-        "time"
+        Vec::new()
     };
-    let markers = stop_marker(r.string_attr(layout::ATTR_STATUS), &time);
     let file_name = file
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| file.display().to_string());
+    let others: Vec<(PathBuf, ResultReader)> = options
+        .overlay
+        .iter()
+        .map(|p| ResultReader::open(p).map(|r| (p.clone(), r)))
+        .collect::<Result<_, _>>()?;
+    let overlaid = !others.is_empty();
 
     let mut charts = Vec::with_capacity(datasets.len());
     for requested in datasets {
         let name = format!("/{}", requested.trim_start_matches('/'));
         let shape = r.shape(&name)?;
-        let bad_shape = || PlotError::BadShape {
-            path: file.to_path_buf(),
-            dataset: name.clone(),
-            shape: shape.clone(),
-            steps,
-        };
+        let stem = out_dir.join(name.trim_start_matches('/').replace('/', "_"));
         if let [n, _, 3] = shape.as_slice() {
-            if *n == steps && name.starts_with(layout::RESULTANTS) {
-                let chart = resultants_chart(&r, &name, &file_name, &time)?;
-                let stem = out_dir.join(name.trim_start_matches('/').replace('/', "_"));
+            if *n == time.len() && name.starts_with(layout::RESULTANTS) {
+                let mut chart = resultants_chart(&r, &name, &file_name, &time)?;
+                if let Some(t) = &options.title {
+                    chart.title.clone_from(t);
+                }
                 charts.push((name, chart, stem));
                 continue;
             }
         }
-        let values = match shape.as_slice() {
-            [n] | [n, 3] if *n == steps => r.values(&name)?,
-            _ => return Err(bad_shape()),
-        };
-        let series = if shape.len() == 1 {
-            let label = name.rsplit('/').next().unwrap_or(&name).to_owned();
-            vec![Series::new(label, time.clone(), values)]
+        let own = if overlaid {
+            stem_of(file)
         } else {
-            ["x", "y", "z"]
-                .iter()
-                .enumerate()
-                .map(|(c, label)| {
-                    let y = values.iter().skip(c).step_by(3).copied().collect();
-                    Series::new(*label, time.clone(), y)
-                })
-                .collect()
+            String::new()
         };
-        let title = match r.description(&name) {
-            Some(d) if !d.is_empty() => format!("{file_name}: {d}"),
-            _ => file_name.clone(),
+        let mut series = curves(&r, file, &name, &x, &own)?;
+        for (path, other) in &others {
+            let (ox, _) = abscissae(other, path, options.x.as_deref())?;
+            series.extend(curves(other, path, &name, &ox, &stem_of(path))?);
+        }
+        let title = match (&options.title, r.description(&name)) {
+            (Some(t), _) => t.clone(),
+            (None, Some(d)) if !d.is_empty() => format!("{file_name}: {d}"),
+            (None, _) => file_name.clone(),
         };
         let chart = LineChart {
             title,
-            x_label: x_label.to_owned(),
-            y_label: name.clone(),
-            log_y,
+            x_label: x_label.clone(),
+            y_label: options
+                .y_label
+                .clone()
+                .unwrap_or_else(|| label_of(&r, &name)),
+            log_y: options.log_y,
             series,
             markers: markers.clone(),
         };
-        let stem = out_dir.join(name.trim_start_matches('/').replace('/', "_"));
         charts.push((name, chart, stem));
     }
 
@@ -211,8 +384,8 @@ fn resultants_chart(
     let t = time.last().copied().unwrap_or(f64::NAN);
     Ok(LineChart {
         title: format!("{file_name}: {name} at t = {t}"),
-        x_label: "arc length from the beam's start".to_owned(),
-        y_label: name.to_owned(),
+        x_label: "arc length from the beam's start (m)".to_owned(),
+        y_label: label_of(r, name),
         log_y: false,
         series,
         markers: Vec::new(),

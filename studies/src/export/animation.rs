@@ -422,50 +422,39 @@ fn mp4(
     }
     let dir = out.with_extension("frames");
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let result = encode(frames, camera, tracked, unit, out, opts, &dir);
+    let result = (|| {
+        for (i, k) in frame_steps(frames.steps(), opts.max_frames)
+            .into_iter()
+            .enumerate()
+        {
+            let path = dir.join(format!("frame_{i:06}.png"));
+            let area = BitMapBackend::new(&path, opts.size).into_drawing_area();
+            draw_frame(&area, frames, camera, k, tracked, unit)?;
+            area.present().map_err(|e| e.to_string())?;
+        }
+        // Even dimensions for yuv420p.
+        let status = std::process::Command::new("ffmpeg")
+            .args(["-y", "-loglevel", "error", "-framerate"])
+            .arg(format!("{}", opts.fps))
+            .arg("-i")
+            .arg(dir.join("frame_%06d.png"))
+            .args([
+                "-vf",
+                "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                "-c:v",
+                "libx264",
+                "-pix_fmt",
+                "yuv420p",
+            ])
+            .arg(out)
+            .status()
+            .map_err(|e| e.to_string())?;
+        if status.success() {
+            Ok(())
+        } else {
+            Err(format!("ffmpeg failed ({status})"))
+        }
+    })();
     let _ = std::fs::remove_dir_all(&dir);
     result
-}
-
-/// [`mp4`]'s frames in `dir`, then `ffmpeg`.
-fn encode(
-    frames: &Frames,
-    camera: &Camera,
-    tracked: &[usize],
-    unit: &str,
-    out: &Path,
-    opts: &AnimationOptions,
-    dir: &Path,
-) -> Result<(), String> {
-    for (i, k) in frame_steps(frames.steps(), opts.max_frames)
-        .into_iter()
-        .enumerate()
-    {
-        let path = dir.join(format!("frame_{i:06}.png"));
-        let area = BitMapBackend::new(&path, opts.size).into_drawing_area();
-        draw_frame(&area, frames, camera, k, tracked, unit)?;
-        area.present().map_err(|e| e.to_string())?;
-    }
-    // Even dimensions for yuv420p.
-    let status = std::process::Command::new("ffmpeg")
-        .args(["-y", "-loglevel", "error", "-framerate"])
-        .arg(format!("{}", opts.fps))
-        .arg("-i")
-        .arg(dir.join("frame_%06d.png"))
-        .args([
-            "-vf",
-            "pad=ceil(iw/2)*2:ceil(ih/2)*2",
-            "-c:v",
-            "libx264",
-            "-pix_fmt",
-            "yuv420p",
-        ])
-        .arg(out)
-        .status()
-        .map_err(|e| e.to_string())?;
-    if status.success() {
-        Ok(())
-    } else {
-        Err(format!("ffmpeg failed ({status})"))
-    }
 }

@@ -73,6 +73,55 @@ fn failure_markers(runs: &[&RunRecord]) -> Vec<(f64, String)> {
         .collect()
 }
 
+/// Energy–momentum markers on Fig. 8's curve (about this many).
+const FIG8_MARKERS: usize = 25;
+
+/// How far beyond the completed runs' range a failed run is still drawn,
+/// in units of that range: once past it, the run is off the chart's scale
+/// (its failure marker says when it failed).
+const OFF_SCALE: f64 = 1.0;
+
+/// The range `(lo, hi)` of `values` over the completed runs, when some run
+/// failed and some completed.
+fn completed_band(
+    runs: &[&RunRecord],
+    values: impl Fn(&RunRecord) -> Vec<f64>,
+) -> Option<(f64, f64)> {
+    if runs.iter().all(|r| r.failure_time.is_none()) {
+        return None;
+    }
+    let all: Vec<f64> = runs
+        .iter()
+        .filter(|r| r.failure_time.is_none())
+        .flat_map(|r| values(r))
+        .filter(|v| v.is_finite())
+        .collect();
+    let lo = all.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = all.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// A diverged run would set the scale and flatten the others: its curve
+/// stops where it leaves the completed runs' band widened by [`OFF_SCALE`],
+/// and its legend says so.
+fn keep_on_scale(chart: &mut LineChart, runs: &[&RunRecord], (lo, hi): (f64, f64)) {
+    let span = (hi - lo).max(1e-12 * hi.abs().max(lo.abs()).max(1.0));
+    let (min, max) = (lo - OFF_SCALE * span, hi + OFF_SCALE * span);
+    for (s, r) in chart.series.iter_mut().zip(runs) {
+        if r.failure_time.is_none() {
+            continue;
+        }
+        if let Some(k) =
+            s.y.iter()
+                .position(|&y| y.is_finite() && !(min..=max).contains(&y))
+        {
+            let t = s.x[k];
+            s.y[k..].iter_mut().for_each(|y| *y = f64::NAN);
+            s.label = format!("{} (off scale from t = {t:.2} s)", s.label);
+        }
+    }
+}
+
 /// A time-series chart of one quantity for the three schemes of a model.
 fn scheme_chart(
     runs: &[&RunRecord],
@@ -93,7 +142,11 @@ fn scheme_chart(
 }
 
 /// Draws every chart of the reproduction; returns the PNG paths.
-pub fn draw_all(records: &[RunRecord], out: &Path) -> Result<Vec<PathBuf>, ReproduceError> {
+pub fn draw_all(
+    records: &[RunRecord],
+    out: &Path,
+    titles: bool,
+) -> Result<Vec<PathBuf>, ReproduceError> {
     let dir = out.join("charts");
     let mut written = Vec::new();
     let mut models: Vec<&str> = records.iter().map(|r| r.model.as_str()).collect();
@@ -107,7 +160,10 @@ pub fn draw_all(records: &[RunRecord], out: &Path) -> Result<Vec<PathBuf>, Repro
                     .find(|r| r.model == model && r.integrator == *i)
             })
             .collect();
-        let mut draw = |name: String, chart: LineChart| -> Result<(), ReproduceError> {
+        let mut draw = |name: String, mut chart: LineChart| -> Result<(), ReproduceError> {
+            if !titles {
+                chart.title.clear();
+            }
             let (png, _) = chart.render(&dir.join(name))?;
             written.push(png);
             Ok(())
@@ -143,9 +199,17 @@ pub fn draw_all(records: &[RunRecord], out: &Path) -> Result<Vec<PathBuf>, Repro
             let chart = scheme_chart(
                 &runs,
                 "Driven screw joint: tip displacement (paper Fig. 8)",
-                "out-of-plane displacement u_z (m)",
+                "out-of-plane tip displacement (m)",
                 |r| column(&r.file, "/nodes/arm.end/displacement", 2),
             )?;
+            // The two conserving schemes' curves lie on each other: markers
+            // keep the energy–momentum one visible.
+            let mut chart = chart;
+            for (s, r) in chart.series.iter_mut().zip(&runs) {
+                if r.integrator == "energy-momentum" {
+                    s.mark_every = (s.x.len() / FIG8_MARKERS).max(1);
+                }
+            }
             draw("fig8_screw_driven_tip_uz".into(), chart)?;
             let chart = scheme_chart(
                 &runs,
@@ -160,17 +224,21 @@ pub fn draw_all(records: &[RunRecord], out: &Path) -> Result<Vec<PathBuf>, Repro
         } else {
             "total energy − work of the drive (J)"
         };
-        let chart = scheme_chart(
+        let band = completed_band(&runs, |r| r.balance.clone());
+        let mut chart = scheme_chart(
             &runs,
             &format!("{model}: energy balance"),
             energy_label,
             |r| Ok(r.balance.clone()),
         )?;
+        if let Some(band) = band {
+            keep_on_scale(&mut chart, &runs, band);
+        }
         draw(format!("{model}_energy"), chart)?;
         let mut chart = scheme_chart(
             &runs,
             &format!("{model}: relative energy error"),
-            "|E − E₀| / E_ref  (E_ref = E₀, or the drive's largest work)",
+            "relative energy error",
             |r| {
                 let b0 = r.balance.first().copied().unwrap_or(0.0);
                 Ok(r.balance
@@ -235,7 +303,7 @@ pub fn draw_all(records: &[RunRecord], out: &Path) -> Result<Vec<PathBuf>, Repro
                     })
                     .unwrap_or(0);
                 let axis = ["x", "y", "z"][c];
-                chart.y_label = format!("released translation r_R,{axis} (m)");
+                chart.y_label = format!("released translation, {axis} (m)");
                 chart.series.push(Series::new(
                     legend(&r.integrator),
                     angle,
@@ -263,6 +331,7 @@ pub fn draw_consistency(
     runs: &[RunRecord],
     half_step: &[RunRecord],
     out: &Path,
+    titles: bool,
 ) -> Result<Vec<PathBuf>, ReproduceError> {
     if half_step.is_empty() {
         return Ok(Vec::new());
@@ -287,6 +356,9 @@ pub fn draw_consistency(
         }
     }
     chart.log_y = true;
+    if !titles {
+        chart.title.clear();
+    }
     let (png, _) = chart.render(
         &out.join("charts")
             .join(format!("{CONSISTENCY_MODEL}_consistency")),

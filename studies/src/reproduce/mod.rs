@@ -81,6 +81,9 @@ pub struct ReproduceOptions {
     /// Factor on every model's `t_end` (1: the full examples; smaller for a
     /// quick look).
     pub time_scale: f64,
+    /// Titles inside the charts (false: none, for papers whose captions
+    /// carry them).
+    pub titles: bool,
 }
 
 impl ReproduceOptions {
@@ -90,6 +93,7 @@ impl ReproduceOptions {
             out: out.into(),
             models: Vec::new(),
             time_scale: 1.0,
+            titles: true,
         }
     }
 }
@@ -178,8 +182,13 @@ pub fn reproduce(options: &ReproduceOptions) -> Result<Reproduction, ReproduceEr
         .filter(|m| options.models.is_empty() || options.models.iter().any(|n| n == m.0))
         .collect();
     let (runs, half_step) = run_all(&selected, &options.out, options.time_scale)?;
-    let mut charts = charts::draw_all(&runs, &options.out)?;
-    charts.extend(charts::draw_consistency(&runs, &half_step, &options.out)?);
+    let mut charts = charts::draw_all(&runs, &options.out, options.titles)?;
+    charts.extend(charts::draw_consistency(
+        &runs,
+        &half_step,
+        &options.out,
+        options.titles,
+    )?);
     let summary = summary::write(&runs, &options.out)?;
     let views = views::write_all(&runs, &options.out)?;
     Ok(Reproduction {
