@@ -84,6 +84,9 @@ enum Command {
         /// Charts without titles (for papers whose captions carry them).
         #[arg(long)]
         no_titles: bool,
+        /// Also a PDF of every chart, from its PGFPlots copy (needs pdflatex).
+        #[arg(long)]
+        pdf: bool,
     },
     /// Draw line charts (PNG and SVG) of result datasets over /time (or
     /// over another dataset with --x), overlaying other files with --with.
@@ -121,6 +124,9 @@ enum Command {
         /// charts (repeat for more); curves are named by file.
         #[arg(long = "with", value_name = "RESULT.h5")]
         with: Vec<PathBuf>,
+        /// Also a PDF of each chart, from its PGFPlots copy (needs pdflatex).
+        #[arg(long)]
+        pdf: bool,
     },
     /// Write a result file as a ParaView time series.
     ///
@@ -350,12 +356,14 @@ fn execute(cli: Cli) -> ExitCode {
             models,
             time_scale,
             no_titles,
+            pdf,
         } => {
             let options = ReproduceOptions {
                 out,
                 models,
                 time_scale,
                 titles: !no_titles,
+                pdf,
             };
             match reproduce(&options) {
                 Ok(rep) => {
@@ -404,6 +412,7 @@ fn execute(cli: Cli) -> ExitCode {
             ylabel,
             title,
             with,
+            pdf,
         } => match plot_with(
             &result,
             &datasets,
@@ -415,6 +424,7 @@ fn execute(cli: Cli) -> ExitCode {
                 y_label: ylabel,
                 title,
                 overlay: with,
+                pdf,
             },
         ) {
             Ok(files) => {

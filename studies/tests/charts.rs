@@ -676,7 +676,17 @@ fn every_chart_gets_its_data_as_csv_and_a_pgfplots_file_that_compiles() {
         let tex = png.with_extension("tex");
         let text = std::fs::read_to_string(&tex).expect("the .tex exists");
         assert_eq!(text.matches("\\addplot[").count(), chart.series.len());
-        compiles(&tex);
+        if compiles(&tex) {
+            // The PDF output of `plot --pdf` / `reproduce --pdf`.
+            let stem = dir.path().join(format!("{stem}-pdf"));
+            let (_, _, pdf) = chart.render_with_pdf(&stem).expect("a PDF");
+            let bytes = std::fs::read(&pdf).expect("the PDF exists");
+            assert!(bytes.starts_with(b"%PDF") && bytes.len() > 1000);
+            assert!(
+                !stem.with_extension("log").exists(),
+                "pdflatex's log is removed"
+            );
+        }
     }
 }
 

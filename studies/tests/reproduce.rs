@@ -28,6 +28,7 @@ fn screw_free_shows_the_papers_claims() {
         models: vec!["screw_free".into()],
         time_scale: 1.0,
         titles: true,
+        pdf: false,
     };
     let rep = reproduce(&options).unwrap();
     assert_eq!(rep.runs.len(), 4);
@@ -175,6 +176,7 @@ fn driven_examples_run_and_balance_their_energy() {
         ],
         time_scale: 0.2,
         titles: false,
+        pdf: false,
     };
     let rep = reproduce(&options).unwrap();
     assert_eq!(rep.runs.len(), 4 * INTEGRATORS.len());

@@ -33,6 +33,15 @@ pub fn ensure_registered() -> bool {
     REGISTERED.load(Ordering::Acquire)
 }
 
+/// Width in pixels of `text` at font size `size`.
+pub(crate) fn text_width(content: &str, size: f64) -> f64 {
+    text(size)
+        .font
+        .box_size(content)
+        .map(|(w, _)| f64::from(w))
+        .unwrap_or(0.6 * size * content.chars().count() as f64)
+}
+
 /// A text style of the embedded family, `size` in pixels.
 pub fn text(size: f64) -> TextStyle<'static> {
     (FAMILY, size).into_font().into()

@@ -1,22 +1,26 @@
 //! Line charts in a journal style, written as a 1600×1000 px PNG and an SVG of
-//! the same layout.
+//! the same layout (with their CSV data and PGFPlots copy, [`super::pgfplots`]).
 //!
-//! Plotters draws the axes, tick labels and grid; this module chooses the
-//! ticks and their labels, lays the figure out (title, marker labels, axis
-//! areas), draws the curves with their own dash patterns, and places the
-//! legend in the corner where it hides the least data.
+//! Plotters draws the axes, tick labels, grid and text; this module lays the
+//! figure out (title, marker labels, axis areas), draws the curves clipped
+//! to the frame ([`super::clip`]) with their own dash patterns
+//! ([`super::strokes`]) and markers. The ticks and their labels are
+//! [`super::ticks`]'s, the legend's place [`super::legend`]'s — the parts
+//! plotters does not provide (common `×10ⁿ` factors, superscript decades,
+//! dash-dot patterns, a legend that avoids the data, supersampled PNGs).
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
-use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
-use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::clip::clip_polyline;
-use super::font;
+use super::font::{self, text_width};
+use super::legend::{Corner, LEGEND_INSET};
+use super::strokes::{dashed, pixels};
+use super::ticks::{Axis, TickRange};
 
 /// Width of the PNG (and of the SVG's canvas) in pixels.
 pub const WIDTH: u32 = 1600;
@@ -161,6 +165,14 @@ pub enum ChartError {
         /// The backend's message.
         message: String,
     },
+    /// The PDF could not be made from the chart's PGFPlots file.
+    #[error("chart {}: {why}", .path.display())]
+    Pdf {
+        /// The `.tex` file.
+        path: PathBuf,
+        /// What went wrong and how to fix it.
+        why: String,
+    },
     /// The output directory or file could not be written.
     #[error("chart {}: {source}", .path.display())]
     Io {
@@ -211,6 +223,16 @@ impl LineChart {
         super::pgfplots::write(self, &csv, &with_suffix(stem, ".tex"))
             .map_err(|source| ChartError::Io { path: csv, source })?;
         Ok((png, svg))
+    }
+
+    /// [`Self::render`], then the PDF of the chart's PGFPlots copy
+    /// (`<stem>.pdf`, by `pdflatex`: [`super::pgfplots::compile_pdf`]).
+    pub fn render_with_pdf(&self, stem: &Path) -> Result<(PathBuf, PathBuf, PathBuf), ChartError> {
+        let (png, svg) = self.render(stem)?;
+        let tex = with_suffix(stem, ".tex");
+        let pdf =
+            super::pgfplots::compile_pdf(&tex).map_err(|why| ChartError::Pdf { path: tex, why })?;
+        Ok((png, svg, pdf))
     }
 }
 
@@ -308,23 +330,16 @@ fn draw_error<E: std::error::Error + Send + Sync>(
 // Style (pixel sizes at the output size; multiplied by the drawing scale)
 // ---------------------------------------------------------------------------
 
-const MARGIN: f64 = 28.0;
+pub(super) const MARGIN: f64 = 28.0;
 const TITLE_FONT: f64 = 52.0;
 const DESC_FONT: f64 = 46.0;
 const TICK_FONT: f64 = 44.0;
-const LEGEND_FONT: f64 = 40.0;
 const NOTE_FONT: f64 = 36.0;
 const TICK_LEN: f64 = 12.0;
-const LINE_WIDTH: f64 = 4.0;
+pub(super) const LINE_WIDTH: f64 = 4.0;
 /// Radius of the data markers ([`Series::mark_every`]).
-const MARKER_RADIUS: f64 = 7.0;
-const AXIS_WIDTH: f64 = 2.0;
-const LEGEND_PAD: f64 = 16.0;
-const LEGEND_SAMPLE: f64 = 84.0;
-const LEGEND_GAP: f64 = 14.0;
-const LEGEND_INSET: f64 = 18.0;
-const LEGEND_COLUMN_GAP: f64 = 36.0;
-const LEGEND_ROW: f64 = LEGEND_FONT * 1.3;
+pub(super) const MARKER_RADIUS: f64 = 7.0;
+pub(super) const AXIS_WIDTH: f64 = 2.0;
 const NOTE_ROW: f64 = NOTE_FONT * 1.35;
 
 /// Okabe–Ito colours (distinguishable with colour-vision deficiencies).
@@ -355,276 +370,8 @@ fn series_style(index: usize) -> (RGBColor, &'static [f64]) {
     (PALETTE[index % n], DASHES[(index + index / n) % n])
 }
 
-/// Width in pixels of `text` at font size `size`.
-fn text_width(text: &str, size: f64) -> f64 {
-    font::text(size)
-        .font
-        .box_size(text)
-        .map(|(w, _)| f64::from(w))
-        .unwrap_or(0.6 * size * text.chars().count() as f64)
-}
-
-fn px(v: f64) -> i32 {
+pub(super) fn px(v: f64) -> i32 {
     v.round() as i32
-}
-
-// ---------------------------------------------------------------------------
-// Ticks
-// ---------------------------------------------------------------------------
-
-/// One axis: its range (in plotted coordinates: log10 of the value on a
-/// logarithmic axis), labelled ticks, unlabelled minor grid lines and an
-/// optional common factor such as `×10⁻³`.
-#[derive(Debug, Clone)]
-struct Axis {
-    lo: f64,
-    hi: f64,
-    ticks: Vec<f64>,
-    labels: Vec<String>,
-    minor: Vec<f64>,
-    factor: Option<String>,
-}
-
-impl Axis {
-    fn linear(lo: f64, hi: f64, target: usize) -> Self {
-        let (step, ticks) = nice_ticks(lo, hi, target);
-        let (labels, factor) = linear_labels(&ticks, step);
-        Self {
-            lo,
-            hi,
-            ticks,
-            labels,
-            minor: Vec::new(),
-            factor,
-        }
-    }
-
-    /// `lo`, `hi` are the data's exponents (log10). The range gets a small
-    /// margin, or is widened to whole decades when it would otherwise hold
-    /// fewer than two of them.
-    fn logarithmic(lo: f64, hi: f64) -> Self {
-        let pad = 0.04 * (hi - lo);
-        let (mut lo, mut hi) = (lo - pad, hi + pad);
-        if hi.floor() - lo.ceil() < 1.0 {
-            lo = (lo + 1e-9).floor();
-            hi = (hi - 1e-9).ceil().max(lo + 1.0);
-        }
-        let first = (lo - 1e-9).ceil() as i64;
-        let last = (hi + 1e-9).floor() as i64;
-        let decades = last - first;
-        let every = (decades + 8) / 9; // at most ~9 labelled decades
-        let mut ticks = Vec::new();
-        let mut minor = Vec::new();
-        for e in first..=last {
-            if e.rem_euclid(every) == 0 {
-                ticks.push(e as f64);
-            } else {
-                minor.push(e as f64);
-            }
-        }
-        if decades <= 6 {
-            for e in first - 1..=last {
-                minor.extend(
-                    (2..=9)
-                        .map(|m| e as f64 + f64::from(m).log10())
-                        .filter(|v| *v > lo && *v < hi),
-                );
-            }
-        }
-        let mut labels: Vec<String> = ticks
-            .iter()
-            .map(|&e| format!("10{}", superscript(e as i64)))
-            .collect();
-        // Fewer than three labelled decades: label 2× and 5× as well.
-        if ticks.len() < 3 {
-            for e in first - 1..=last {
-                for m in [2u8, 5] {
-                    let v = e as f64 + f64::from(m).log10();
-                    if v > lo && v < hi {
-                        ticks.push(v);
-                        labels.push(format!("{m}×10{}", superscript(e)));
-                        minor.retain(|&w| (w - v).abs() > 1e-9);
-                    }
-                }
-            }
-        }
-        Self {
-            lo,
-            hi,
-            ticks,
-            labels,
-            minor,
-            factor: None,
-        }
-    }
-
-    fn label_of(&self, v: f64) -> String {
-        self.ticks
-            .iter()
-            .position(|&t| t == v)
-            .map(|i| self.labels[i].clone())
-            .unwrap_or_default()
-    }
-
-    fn widest_label(&self, size: f64) -> f64 {
-        self.labels
-            .iter()
-            .map(|l| text_width(l, size))
-            .fold(0.0, f64::max)
-    }
-}
-
-/// A linear plotters coordinate whose grid lines are exactly an [`Axis`]'s
-/// ticks (bold) and minor lines (light).
-struct TickRange {
-    linear: RangedCoordf64,
-    ticks: Vec<f64>,
-    minor: Vec<f64>,
-}
-
-impl TickRange {
-    fn new(axis: &Axis) -> Self {
-        Self {
-            linear: (axis.lo..axis.hi).into(),
-            ticks: axis.ticks.clone(),
-            minor: axis.minor.clone(),
-        }
-    }
-}
-
-impl Ranged for TickRange {
-    type FormatOption = DefaultFormatting;
-    type ValueType = f64;
-
-    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
-        self.linear.map(value, limit)
-    }
-
-    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
-        if hint.weight().allow_light_points() {
-            self.minor.clone()
-        } else {
-            self.ticks.clone()
-        }
-    }
-
-    fn range(&self) -> std::ops::Range<f64> {
-        self.linear.range()
-    }
-}
-
-/// Ticks at multiples of 1, 2, 2.5 or 5 × 10ᵏ inside `[lo, hi]`, as close to
-/// `target` ticks as possible (2.5 slightly disfavoured, then coarser steps
-/// preferred). Returns the step and the ticks.
-fn nice_ticks(lo: f64, hi: f64, target: usize) -> (f64, Vec<f64>) {
-    let ticks_of = |step: f64| -> Vec<f64> {
-        let first = (lo / step - 1e-9).ceil() as i64;
-        let last = (hi / step + 1e-9).floor() as i64;
-        (first..=last)
-            .map(|k| {
-                let t = k as f64 * step;
-                if t.abs() < step * 1e-9 {
-                    0.0
-                } else {
-                    t
-                }
-            })
-            .collect()
-    };
-    let base = 10f64.powf(((hi - lo) / target.max(1) as f64).log10().floor());
-    let mut best: Option<(usize, f64)> = None;
-    for mag in [0.1 * base, base, 10.0 * base] {
-        for m in [1.0, 2.0, 2.5, 5.0] {
-            let step = m * mag;
-            let n = ((hi / step + 1e-9).floor() - (lo / step - 1e-9).ceil() + 1.0).max(0.0);
-            if n < 2.0 {
-                continue;
-            }
-            let score = 2 * (n as usize).abs_diff(target) + usize::from(m == 2.5);
-            if best.is_none_or(|(s, _)| score <= s) {
-                best = Some((score, step));
-            }
-        }
-    }
-    let step = best.map_or(hi - lo, |(_, s)| s);
-    (step, ticks_of(step))
-}
-
-/// Tick labels with as many decimals as the step needs; very large or small
-/// values get a common factor `×10ᵏ` shown once beside the axis. When the
-/// ticks differ only far behind their leading digits (a conserved energy, say),
-/// they are labelled as deviations from a reference tick, and the note beside
-/// the axis reads `×10ᵏ + offset`.
-fn linear_labels(ticks: &[f64], step: f64) -> (Vec<String>, Option<String>) {
-    let max_abs = ticks.iter().fold(0.0f64, |m, t| m.max(t.abs()));
-    let offset = if max_abs > 0.0 && step < 1e-4 * max_abs && !ticks.is_empty() {
-        ticks[ticks.len() / 2]
-    } else {
-        0.0
-    };
-    let shifted: Vec<f64> = ticks.iter().map(|t| t - offset).collect();
-    let max_abs = shifted.iter().fold(0.0f64, |m, t| m.max(t.abs()));
-    let exponent = if max_abs >= 1e4 || (max_abs > 0.0 && max_abs < 1e-2) {
-        max_abs.log10().floor() as i32
-    } else {
-        0
-    };
-    let scale = 10f64.powi(-exponent);
-    let scaled_step = step * scale;
-    let decimals = (0..=12)
-        .find(|&d| {
-            let v = scaled_step * 10f64.powi(d);
-            (v - v.round()).abs() < 1e-6 * v.max(1.0)
-        })
-        .unwrap_or(12) as usize;
-    let labels = shifted
-        .iter()
-        .map(|t| minus_sign(&format!("{:.*}", decimals, t * scale)))
-        .collect();
-    let factor = (exponent != 0).then(|| format!("×10{}", superscript(i64::from(exponent))));
-    if offset == 0.0 {
-        return (labels, factor);
-    }
-    // Enough significant digits that the offset is exact to the tick step.
-    let digits = ((offset.abs() / step).log10().ceil().max(1.0) as usize).min(16);
-    let off = minus_sign(&format!("{:+.*e}", digits, offset));
-    let note = match factor {
-        Some(f) => format!("{f} {off}"),
-        None => off,
-    };
-    (labels, Some(note))
-}
-
-/// Typographic minus; no negative zero.
-fn minus_sign(text: &str) -> String {
-    let zero = text
-        .trim_start_matches('-')
-        .chars()
-        .all(|c| c == '0' || c == '.');
-    if zero {
-        text.trim_start_matches('-').to_owned()
-    } else {
-        text.replace('-', "\u{2212}")
-    }
-}
-
-fn superscript(n: i64) -> String {
-    n.to_string()
-        .chars()
-        .map(|c| match c {
-            '-' => '⁻',
-            '0' => '⁰',
-            '1' => '¹',
-            '2' => '²',
-            '3' => '³',
-            '4' => '⁴',
-            '5' => '⁵',
-            '6' => '⁶',
-            '7' => '⁷',
-            '8' => '⁸',
-            _ => '⁹',
-        })
-        .collect()
 }
 
 // ---------------------------------------------------------------------------
@@ -632,59 +379,49 @@ fn superscript(n: i64) -> String {
 // ---------------------------------------------------------------------------
 
 /// A series reduced to drawable runs of points (plotted coordinates).
-struct Curve {
-    label: String,
-    color: RGBColor,
-    dash: &'static [f64],
-    runs: Vec<Vec<(f64, f64)>>,
+pub(super) struct Curve {
+    pub(super) label: String,
+    pub(super) color: RGBColor,
+    pub(super) dash: &'static [f64],
+    pub(super) runs: Vec<Vec<(f64, f64)>>,
     /// Marker on every k-th drawn point (0: none).
-    mark_every: usize,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Corner {
-    UpperRight,
-    UpperLeft,
-    LowerRight,
-    LowerLeft,
-    /// Below the plot, left-aligned with it (the plot is shortened to make room).
-    Outside,
+    pub(super) mark_every: usize,
 }
 
 /// Pixel geometry of the figure at one drawing scale (1 for the SVG, the
 /// supersampling factor for the PNG).
 #[derive(Debug, Clone)]
-struct Layout {
-    scale: f64,
-    x: Axis,
-    y: Axis,
-    top: f64,
-    right_margin: f64,
+pub(super) struct Layout {
+    pub(super) scale: f64,
+    pub(super) x: Axis,
+    pub(super) y: Axis,
+    pub(super) top: f64,
+    pub(super) right_margin: f64,
     /// Below the x axis' label: the margin, and the legend when it is
     /// outside the plot.
-    bottom_margin: f64,
-    x_area: f64,
-    y_area: f64,
+    pub(super) bottom_margin: f64,
+    pub(super) x_area: f64,
+    pub(super) y_area: f64,
     /// Plot rectangle: left, top, right, bottom.
-    plot: (f64, f64, f64, f64),
+    pub(super) plot: (f64, f64, f64, f64),
     /// Row (0 = nearest the plot) of each marker label.
-    marker_rows: Vec<usize>,
+    pub(super) marker_rows: Vec<usize>,
 }
 
 /// Everything needed to draw, independent of the backend.
-struct Figure {
-    title: String,
-    x_label: String,
-    y_label: String,
-    log_y: bool,
-    curves: Vec<Curve>,
-    markers: Vec<(f64, String)>,
+pub(super) struct Figure {
+    pub(super) title: String,
+    pub(super) x_label: String,
+    pub(super) y_label: String,
+    pub(super) log_y: bool,
+    pub(super) curves: Vec<Curve>,
+    pub(super) markers: Vec<(f64, String)>,
     /// Plotted x and y ranges before ticks are chosen.
-    x_range: (f64, f64),
-    y_range: (f64, f64),
-    legend: Option<Corner>,
+    pub(super) x_range: (f64, f64),
+    pub(super) y_range: (f64, f64),
+    pub(super) legend: Option<Corner>,
     /// Legend columns (more than one only below the plot).
-    legend_columns: usize,
+    pub(super) legend_columns: usize,
 }
 
 impl Figure {
@@ -791,130 +528,12 @@ impl Figure {
             legend: None,
             legend_columns: 1,
         };
-        if figure.legend_lines() == 0 {
-            return Ok(figure);
-        }
-
-        // The legend goes upper right unless it would hide data there and a
-        // free corner exists. If no corner is free, the top of the y range
-        // is raised so that the legend sits above every curve, or, for a
-        // legend too tall for that, it goes beside the plot.
-        let layout = figure.layout(1.0);
-        let corners = [
-            Corner::UpperRight,
-            Corner::UpperLeft,
-            Corner::LowerRight,
-            Corner::LowerLeft,
-        ];
-        let hidden: Vec<usize> = corners
-            .iter()
-            .map(|&c| figure.hidden_by(&layout, c))
-            .collect();
-        if let Some(i) = hidden.iter().position(|&n| n == 0) {
-            figure.legend = Some(corners[i]);
-            return Ok(figure);
-        }
-        let (_, top, _, bottom) = layout.plot;
-        let (_, legend_h) = figure.legend_size(1.0);
-        let f = (legend_h + LEGEND_INSET + 12.0) / (bottom - top);
-        if f < 0.3 {
-            let lo = layout.y.lo;
-            figure.y_range = (lo, d_hi + f / (1.0 - f) * (d_hi - lo));
-            figure.legend = Some(Corner::UpperRight);
-        } else {
-            // Below the plot: as many columns (up to three) as its width holds.
-            figure.legend = Some(Corner::Outside);
-            let (l, _, r, _) = layout.plot;
-            let entry = figure.legend_entry_width(1.0) + LEGEND_COLUMN_GAP;
-            let fit = ((r - l - 2.0 * LEGEND_PAD + LEGEND_COLUMN_GAP) / entry).floor() as usize;
-            figure.legend_columns = fit.clamp(1, 3).min(figure.legend_lines());
-        }
+        figure.place_legend(d_hi);
         Ok(figure)
     }
 
-    fn layout(&self, scale: f64) -> Layout {
+    pub(super) fn layout(&self, scale: f64) -> Layout {
         Layout::compute(self, scale)
-    }
-
-    fn legend_lines(&self) -> usize {
-        self.curves.iter().filter(|c| !c.label.is_empty()).count()
-    }
-
-    /// Width of one legend entry (sample, gap, longest label).
-    fn legend_entry_width(&self, scale: f64) -> f64 {
-        let text = self
-            .curves
-            .iter()
-            .filter(|c| !c.label.is_empty())
-            .map(|c| text_width(&c.label, LEGEND_FONT * scale))
-            .fold(0.0, f64::max);
-        (LEGEND_SAMPLE + LEGEND_GAP) * scale + text
-    }
-
-    fn legend_size(&self, scale: f64) -> (f64, f64) {
-        let cols = self.legend_columns.max(1);
-        let rows = self.legend_lines().div_ceil(cols) as f64;
-        let entry = self.legend_entry_width(scale);
-        (
-            2.0 * LEGEND_PAD * scale
-                + cols as f64 * entry
-                + (cols - 1) as f64 * LEGEND_COLUMN_GAP * scale,
-            (2.0 * LEGEND_PAD + rows * LEGEND_ROW) * scale,
-        )
-    }
-
-    /// Legend box (left, top, right, bottom) in a corner of the plot.
-    fn legend_box(&self, layout: &Layout, corner: Corner) -> (f64, f64, f64, f64) {
-        let s = layout.scale;
-        let (l, t, r, b) = layout.plot;
-        let (w, h) = self.legend_size(s);
-        let left = match corner {
-            Corner::UpperLeft | Corner::LowerLeft => l + LEGEND_INSET * s,
-            Corner::UpperRight | Corner::LowerRight => r - LEGEND_INSET * s - w,
-            Corner::Outside => l,
-        };
-        let top = match corner {
-            Corner::UpperLeft | Corner::UpperRight => t + LEGEND_INSET * s,
-            Corner::Outside => f64::from(HEIGHT) * s - MARGIN * s - h,
-            Corner::LowerLeft | Corner::LowerRight => b - LEGEND_INSET * s - h,
-        };
-        (left, top, left + w, top + h)
-    }
-
-    /// How many sampled points of the curves and marker lines (every ~6 px
-    /// along each line) the legend would hide in `corner`.
-    fn hidden_by(&self, layout: &Layout, corner: Corner) -> usize {
-        let (l, t, r, b) = self.legend_box(layout, corner);
-        let (l, t, r, b) = (l - 6.0, t - 6.0, r + 6.0, b + 6.0);
-        let inside = |(x, y): (f64, f64)| x >= l && x <= r && y >= t && y <= b;
-        let mut count = 0;
-        // Marker lines count as data too.
-        let (_, top, _, bottom) = layout.plot;
-        for (x, _) in &self.markers {
-            let (mx, _) = layout.to_px((*x, layout.y.lo));
-            let n = ((bottom - top) / 6.0).ceil() as usize;
-            count += (0..=n)
-                .filter(|k| inside((mx, top + (bottom - top) * *k as f64 / n as f64)))
-                .count();
-        }
-        for run in self.curves.iter().flat_map(|c| &c.runs) {
-            let pts: Vec<(f64, f64)> = run.iter().map(|&p| layout.to_px(p)).collect();
-            count += usize::from(inside(pts[0]));
-            for w in pts.windows(2) {
-                let n = ((w[1].0 - w[0].0).hypot(w[1].1 - w[0].1) / 6.0)
-                    .ceil()
-                    .max(1.0);
-                for k in 1..=n as usize {
-                    let f = k as f64 / n;
-                    let p = (
-                        w[0].0 + f * (w[1].0 - w[0].0),
-                        w[0].1 + f * (w[1].1 - w[0].1),
-                    );
-                    count += usize::from(inside(p));
-                }
-            }
-        }
-        count
     }
 
     /// Draws the figure on a canvas `scale` times the output size.
@@ -1077,48 +696,6 @@ impl Figure {
         }
         Ok(())
     }
-
-    fn draw_legend<DB: DrawingBackend>(
-        &self,
-        root: &DrawingArea<DB, Shift>,
-        lay: &Layout,
-        corner: Corner,
-    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-        let s = lay.scale;
-        let (l, t, r, b) = self.legend_box(lay, corner);
-        let corners = [(px(l), px(t)), (px(r), px(b))];
-        root.draw(&Rectangle::new(corners, WHITE.filled()))?;
-        root.draw(&Rectangle::new(
-            corners,
-            BLACK.mix(0.6).stroke_width(px(AXIS_WIDTH * s) as u32),
-        ))?;
-        let labelled = self.curves.iter().filter(|c| !c.label.is_empty());
-        let cols = self.legend_columns.max(1);
-        let column_step = self.legend_entry_width(s) + LEGEND_COLUMN_GAP * s;
-        for (i, curve) in labelled.enumerate() {
-            let (row, col) = (i / cols, i % cols);
-            let y = t + (LEGEND_PAD + (row as f64 + 0.5) * LEGEND_ROW) * s;
-            let x0 = l + LEGEND_PAD * s + col as f64 * column_step;
-            let sample = [(x0, y), (x0 + LEGEND_SAMPLE * s, y)];
-            let dash: Vec<f64> = curve.dash.iter().map(|d| d * s).collect();
-            for piece in dashed(&sample, &dash) {
-                root.draw(&PathElement::new(
-                    pixels(&piece),
-                    curve.color.stroke_width(px(LINE_WIDTH * s) as u32),
-                ))?;
-            }
-            if curve.mark_every > 0 {
-                let c = (px(x0 + 0.5 * LEGEND_SAMPLE * s), px(y));
-                root.draw(&Circle::new(c, px(MARKER_RADIUS * s), curve.color.filled()))?;
-            }
-            root.draw(&Text::new(
-                curve.label.clone(),
-                (px(x0 + (LEGEND_SAMPLE + LEGEND_GAP) * s), px(y)),
-                font::text(LEGEND_FONT * s).pos(Pos::new(HPos::Left, VPos::Center)),
-            ))?;
-        }
-        Ok(())
-    }
 }
 
 impl Layout {
@@ -1206,7 +783,7 @@ impl Layout {
     }
 
     /// Predicted pixel position of a plotted point.
-    fn to_px(&self, (x, y): (f64, f64)) -> (f64, f64) {
+    pub(super) fn to_px(&self, (x, y): (f64, f64)) -> (f64, f64) {
         let (l, t, r, b) = self.plot;
         (
             l + (x - self.x.lo) / (self.x.hi - self.x.lo) * (r - l),
@@ -1229,125 +806,9 @@ fn widen_if_flat(lo: f64, hi: f64) -> (f64, f64) {
     let pad = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
     (lo - pad, hi + pad)
 }
-
-fn pixels(points: &[(f64, f64)]) -> Vec<(i32, i32)> {
-    let mut out: Vec<(i32, i32)> = Vec::with_capacity(points.len());
-    for &(x, y) in points {
-        let p = (px(x), px(y));
-        if out.last() != Some(&p) {
-            out.push(p);
-        }
-    }
-    if out.len() == 1 {
-        out.push(out[0]);
-    }
-    out
-}
-
-/// Cuts a polyline into the "on" pieces of a dash pattern (pixel lengths,
-/// alternating on and off), keeping the pattern's phase across vertices.
-fn dashed(points: &[(f64, f64)], pattern: &[f64]) -> Vec<Vec<(f64, f64)>> {
-    if pattern.is_empty() || points.len() < 2 {
-        return vec![points.to_vec()];
-    }
-    let mut pieces = Vec::new();
-    let mut current = vec![points[0]];
-    let mut index = 0;
-    let mut left = pattern[0];
-    for w in points.windows(2) {
-        let (mut a, b) = (w[0], w[1]);
-        let mut d = (b.0 - a.0).hypot(b.1 - a.1);
-        while d > left {
-            let f = left / d;
-            let p = (a.0 + f * (b.0 - a.0), a.1 + f * (b.1 - a.1));
-            if index % 2 == 0 {
-                current.push(p);
-                pieces.push(std::mem::take(&mut current));
-            } else {
-                current = vec![p];
-            }
-            a = p;
-            d -= left;
-            index = (index + 1) % pattern.len();
-            left = pattern[index];
-        }
-        left -= d;
-        if index % 2 == 0 {
-            current.push(b);
-        }
-    }
-    if index % 2 == 0 && current.len() > 1 {
-        pieces.push(current);
-    }
-    pieces
-}
-
 #[cfg(test)]
 mod tests {
-
-    #[test]
-    fn nearly_constant_values_get_offset_labels() {
-        // Ticks 1e-12 apart on a value of 163: every label must differ, and
-        // the note beside the axis carries the factor and the offset.
-        let (step, ticks) = nice_ticks(163.0 - 2.5e-12, 163.0 + 2.5e-12, 6);
-        let (labels, note) = linear_labels(&ticks, step);
-        let mut unique = labels.clone();
-        unique.dedup();
-        assert_eq!(unique.len(), labels.len(), "{labels:?}");
-        let note = note.expect("offset note");
-        assert!(note.contains("×10") && note.contains("e2"), "{note}");
-        // Ordinary ranges keep plain labels.
-        let (step, ticks) = nice_ticks(0.0, 10.0, 6);
-        assert_eq!(linear_labels(&ticks, step).1, None);
-    }
-
     use super::*;
-
-    #[test]
-    fn ticks_come_close_to_the_target_count() {
-        assert_eq!(nice_ticks(0.0, 2.0, 7).0, 0.5);
-        assert_eq!(nice_ticks(0.1, 1.2, 7).0, 0.2);
-        assert_eq!(nice_ticks(-0.17, 0.5, 6).0, 0.1);
-        assert_eq!(nice_ticks(0.0, 11.0, 7).0, 2.0);
-    }
-
-    #[test]
-    fn linear_labels_use_the_steps_decimals_and_a_common_factor() {
-        let a = Axis::linear(-0.05, 1.05, 6);
-        assert_eq!(a.labels, ["0.0", "0.2", "0.4", "0.6", "0.8", "1.0"]);
-        let b = Axis::linear(-1.0e-4, 3.0e-4, 5);
-        assert_eq!(b.factor.as_deref(), Some("×10⁻⁴"));
-        assert_eq!(b.labels, ["\u{2212}1", "0", "1", "2", "3"]);
-        let c = Axis::linear(0.0, 2.5e5, 6);
-        assert_eq!(c.factor.as_deref(), Some("×10⁵"));
-        assert_eq!(c.labels[1], "0.5");
-    }
-
-    #[test]
-    fn log_axis_labels_decades() {
-        let a = Axis::logarithmic(-3.2, 0.4);
-        assert_eq!(a.labels, ["10⁻³", "10⁻²", "10⁻¹", "10⁰"]);
-        assert!(a.lo < -3.2 && a.hi > 0.4);
-        // Less than a decade of data: widened to whole decades, with 2× and
-        // 5× labelled too.
-        let b = Axis::logarithmic(-2.9, -2.6);
-        assert_eq!((b.lo, b.hi), (-3.0, -2.0));
-        assert_eq!(b.labels, ["10⁻³", "10⁻²", "2×10⁻³", "5×10⁻³"]);
-        let c = Axis::logarithmic(-16.0, 4.0);
-        assert!(c.ticks.len() <= 10, "{:?}", c.ticks);
-        assert!(c.ticks.contains(&0.0));
-    }
-
-    #[test]
-    fn dashes_keep_their_phase() {
-        let line = [(0.0, 0.0), (5.0, 0.0), (30.0, 0.0)];
-        let pieces = dashed(&line, &[10.0, 5.0]);
-        let spans: Vec<(f64, f64)> = pieces
-            .iter()
-            .map(|p| (p[0].0, p.last().unwrap().0))
-            .collect();
-        assert_eq!(spans, [(0.0, 10.0), (15.0, 25.0)]);
-    }
 
     #[test]
     fn downsampling_averages_blocks() {

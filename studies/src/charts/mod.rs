@@ -10,9 +10,12 @@
 
 mod clip;
 pub mod font;
+mod legend;
 mod line;
 pub mod pgfplots;
 mod plot;
+mod strokes;
+mod ticks;
 
 pub use line::{ChartError, LineChart, Series, AUTO_MARKERS, HEIGHT, WIDTH};
 pub use plot::{plot_datasets, plot_with, unit_of, PlotError, PlotOptions};

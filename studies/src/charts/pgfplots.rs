@@ -247,6 +247,42 @@ pub fn tex(chart: &LineChart, csv_name: &str) -> String {
     t
 }
 
+/// Compiles `tex` (a file [`write`] made) with `pdflatex` into the PDF next
+/// to it — vector graphics with the paper's own LaTeX fonts — and removes
+/// the run's `.aux` and `.log`. Fails naming `pdflatex` when it is not
+/// installed, or with the end of its log when the document does not compile.
+pub fn compile_pdf(tex: &Path) -> Result<std::path::PathBuf, String> {
+    let dir = tex
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = tex.file_name().ok_or("no file name")?;
+    let out = std::process::Command::new("pdflatex")
+        .args(["-interaction=nonstopmode", "-halt-on-error"])
+        .arg(name)
+        .current_dir(dir)
+        .output()
+        .map_err(|e| {
+            format!(
+                "PDF output needs pdflatex with pgfplots (Debian/Ubuntu: apt-get install \
+                 texlive-latex-base texlive-pictures texlive-latex-recommended): {e}"
+            )
+        })?;
+    for ext in ["aux", "log"] {
+        let _ = std::fs::remove_file(tex.with_extension(ext));
+    }
+    if !out.status.success() {
+        let log = String::from_utf8_lossy(&out.stdout);
+        let tail: Vec<&str> = log.lines().rev().take(12).collect();
+        return Err(format!(
+            "pdflatex failed on {}:\n{}",
+            tex.display(),
+            tail.into_iter().rev().collect::<Vec<_>>().join("\n")
+        ));
+    }
+    Ok(tex.with_extension("pdf"))
+}
+
 /// Writes `<stem>.csv` and `<stem>.tex` for `chart`.
 pub fn write(chart: &LineChart, csv_path: &Path, tex_path: &Path) -> std::io::Result<()> {
     std::fs::write(csv_path, csv(chart))?;

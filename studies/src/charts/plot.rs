@@ -88,6 +88,8 @@ pub struct PlotOptions {
     pub title: Option<String>,
     /// Other result files whose same datasets are drawn in the same charts.
     pub overlay: Vec<PathBuf>,
+    /// Also a PDF of each chart (its PGFPlots copy through `pdflatex`).
+    pub pdf: bool,
 }
 
 /// The unit of a dataset's values by its name (SI names for the model's
@@ -326,13 +328,18 @@ pub fn plot_with(
     })?;
     let mut written = Vec::with_capacity(2 * charts.len());
     for (name, chart, stem) in charts {
-        let (png, svg) = chart.render(&stem).map_err(|source| PlotError::Chart {
+        let error = |source| PlotError::Chart {
             path: file.to_path_buf(),
-            dataset: name,
+            dataset: name.clone(),
             source,
-        })?;
-        written.push(png);
-        written.push(svg);
+        };
+        if options.pdf {
+            let (png, svg, pdf) = chart.render_with_pdf(&stem).map_err(error)?;
+            written.extend([png, svg, pdf]);
+        } else {
+            let (png, svg) = chart.render(&stem).map_err(error)?;
+            written.extend([png, svg]);
+        }
     }
     Ok(written)
 }

@@ -73,6 +73,29 @@ fn failure_markers(runs: &[&RunRecord]) -> Vec<(f64, String)> {
         .collect()
 }
 
+/// How the reproduction's charts are written.
+#[derive(Debug, Clone, Copy)]
+pub struct Style {
+    /// Titles inside the charts.
+    pub titles: bool,
+    /// Also a PDF of each chart (pdflatex on its PGFPlots copy).
+    pub pdf: bool,
+}
+
+impl Style {
+    /// Writes `chart` at `stem` in this style; returns the PNG.
+    fn render(self, mut chart: LineChart, stem: &Path) -> Result<PathBuf, ReproduceError> {
+        if !self.titles {
+            chart.title.clear();
+        }
+        Ok(if self.pdf {
+            chart.render_with_pdf(stem)?.0
+        } else {
+            chart.render(stem)?.0
+        })
+    }
+}
+
 /// Energy–momentum markers on Fig. 8's curve (about this many).
 const FIG8_MARKERS: usize = 25;
 
@@ -145,7 +168,7 @@ fn scheme_chart(
 pub fn draw_all(
     records: &[RunRecord],
     out: &Path,
-    titles: bool,
+    style: Style,
 ) -> Result<Vec<PathBuf>, ReproduceError> {
     let dir = out.join("charts");
     let mut written = Vec::new();
@@ -160,11 +183,8 @@ pub fn draw_all(
                     .find(|r| r.model == model && r.integrator == *i)
             })
             .collect();
-        let mut draw = |name: String, mut chart: LineChart| -> Result<(), ReproduceError> {
-            if !titles {
-                chart.title.clear();
-            }
-            let (png, _) = chart.render(&dir.join(name))?;
+        let mut draw = |name: String, chart: LineChart| -> Result<(), ReproduceError> {
+            let png = style.render(chart, &dir.join(name))?;
             written.push(png);
             Ok(())
         };
@@ -331,7 +351,7 @@ pub fn draw_consistency(
     runs: &[RunRecord],
     half_step: &[RunRecord],
     out: &Path,
-    titles: bool,
+    style: Style,
 ) -> Result<Vec<PathBuf>, ReproduceError> {
     if half_step.is_empty() {
         return Ok(Vec::new());
@@ -356,10 +376,8 @@ pub fn draw_consistency(
         }
     }
     chart.log_y = true;
-    if !titles {
-        chart.title.clear();
-    }
-    let (png, _) = chart.render(
+    let png = style.render(
+        chart,
         &out.join("charts")
             .join(format!("{CONSISTENCY_MODEL}_consistency")),
     )?;

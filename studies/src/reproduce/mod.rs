@@ -84,6 +84,8 @@ pub struct ReproduceOptions {
     /// Titles inside the charts (false: none, for papers whose captions
     /// carry them).
     pub titles: bool,
+    /// Also a PDF of every chart (its PGFPlots copy through `pdflatex`).
+    pub pdf: bool,
 }
 
 impl ReproduceOptions {
@@ -94,6 +96,7 @@ impl ReproduceOptions {
             models: Vec::new(),
             time_scale: 1.0,
             titles: true,
+            pdf: false,
         }
     }
 }
@@ -182,12 +185,16 @@ pub fn reproduce(options: &ReproduceOptions) -> Result<Reproduction, ReproduceEr
         .filter(|m| options.models.is_empty() || options.models.iter().any(|n| n == m.0))
         .collect();
     let (runs, half_step) = run_all(&selected, &options.out, options.time_scale)?;
-    let mut charts = charts::draw_all(&runs, &options.out, options.titles)?;
+    let style = charts::Style {
+        titles: options.titles,
+        pdf: options.pdf,
+    };
+    let mut charts = charts::draw_all(&runs, &options.out, style)?;
     charts.extend(charts::draw_consistency(
         &runs,
         &half_step,
         &options.out,
-        options.titles,
+        style,
     )?);
     let summary = summary::write(&runs, &options.out)?;
     let views = views::write_all(&runs, &options.out)?;
