@@ -665,3 +665,18 @@ fn the_shipped_study_file_loads() {
         flexmech_studies::study::sweep::model_for(&spec, &plan).unwrap();
     }
 }
+
+#[test]
+fn titles_are_optional_and_a_wrong_value_is_refused_by_key() {
+    let dir = scratch("titles");
+    assert!(small_spec(&dir).titles, "titles by default");
+    let file = dir.join("untitled.toml");
+    std::fs::write(&file, small_study_text() + "\n[output]\ntitles = false\n").unwrap();
+    assert!(!load_study(&file).unwrap().titles);
+    std::fs::write(&file, small_study_text() + "\n[output]\ntitles = \"no\"\n").unwrap();
+    let err = load_study(&file).unwrap_err().to_string();
+    assert!(
+        err.contains("output.titles") && err.contains("true or false"),
+        "{err}"
+    );
+}

@@ -91,11 +91,12 @@ pub fn summary_charts(
     let first_figure = 2 + spec.grid.len();
     for (f, figure) in spec.figures.iter().enumerate() {
         let col = first_figure + f;
-        let mut chart = LineChart::new(
-            format!("{}: {}", spec.name, figure.name()),
-            x_label.clone(),
-            figure.axis_label(),
-        );
+        let title = if spec.titles {
+            format!("{}: {}", spec.name, figure.name())
+        } else {
+            String::new()
+        };
+        let mut chart = LineChart::new(title, x_label.clone(), figure.axis_label());
         for (label, rows) in &groups {
             let mut points: Vec<(f64, f64)> = rows
                 .iter()

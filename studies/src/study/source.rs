@@ -80,6 +80,7 @@ impl StudySpec {
             source: RunSource::Function(ModelFn(Arc::new(build))),
             grid,
             figures,
+            titles: true,
         })
     }
 
@@ -115,6 +116,7 @@ impl StudySpec {
             },
             grid,
             figures,
+            titles: true,
         })
     }
 }

@@ -234,6 +234,9 @@ pub struct StudySpec {
     pub grid: Vec<GridKey>,
     /// The summary figures, in the order written.
     pub figures: Vec<Figure>,
+    /// Titles inside the summary charts (`[output] titles = false`: none,
+    /// for papers whose captions carry them).
+    pub titles: bool,
 }
 
 /// Why a study file was rejected.
@@ -645,18 +648,24 @@ pub fn parse_study(text: &str, path: &Path) -> Result<StudySpec, SpecError> {
     }
 
     let mut figures = Figure::ALL.to_vec();
+    let mut titles = true;
     match root.get("output") {
         None => {}
         Some(Value::Table(t)) => {
             for key in t.keys() {
-                if key != "figures" {
+                if key != "figures" && key != "titles" {
                     return Err(SpecError::UnknownKey {
                         file,
                         line: lines.get(&format!("output.{key}")),
                         key: format!("output.{key}"),
-                        allowed: "output.figures",
+                        allowed: "output.figures, output.titles",
                     });
                 }
+            }
+            match t.get("titles") {
+                None => {}
+                Some(Value::Boolean(b)) => titles = *b,
+                Some(v) => return Err(wrong_type("output.titles", "true or false", v)),
             }
             if let Some(v) = t.get("figures") {
                 let line = lines.get("output.figures");
@@ -705,6 +714,7 @@ pub fn parse_study(text: &str, path: &Path) -> Result<StudySpec, SpecError> {
         },
         grid,
         figures,
+        titles,
     })
 }
 
