@@ -5,8 +5,10 @@
 # dynamic benchmarks in full with every integrator (the long, #[ignore]d runs
 # of studies/tests/published_dynamics.rs).
 #   results/<model>/<integrator>.h5   the paper's examples
-#   results/charts/*.png, *.svg       their figures
+#   results/charts/*.png, .svg, .csv, .tex   their figures (and editable copies)
 #   results/summary.csv, summary.md   outcome, energy drift, step halvings
+#   results/<model>/<integrator>.pvd  ParaView series of each run
+#   results/animations/<model>.gif    each example moving
 #   results/models/<name>.h5          the other models
 # (or the directory given as the first argument instead of results/).
 set -e
@@ -17,4 +19,4 @@ FLEXMECH="${CARGO_TARGET_DIR:-target}/release/flexmech"
 "$FLEXMECH" reproduce --out "$OUT"
 "$FLEXMECH" run data/benchmarks/*.toml data/statics/*.toml data/dynamics/*.toml --out "$OUT/models"
 cargo test --release -p flexmech-studies --test published_dynamics -- --ignored
-echo "results written to $OUT/ (figures in $OUT/charts/, summary in $OUT/summary.md)"
+echo "results written to $OUT/ (figures in $OUT/charts/, summary in $OUT/summary.md, ParaView series $OUT/<model>/<integrator>.pvd, animations in $OUT/animations/)"
