@@ -9,26 +9,11 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::font::{self, text_width};
-use super::line::{px, Figure, Layout, AXIS_WIDTH, HEIGHT, LINE_WIDTH, MARGIN, MARKER_RADIUS};
+use super::line::{
+    px, Corner, Figure, Layout, AXIS_WIDTH, HEIGHT, LEGEND_COLUMN_GAP, LEGEND_FONT, LEGEND_GAP,
+    LEGEND_INSET, LEGEND_PAD, LEGEND_ROW, LEGEND_SAMPLE, LINE_WIDTH, MARGIN, MARKER_RADIUS,
+};
 use super::strokes::{dashed, pixels};
-
-pub(super) const LEGEND_FONT: f64 = 40.0;
-pub(super) const LEGEND_PAD: f64 = 16.0;
-pub(super) const LEGEND_SAMPLE: f64 = 84.0;
-pub(super) const LEGEND_GAP: f64 = 14.0;
-pub(super) const LEGEND_INSET: f64 = 18.0;
-pub(super) const LEGEND_COLUMN_GAP: f64 = 36.0;
-pub(super) const LEGEND_ROW: f64 = LEGEND_FONT * 1.3;
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum Corner {
-    UpperRight,
-    UpperLeft,
-    LowerRight,
-    LowerLeft,
-    /// Below the plot, left-aligned with it (the plot is shortened to make room).
-    Outside,
-}
 
 impl Figure {
     /// Chooses the legend's place (module docs); `d_hi` is the data's top.

@@ -16,9 +16,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+use super::chart::{LineChart, AUTO_MARKERS};
 use super::clip::clip_polyline;
 use super::font::{self, text_width};
-use super::legend::{Corner, LEGEND_INSET};
 use super::strokes::{dashed, pixels};
 use super::ticks::{Axis, TickRange};
 
@@ -26,63 +26,6 @@ use super::ticks::{Axis, TickRange};
 pub const WIDTH: u32 = 1600;
 /// Height of the PNG (and of the SVG's canvas) in pixels.
 pub const HEIGHT: u32 = 1000;
-
-/// One curve: `y[i]` over `x[i]`. Points where either value is NaN or
-/// infinite (or, on a logarithmic axis, where `y ≤ 0`) are left out and split
-/// the curve.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Series {
-    /// Legend entry; an empty label keeps the series out of the legend.
-    pub label: String,
-    /// Abscissae.
-    pub x: Vec<f64>,
-    /// Ordinates, as many as `x`.
-    pub y: Vec<f64>,
-    /// A marker on every `mark_every`-th point (0: none, unless the curve
-    /// has at most [`AUTO_MARKERS`] points, which are then all marked), so
-    /// curves that lie on each other stay visible and short ones are not
-    /// mistaken for lines through data.
-    pub mark_every: usize,
-}
-
-/// Curves with at most this many points get a marker on every point.
-pub const AUTO_MARKERS: usize = 12;
-
-impl Series {
-    /// A series from its label and values.
-    pub fn new(label: impl Into<String>, x: Vec<f64>, y: Vec<f64>) -> Self {
-        Self {
-            label: label.into(),
-            x,
-            y,
-            mark_every: 0,
-        }
-    }
-
-    /// The series with a marker on every `k`-th point.
-    pub fn with_markers(mut self, k: usize) -> Self {
-        self.mark_every = k;
-        self
-    }
-}
-
-/// A line chart: curves, axis labels (with units, written as given) and
-/// vertical marker lines such as a failure time.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct LineChart {
-    /// Text above the plot; may be empty.
-    pub title: String,
-    /// Label of the horizontal axis, e.g. `"time (s)"`.
-    pub x_label: String,
-    /// Label of the vertical axis, e.g. `"strain energy (J)"`.
-    pub y_label: String,
-    /// Logarithmic vertical axis (decades, labels `10ⁿ`).
-    pub log_y: bool,
-    /// The curves; colours and line styles are distinct for up to six.
-    pub series: Vec<Series>,
-    /// Vertical lines at `x` with a label shown above the plot.
-    pub markers: Vec<(f64, String)>,
-}
 
 /// Why a chart could not be drawn or written; every variant names the file.
 #[derive(Debug, thiserror::Error)]
@@ -185,20 +128,6 @@ pub enum ChartError {
 }
 
 impl LineChart {
-    /// An empty chart with a title and axis labels.
-    pub fn new(
-        title: impl Into<String>,
-        x_label: impl Into<String>,
-        y_label: impl Into<String>,
-    ) -> Self {
-        Self {
-            title: title.into(),
-            x_label: x_label.into(),
-            y_label: y_label.into(),
-            ..Self::default()
-        }
-    }
-
     /// Draws the chart into `<stem>.png` (1600×1000 px) and `<stem>.svg`,
     /// writes its editable copies `<stem>.csv` and `<stem>.tex` (PGFPlots,
     /// [`super::pgfplots`]) and returns the PNG and SVG paths. The extensions are appended, so a stem may contain
@@ -341,6 +270,25 @@ pub(super) const LINE_WIDTH: f64 = 4.0;
 pub(super) const MARKER_RADIUS: f64 = 7.0;
 pub(super) const AXIS_WIDTH: f64 = 2.0;
 const NOTE_ROW: f64 = NOTE_FONT * 1.35;
+
+// Legend (drawn and placed by [`super::legend`]).
+pub(super) const LEGEND_FONT: f64 = 40.0;
+pub(super) const LEGEND_PAD: f64 = 16.0;
+pub(super) const LEGEND_SAMPLE: f64 = 84.0;
+pub(super) const LEGEND_GAP: f64 = 14.0;
+pub(super) const LEGEND_INSET: f64 = 18.0;
+pub(super) const LEGEND_COLUMN_GAP: f64 = 36.0;
+pub(super) const LEGEND_ROW: f64 = LEGEND_FONT * 1.3;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Corner {
+    UpperRight,
+    UpperLeft,
+    LowerRight,
+    LowerLeft,
+    /// Below the plot, left-aligned with it (the plot is shortened to make room).
+    Outside,
+}
 
 /// Okabe–Ito colours (distinguishable with colour-vision deficiencies).
 const PALETTE: [RGBColor; 6] = [

@@ -8,6 +8,7 @@
 //! system font. [`plot_datasets`] is the `flexmech plot` command: charts of
 //! HDF5 result datasets over `/time`.
 
+mod chart;
 mod clip;
 pub mod font;
 mod legend;
@@ -17,5 +18,6 @@ mod plot;
 mod strokes;
 mod ticks;
 
-pub use line::{ChartError, LineChart, Series, AUTO_MARKERS, HEIGHT, WIDTH};
+pub use chart::{LineChart, Series, AUTO_MARKERS};
+pub use line::{ChartError, HEIGHT, WIDTH};
 pub use plot::{plot_datasets, plot_with, unit_of, PlotError, PlotOptions};

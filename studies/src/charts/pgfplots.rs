@@ -14,7 +14,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::line::{LineChart, Series, AUTO_MARKERS};
+use super::chart::{LineChart, Series, AUTO_MARKERS};
 
 /// The curves' colours (Okabe–Ito, as the PNG) and dash patterns.
 const COLORS: [(&str, &str); 6] = [

@@ -14,7 +14,8 @@
 
 use std::path::{Path, PathBuf};
 
-use super::line::{ChartError, LineChart, Series};
+use super::chart::{LineChart, Series};
+use super::line::ChartError;
 use crate::results::{layout, ReadError, ResultReader};
 
 /// Why `plot_datasets` could not draw the charts; every variant names the
