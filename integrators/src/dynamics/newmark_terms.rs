@@ -121,6 +121,19 @@ fn angular_acceleration<T: flexmech_core::Scalar>(
 ) -> Vector3<T> {
     let c = |x: f64| T::from_subset(&x);
     let omega = log(&(r1 * r_n.map(c).transpose()));
+    acceleration_of_increment(k, r_n, omega, w_n, a_n, dt)
+}
+
+/// [`angular_acceleration`] from the spatial increment `ω = log(Rₙ₊₁Rₙᵀ)`.
+fn acceleration_of_increment<T: flexmech_core::Scalar>(
+    k: &Coefficients,
+    r_n: &Matrix3<f64>,
+    omega: Vector3<T>,
+    w_n: &Vector3<f64>,
+    a_n: &Vector3<f64>,
+    dt: f64,
+) -> Vector3<T> {
+    let c = |x: f64| T::from_subset(&x);
     let big_omega = r_n.map(c).transpose() * omega;
     (big_omega - w_n.map(c) * c(dt) - a_n.map(c) * c(dt * dt * (0.5 - k.beta)))
         / c(k.beta * dt * dt)
@@ -165,7 +178,7 @@ fn inertial_moment_tangent(
     dt: f64,
 ) -> (Vector3<f64>, Matrix3<f64>) {
     let omega = log(&(r1 * r_n.transpose()));
-    let a1 = angular_acceleration(k, r_n, r1, &prev.w[i], &prev.alpha[i], dt);
+    let a1 = acceleration_of_increment(k, r_n, omega, &prev.w[i], &prev.alpha[i], dt);
     let w1 = prev.w[i] + prev.alpha[i] * (dt * (1.0 - k.gamma)) + a1 * (dt * k.gamma);
     let acc1 = k.acceleration(a1, &prev.alpha[i], &prev.ang_acc[i]);
     let jw = j0 * w1;
