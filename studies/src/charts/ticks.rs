@@ -1,10 +1,12 @@
-//! Axis ticks and their labels: "nice" linear steps with a common factor
-//! (`×10ⁿ`) or an offset note when the labels would repeat, decades `10ⁿ`
-//! (and 2×, 5× when few) on a logarithmic axis, the true minus sign and
-//! Unicode superscripts — what plotters' own formatters do not give — and
-//! the plotters coordinate whose grid lines are exactly these ticks.
+//! Axis ticks and their labels. Where the ticks go is plotters' choice (its
+//! linear key points, and `LogCoord`'s decades and 2…9× lines); what is added
+//! here is what plotters' formatters do not give: a common factor (`×10ⁿ`) or
+//! an offset note when the labels would repeat, decade labels `10ⁿ` (and 2×,
+//! 5× when few), the true minus sign and Unicode superscripts — and the
+//! plotters coordinate whose grid lines are exactly these ticks.
 
-use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
+use plotters::coord::combinators::LogCoord;
+use plotters::coord::ranged1d::{BoldPoints, DefaultFormatting, KeyPointHint};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
@@ -24,6 +26,8 @@ pub(super) struct Axis {
 }
 
 impl Axis {
+    /// Ticks from plotters' own choice of "nice" key points (steps of 1, 2 or
+    /// 5 × 10ᵏ, at most `target + 1` of them), labelled here.
     pub(super) fn linear(lo: f64, hi: f64, target: usize) -> Self {
         let (step, ticks) = nice_ticks(lo, hi, target);
         let (labels, factor) = linear_labels(&ticks, step);
@@ -39,50 +43,43 @@ impl Axis {
 
     /// `lo`, `hi` are the data's exponents (log10). The range gets a small
     /// margin, or is widened to whole decades when it would otherwise hold
-    /// fewer than two of them.
+    /// fewer than two of them. Decades and the 2…9× lines between them are
+    /// plotters' logarithmic key points (`LogCoord`: bold and light points);
+    /// at most about nine decades are labelled, always including 10⁰.
     pub(super) fn logarithmic(lo: f64, hi: f64) -> Self {
-        let pad = 0.04 * (hi - lo);
+        let pad = LOG_MARGIN * (hi - lo);
         let (mut lo, mut hi) = (lo - pad, hi + pad);
         if hi.floor() - lo.ceil() < 1.0 {
-            lo = (lo + 1e-9).floor();
-            hi = (hi - 1e-9).ceil().max(lo + 1.0);
+            lo = (lo + EXPONENT_SLACK).floor();
+            hi = (hi - EXPONENT_SLACK).ceil().max(lo + 1.0);
         }
-        let first = (lo - 1e-9).ceil() as i64;
-        let last = (hi + 1e-9).floor() as i64;
-        let decades = last - first;
-        let every = (decades + 8) / 9; // at most ~9 labelled decades
+        let (decades, between) = log_key_points(lo, hi);
+        let every = (decades.len() as i64 + 7) / 9; // at most ~9 labelled decades
         let mut ticks = Vec::new();
         let mut minor = Vec::new();
-        for e in first..=last {
-            if e.rem_euclid(every) == 0 {
-                ticks.push(e as f64);
+        for &e in &decades {
+            if (e.round() as i64).rem_euclid(every.max(1)) == 0 {
+                ticks.push(e);
             } else {
-                minor.push(e as f64);
+                minor.push(e);
             }
         }
-        if decades <= 6 {
-            for e in first - 1..=last {
-                minor.extend(
-                    (2..=9)
-                        .map(|m| e as f64 + f64::from(m).log10())
-                        .filter(|v| *v > lo && *v < hi),
-                );
-            }
+        if decades.len() <= 7 {
+            minor.extend(between.iter().copied());
         }
         let mut labels: Vec<String> = ticks
             .iter()
-            .map(|&e| format!("10{}", superscript(e as i64)))
+            .map(|&e| format!("10{}", superscript(e.round() as i64)))
             .collect();
         // Fewer than three labelled decades: label 2× and 5× as well.
         if ticks.len() < 3 {
-            for e in first - 1..=last {
-                for m in [2u8, 5] {
-                    let v = e as f64 + f64::from(m).log10();
-                    if v > lo && v < hi {
-                        ticks.push(v);
-                        labels.push(format!("{m}×10{}", superscript(e)));
-                        minor.retain(|&w| (w - v).abs() > 1e-9);
-                    }
+            for &v in &between {
+                let e = (v + EXPONENT_SLACK).floor();
+                let m = 10f64.powf(v - e).round() as u8;
+                if m == 2 || m == 5 {
+                    ticks.push(v);
+                    labels.push(format!("{m}×10{}", superscript(e as i64)));
+                    minor.retain(|&w| (w - v).abs() > EXPONENT_SLACK);
                 }
             }
         }
@@ -151,41 +148,79 @@ impl Ranged for TickRange {
     }
 }
 
-/// Ticks at multiples of 1, 2, 2.5 or 5 × 10ᵏ inside `[lo, hi]`, as close to
-/// `target` ticks as possible (2.5 slightly disfavoured, then coarser steps
-/// preferred). Returns the step and the ticks.
+/// Relative margin added to a logarithmic axis's data range.
+const LOG_MARGIN: f64 = 0.04;
+/// Slack on exponents (log10) when deciding whether a value is a decade.
+const EXPONENT_SLACK: f64 = 1e-9;
+
+/// Plotters' linear key points inside `[lo, hi]` — multiples of 1, 2 or
+/// 5 × 10ᵏ, the finest such step giving at most `target + 1` points —
+/// snapped to exact multiples of that step. Returns the step and the ticks.
 fn nice_ticks(lo: f64, hi: f64, target: usize) -> (f64, Vec<f64>) {
-    let ticks_of = |step: f64| -> Vec<f64> {
-        let first = (lo / step - 1e-9).ceil() as i64;
-        let last = (hi / step + 1e-9).floor() as i64;
-        (first..=last)
-            .map(|k| {
-                let t = k as f64 * step;
-                if t.abs() < step * 1e-9 {
-                    0.0
-                } else {
-                    t
-                }
-            })
+    if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+        return (0.0, Vec::new());
+    }
+    let range: RangedCoordf64 = (lo..hi).into();
+    let points = range.key_points(target + 1);
+    let step = match points.as_slice() {
+        [a, b, ..] => round_to_nice(b - a),
+        _ => hi - lo,
+    };
+    let ticks = points
+        .iter()
+        .map(|&t| (t / step).round() * step)
+        .map(|t| if t == 0.0 { 0.0 } else { t })
+        .collect();
+    (step, ticks)
+}
+
+/// The number of the form {1, 2, 5} × 10ᵏ nearest to `step` (the spacing of
+/// plotters' key points, measured with rounding error).
+fn round_to_nice(step: f64) -> f64 {
+    let k = step.log10().floor();
+    let base = 10f64.powf(k);
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * base)
+        .min_by(|a, b| (a - step).abs().total_cmp(&(b - step).abs()))
+        .unwrap_or(step)
+}
+
+/// Plotters' key points of a logarithmic axis over `[10^lo, 10^hi]`: the
+/// decades (bold points) and the 2…9 × 10ᵏ lines (light points), both as
+/// exponents (log10).
+fn log_key_points(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+        return (Vec::new(), Vec::new());
+    }
+    // Half a decade more on both sides, so that rounding in plotters' own
+    // powers of ten cannot drop an end decade; the filters below trim it.
+    // Plotters treats values below f64::EPSILON as zero and skips them, so the
+    // key points are taken on the range shifted to start near 10⁰ (decades
+    // map to decades) and shifted back.
+    let shift = lo.floor();
+    let (from, to) = (-0.5, hi - shift + 0.5);
+    let axis: LogCoord<f64> = (10f64.powf(from)..10f64.powf(to)).log_scale().into();
+    // Plotters adds light points once more than ten points per decade are
+    // allowed: one point per decade gives the decades, ten the 2…9× lines.
+    let decade_count = (to - from).ceil() as usize;
+    let exponents = |points_per_decade: usize| -> Vec<f64> {
+        axis.key_points(BoldPoints(points_per_decade * decade_count))
+            .iter()
+            .map(|v| v.log10() + shift)
             .collect()
     };
-    let base = 10f64.powf(((hi - lo) / target.max(1) as f64).log10().floor());
-    let mut best: Option<(usize, f64)> = None;
-    for mag in [0.1 * base, base, 10.0 * base] {
-        for m in [1.0, 2.0, 2.5, 5.0] {
-            let step = m * mag;
-            let n = ((hi / step + 1e-9).floor() - (lo / step - 1e-9).ceil() + 1.0).max(0.0);
-            if n < 2.0 {
-                continue;
-            }
-            let score = 2 * (n as usize).abs_diff(target) + usize::from(m == 2.5);
-            if best.is_none_or(|(s, _)| score <= s) {
-                best = Some((score, step));
-            }
-        }
-    }
-    let step = best.map_or(hi - lo, |(_, s)| s);
-    (step, ticks_of(step))
+    let decades: Vec<f64> = exponents(1)
+        .into_iter()
+        .map(f64::round)
+        .filter(|e| *e >= lo - EXPONENT_SLACK && *e <= hi + EXPONENT_SLACK)
+        .collect();
+    let between = exponents(10)
+        .into_iter()
+        .filter(|v| *v > lo && *v < hi)
+        .filter(|v| (v - v.round()).abs() > EXPONENT_SLACK)
+        .collect();
+    (decades, between)
 }
 
 /// Tick labels with as many decimals as the step needs; very large or small
@@ -318,5 +353,24 @@ mod tests {
         let c = Axis::logarithmic(-16.0, 4.0);
         assert!(c.ticks.len() <= 10, "{:?}", c.ticks);
         assert!(c.ticks.contains(&0.0));
+    }
+
+    #[test]
+    fn log_axis_keeps_decades_below_machine_epsilon() {
+        // Conserving schemes' energy errors live near 1e-16; plotters alone
+        // would drop those decades as zero.
+        let a = Axis::logarithmic(-17.5, -14.2);
+        assert_eq!(a.labels, ["10⁻¹⁷", "10⁻¹⁶", "10⁻¹⁵"]);
+        assert!(a
+            .minor
+            .iter()
+            .any(|&m| (m - (-17.0 + 2f64.log10())).abs() < 1e-12));
+    }
+
+    #[test]
+    fn degenerate_ranges_give_no_ticks_instead_of_panicking() {
+        assert!(nice_ticks(f64::NAN, 1.0, 6).1.is_empty());
+        assert!(nice_ticks(1.0, 1.0, 6).1.is_empty());
+        assert!(log_key_points(f64::NAN, 2.0).0.is_empty());
     }
 }
