@@ -49,6 +49,7 @@ fn bench(c: &mut Criterion) {
                 tolerance: 1e-10,
                 max_iterations: 30,
                 modified: false,
+                exact_tangent: false,
             },
             max_halvings: 4,
             mass: MassKind::Consistent,

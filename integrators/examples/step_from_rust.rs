@@ -71,6 +71,7 @@ fn first_peak(restart_at: Option<usize>) -> Result<Peak, SolveError> {
             tolerance: 1e-10,
             max_iterations: 20,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 4,
         mass: MassKind::Consistent,

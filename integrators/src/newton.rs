@@ -1,4 +1,5 @@
-//! Newton's method with the exact tangent, shared by every solver.
+//! Newton's method with the exact tangent (or a system's cheaper one while it
+//! contracts fast), shared by every solver.
 //!
 //! Convergence is measured on the *scaled* residual
 //! `‖r‖₂ / max(‖f_ext‖₂, ‖Σₑ|rₑ|‖₂)`: the residual relative to the larger of
@@ -37,11 +38,23 @@ pub struct NewtonSettings {
     /// tolerance; only the path to it differs. `false`: the exact tangent at
     /// every iterate (quadratic convergence).
     pub modified: bool,
+    /// The exact tangent from the first iteration even where the system
+    /// offers a cheaper one ([`NewtonSystem::tangent_is_exact`]; the
+    /// energy–momentum scheme's 2-node elements): quadratic convergence at
+    /// every iterate. `false`: the cheap tangent first, the exact one once
+    /// it contracts slowly. Either way the solution meets the same
+    /// tolerance.
+    pub exact_tangent: bool,
 }
 
 /// Largest ratio of successive residuals modified Newton accepts before it
 /// refactors the tangent at the current iterate.
 pub const MODIFIED_CONTRACTION: f64 = TOLERANCES.modified_contraction;
+
+/// Largest ratio of successive residuals Newton accepts from an approximate
+/// tangent ([`NewtonSystem::tangent_is_exact`]) before it switches to the
+/// exact one for the rest of the solve.
+pub const INEXACT_CONTRACTION: f64 = TOLERANCES.inexact_contraction;
 
 /// A nonlinear system `r(q) = 0` in the reduced unknowns.
 pub trait NewtonSystem {
@@ -72,6 +85,21 @@ pub trait NewtonSystem {
     fn tangent_key(&self) -> f64 {
         f64::NAN
     }
+    /// Whether the tangent the system computes now is the exact derivative
+    /// of its residual (default `true`). A system may offer a cheaper
+    /// approximate tangent (the energy–momentum scheme: see
+    /// `dynamics::midpoint_kernels::element_kernel`); [`solve`] starts every
+    /// solve with it and switches to the exact one at the first iteration
+    /// above the round-off floor that contracts the residual by less than
+    /// [`INEXACT_CONTRACTION`]
+    /// (modified Newton: at the first refactorisation after the first). The
+    /// solution satisfies the same tolerance; only the path to it differs.
+    fn tangent_is_exact(&self) -> bool {
+        true
+    }
+    /// Asks for the exact tangent (`true`) or the system's cheaper one
+    /// (`false`) at the next tangent evaluation. Default: nothing to switch.
+    fn set_exact_tangent(&mut self, _exact: bool) {}
     /// Absolute residual norm below which the residual is round-off.
     fn floor(&self) -> f64 {
         0.0
@@ -108,6 +136,7 @@ pub fn solve<S: NewtonSystem>(
     dq: &mut [f64],
 ) -> Result<NewtonReport, NewtonFailure> {
     let mut factored = false;
+    sys.set_exact_tangent(settings.exact_tangent);
     let report = iterate(sys, lu, settings, r, dq, &mut factored)?;
     if !settings.modified {
         check_regular(sys, lu, factored, true)?;
@@ -153,12 +182,23 @@ fn iterate<S: NewtonSystem>(
         if it == settings.max_iterations {
             break;
         }
-        let reuse = settings.modified
+        let mut reuse = settings.modified
             && if it == 0 {
                 lu.key() == Some(sys.tangent_key())
             } else {
                 res < MODIFIED_CONTRACTION * history[it - 1]
             };
+        let slow = if settings.modified {
+            !reuse
+        } else {
+            res > INEXACT_CONTRACTION * history[it.saturating_sub(1)]
+        };
+        // At the round-off floor a slow contraction says nothing about the
+        // tangent.
+        if it > 0 && slow && norm > sys.floor() && !sys.tangent_is_exact() {
+            sys.set_exact_tangent(true);
+            reuse = false;
+        }
         if !reuse {
             // dq is free until the solve below.
             sys.update_tangent(dq);
@@ -247,3 +287,7 @@ pub(crate) fn diverged(
         }
     })
 }
+
+#[cfg(test)]
+#[path = "newton_tests.rs"]
+mod tests;

@@ -84,6 +84,14 @@ pub trait StepTerms {
     fn tangent_key(&self) -> f64 {
         f64::NAN
     }
+
+    /// See [`NewtonSystem::tangent_is_exact`]. Default: `true`.
+    fn tangent_is_exact(&self) -> bool {
+        true
+    }
+
+    /// See [`NewtonSystem::set_exact_tangent`]. Default: nothing to switch.
+    fn set_exact_tangent(&mut self, _exact: bool) {}
 }
 
 /// The reduced system of one step: the mechanism's structure and the
@@ -269,6 +277,14 @@ impl<T: StepTerms> NewtonSystem for ReducedSystem<'_, T> {
 
     fn tangent_key(&self) -> f64 {
         self.terms.tangent_key()
+    }
+
+    fn tangent_is_exact(&self) -> bool {
+        self.terms.tangent_is_exact()
+    }
+
+    fn set_exact_tangent(&mut self, exact: bool) {
+        self.terms.set_exact_tangent(exact);
     }
 
     fn tangent_values(&self) -> &[f64] {

@@ -16,6 +16,11 @@ pub struct Tolerances {
     /// Modified Newton refactors when a residual is not below this fraction
     /// of the previous one: `½`.
     pub modified_contraction: f64,
+    /// Newton switches from an approximate tangent to the exact one when a
+    /// residual is not below this fraction of the previous one: `1/20`
+    /// (the exact tangent's quadratic convergence then wins within the
+    /// iterations a step usually takes).
+    pub inexact_contraction: f64,
     /// Condition number of the equilibrated tangent above which a solution
     /// is not unique (a mechanism): `1/(100 ε)`. A null direction gives
     /// `κ ≳ 1/ε`; a slender cantilever of a thousand elements with
@@ -41,6 +46,7 @@ pub const TOLERANCES: Tolerances = Tolerances {
     divergence_growth: 1e8,
     stall_ratio: 0.5,
     modified_contraction: 0.5,
+    inexact_contraction: 0.05,
     singular_condition: 1.0 / (100.0 * f64::EPSILON),
     end_of_run: 1e-12,
     level_snap: 1e-9,

@@ -83,6 +83,7 @@ fn newton() -> NewtonSettings {
         tolerance: 1e-10,
         max_iterations: 25,
         modified: false,
+        exact_tangent: false,
     }
 }
 

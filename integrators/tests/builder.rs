@@ -112,6 +112,7 @@ fn a_driven_screw_built_here_raises_its_arm_by_the_pitch() {
             tolerance: 1e-10,
             max_iterations: 30,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 8,
     };
@@ -256,6 +257,7 @@ fn static_settings() -> StaticSettings {
             tolerance: 1e-12,
             max_iterations: 30,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 4,
     }
@@ -321,6 +323,7 @@ fn load_fields_enter_every_scheme_like_nodal_loads() {
             tolerance: 1e-10,
             max_iterations: 20,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 4,
         mass: MassKind::Consistent,

@@ -59,6 +59,7 @@ fn settings(dt: f64) -> DynamicSettings {
             tolerance: 1e-11,
             max_iterations: 30,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 0,
         mass: MassKind::Consistent,

@@ -83,6 +83,7 @@ fn settings(dt: f64) -> DynamicSettings {
             tolerance: TOLERANCE,
             max_iterations: 30,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 6,
         mass: MassKind::Consistent,

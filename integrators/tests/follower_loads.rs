@@ -113,6 +113,7 @@ fn a_follower_tip_force_bends_the_cantilever_as_the_elastica_says() {
             tolerance: 1e-10,
             max_iterations: 30,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 4,
     };

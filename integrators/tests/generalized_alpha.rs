@@ -46,6 +46,7 @@ fn oscillator(dt: f64, t_end: f64) -> (Mechanism, Motion, DynamicSettings) {
             tolerance: NEWTON_TOL,
             max_iterations: 30,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 0,
         mass: MassKind::Consistent,

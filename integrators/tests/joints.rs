@@ -109,6 +109,7 @@ fn settings(steps: usize) -> StaticSettings {
             tolerance: 1e-10,
             max_iterations: 30,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 8,
     }

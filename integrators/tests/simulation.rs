@@ -55,6 +55,7 @@ fn free_beam(v0: Vector3<f64>, om: Vector3<f64>) -> (Mechanism, Motion, DynamicS
             tolerance: 1e-12,
             max_iterations: 30,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 6,
         mass: MassKind::Consistent,

@@ -46,6 +46,7 @@ fn settings(steps: usize) -> StaticSettings {
             tolerance: 1e-10,
             max_iterations: 25,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 10,
     }

@@ -43,6 +43,7 @@ fn statics(mech: &Mechanism) -> Result<usize, SolveError> {
             tolerance: 1e-10,
             max_iterations: 30,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 4,
     };
@@ -144,6 +145,7 @@ fn dynamics(rho_a: f64, rho_j: f64) -> (Mechanism, Motion, DynamicSettings) {
             tolerance: 1e-12,
             max_iterations: 30,
             modified: false,
+            exact_tangent: false,
         },
         max_halvings: 4,
         mass: MassKind::Consistent,

@@ -100,6 +100,7 @@ fn cantilever(ei: f64, force: f64) -> Model {
             max_halvings: 10,
             mass: MassKind::Consistent,
             modified_newton: false,
+            exact_tangent: false,
         },
         output: OutputSpec {
             every: 1,

@@ -202,6 +202,7 @@ fn static_newton(model: &Model) -> NewtonSettings {
         tolerance: model.solver.tolerance,
         max_iterations: model.solver.max_iterations,
         modified: false,
+        exact_tangent: false,
     }
 }
 
@@ -417,6 +418,7 @@ fn run(
                     tolerance: model.solver.tolerance,
                     max_iterations: model.solver.max_iterations,
                     modified: model.solver.modified_newton,
+                    exact_tangent: model.solver.exact_tangent,
                 },
                 max_halvings: model.solver.max_halvings,
                 mass: model.solver.mass,

@@ -220,6 +220,7 @@ fn base_file_parses_with_defaults() {
             max_halvings: 10,
             mass: MassKind::Consistent,
             modified_newton: false,
+            exact_tangent: false,
         }
     );
     assert_eq!(m.output.every, 1);

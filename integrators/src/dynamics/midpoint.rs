@@ -112,6 +112,9 @@ pub(crate) struct MidpointTerms {
     w_n: Vec<Vector3<f64>>,
     /// Rates of each joint's released coordinates over the last step.
     rates: Vec<Vec<f64>>,
+    /// Whether the energy–momentum scheme's exact tangent is asked for
+    /// (see [`NewtonSystem::set_exact_tangent`](crate::newton::NewtonSystem::set_exact_tangent)).
+    exact_tangent: bool,
 }
 
 impl MidpointTerms {
@@ -149,6 +152,7 @@ impl MidpointTerms {
             v_n,
             w_n,
             rates,
+            exact_tangent: true,
         }
     }
 }
@@ -167,10 +171,10 @@ impl StepTerms for MidpointTerms {
         end: &Configuration,
         tangent: bool,
     ) {
-        let (scheme, beta) = (self.scheme, self.beta);
+        let (scheme, beta, exact) = (self.scheme, self.beta, self.exact_tangent);
         if tangent {
             asm.assemble_with(&mech.mesh, dofs, |el, _, re, ke| {
-                element_kernel(el, start, end, scheme, beta, re, ke)
+                element_kernel(el, start, end, scheme, beta, exact, re, ke)
             });
         } else {
             asm.assemble_residual_with(&mech.mesh, |el, re| {
@@ -208,6 +212,16 @@ impl StepTerms for MidpointTerms {
 
     fn tangent_key(&self) -> f64 {
         self.dt
+    }
+
+    /// Only the energy–momentum scheme's 2-node elements have a cheaper
+    /// tangent than the exact one ([`element_kernel`]).
+    fn tangent_is_exact(&self) -> bool {
+        self.exact_tangent || self.scheme != Scheme::EnergyMomentum
+    }
+
+    fn set_exact_tangent(&mut self, exact: bool) {
+        self.exact_tangent = exact;
     }
 }
 

@@ -84,12 +84,24 @@ pub(crate) fn midpoint_forces(
 /// closed-form chord columns for the energy–momentum scheme
 /// ([`flexmech_core::conserving_tangent`]), forward-mode AD over all twelve
 /// increments for the paper's scheme.
+///
+/// `exact = false` asks for the energy–momentum scheme's cheap tangent
+/// (the force stays the exact discrete gradient): the momentum scheme's
+/// closed-form derivative of `q_k(Nₙ₊½, Mₙ₊½)`. The discrete gradient is
+/// that force with secant operators in place of the geodesic mid rotation
+/// plus rank-one corrections of size `O(|Δθ|²)` ([`correction_size`]), so
+/// the two derivatives differ by terms that vanish with the step's rotation
+/// increment, and Newton with the cheap one contracts linearly at a rate of
+/// that order; [`crate::newton`] switches to the exact tangent when it does
+/// not. Other schemes and 3-node elements ignore the flag.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn element_kernel(
     el: &Element,
     start: &Configuration,
     end: &Configuration,
     scheme: Scheme,
     beta: f64,
+    exact: bool,
     r: &mut [f64],
     k: &mut [f64],
 ) {
@@ -100,7 +112,15 @@ pub(crate) fn element_kernel(
     let pose = |c: &Configuration| pose_of(e, c);
     let (q, jac) = match scheme {
         Scheme::Momentum => e.momentum_force_tangent(&pose(start), &pose(end)),
-        Scheme::EnergyMomentum => e.energy_momentum_force_tangent(&pose(start), &pose(end)),
+        Scheme::EnergyMomentum if exact => {
+            e.energy_momentum_force_tangent(&pose(start), &pose(end))
+        }
+        Scheme::EnergyMomentum => {
+            let (s, t) = (pose(start), pose(end));
+            let (nbar, mbar) = averaged_resultants(e, &s, &t);
+            let q = e.discrete_gradient_force(&s, &t, &nbar, &mbar);
+            (q, e.momentum_force_tangent(&s, &t).1)
+        }
         Scheme::EnergyMomentumPaper => {
             type D = Dual12;
             let (s, sd, ed) = seeded_poses(e, start, end);
@@ -151,7 +171,7 @@ pub(crate) fn element_force(
         }
         (Element::Linear(_), Scheme::EnergyMomentumPaper) => {
             let mut k = [0.0; 144];
-            return element_kernel(el, start, end, scheme, beta, r, &mut k);
+            return element_kernel(el, start, end, scheme, beta, true, r, &mut k);
         }
     };
     r.copy_from_slice(q.as_slice());

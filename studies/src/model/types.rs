@@ -244,6 +244,10 @@ pub struct SolverSpec {
     /// `newton = "modified"`: keep a factorised tangent while it converges
     /// fast enough (dynamic analyses; default `"full"`).
     pub modified_newton: bool,
+    /// `newton = "exact"`: full Newton with the exact tangent at every
+    /// iterate, also in the energy–momentum scheme, whose `"full"` Newton
+    /// starts with a cheaper tangent (dynamic analyses).
+    pub exact_tangent: bool,
 }
 
 /// `[output]`.

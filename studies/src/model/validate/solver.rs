@@ -18,6 +18,7 @@ impl Ctx<'_> {
                 max_halvings: 10,
                 mass: MassKind::Consistent,
                 modified_newton: false,
+                exact_tangent: false,
             });
         };
         let hs = entry.span();
@@ -252,10 +253,11 @@ impl Ctx<'_> {
                 }
             },
         };
-        let modified_newton = match &s.newton {
-            None => false,
+        let (modified_newton, exact_tangent) = match &s.newton {
+            None => (false, false),
             Some(m) => match m.get_ref().as_str() {
-                "full" => false,
+                "full" => (false, false),
+                "exact" => (false, true),
                 "modified" => match &analysis {
                     Analysis::Static { .. } | Analysis::ArcLength { .. } => {
                         return Err(self.at(
@@ -278,13 +280,13 @@ impl Ctx<'_> {
                              integrator = \"energy-momentum\"",
                         ))
                     }
-                    Analysis::Dynamic { .. } => true,
+                    Analysis::Dynamic { .. } => (true, false),
                 },
                 other => {
                     return Err(self.at(
                         "solver.newton",
                         m,
-                        format!("expected \"full\" or \"modified\", found \"{other}\""),
+                        format!("expected \"full\", \"exact\" or \"modified\", found \"{other}\""),
                     ))
                 }
             },
@@ -296,6 +298,7 @@ impl Ctx<'_> {
             max_halvings,
             mass,
             modified_newton,
+            exact_tangent,
         })
     }
 

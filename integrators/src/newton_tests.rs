@@ -1,0 +1,112 @@
+//! Newton's switch from a cheap tangent to the exact one, on a small system
+//! with a known root.
+
+use super::*;
+use faer::sparse::SymbolicSparseColMat;
+
+/// `rᵢ(q) = qᵢ³ + qᵢ − 2` (root `qᵢ = 1`), two uncoupled unknowns; the
+/// cheap tangent is the exact one times `factor`.
+struct Cubic {
+    q: [f64; 2],
+    factor: f64,
+    exact: bool,
+    values: Vec<f64>,
+    /// Tangent evaluations with the exact and the cheap tangent.
+    exact_count: usize,
+    cheap_count: usize,
+}
+
+impl Cubic {
+    fn new(factor: f64) -> Self {
+        Self {
+            q: [1.02, 0.99],
+            factor,
+            exact: true,
+            values: vec![0.0; 2],
+            exact_count: 0,
+            cheap_count: 0,
+        }
+    }
+}
+
+impl NewtonSystem for Cubic {
+    fn evaluate(&mut self, r: &mut [f64]) -> f64 {
+        let factor = if self.exact { 1.0 } else { self.factor };
+        for ((ri, vi), &q) in r.iter_mut().zip(&mut self.values).zip(&self.q) {
+            *ri = q * q * q + q - 2.0;
+            *vi = factor * (3.0 * q * q + 1.0);
+        }
+        if self.exact {
+            self.exact_count += 1;
+        } else {
+            self.cheap_count += 1;
+        }
+        2.0
+    }
+    fn tangent_values(&self) -> &[f64] {
+        &self.values
+    }
+    fn apply(&mut self, dq: &[f64]) {
+        self.q[0] += dq[0];
+        self.q[1] += dq[1];
+    }
+    fn tangent_is_exact(&self) -> bool {
+        self.exact
+    }
+    /// Round-off of `q³ + q − 2` near the root: a few ε.
+    fn floor(&self) -> f64 {
+        16.0 * f64::EPSILON
+    }
+    fn set_exact_tangent(&mut self, exact: bool) {
+        self.exact = exact;
+    }
+    fn free_motion(&self, _mode: &[f64], _tangent: TangentRef) -> FreeMotion {
+        FreeMotion::default()
+    }
+}
+
+fn run(sys: &mut Cubic, exact_tangent: bool) -> NewtonReport {
+    let pattern = SymbolicSparseColMat::new_checked(2, 2, vec![0, 1, 2], None, vec![0, 1]);
+    let mut lu = SparseLu::new(pattern).expect("pattern");
+    let settings = NewtonSettings {
+        tolerance: 1e-12,
+        max_iterations: 40,
+        modified: false,
+        exact_tangent,
+    };
+    let (mut r, mut dq) = (vec![0.0; 2], vec![0.0; 2]);
+    let report = solve(sys, &mut lu, &settings, &mut r, &mut dq).expect("converges");
+    assert!((sys.q[0] - 1.0).abs() < 1e-10 && (sys.q[1] - 1.0).abs() < 1e-10);
+    report
+}
+
+#[test]
+fn a_good_cheap_tangent_is_kept_to_the_end() {
+    // 1 % off the exact derivative: linear contraction ≈ 0.01 < 1/20.
+    let mut sys = Cubic::new(1.01);
+    run(&mut sys, false);
+    assert!(sys.cheap_count > 0);
+    assert_eq!(sys.exact_count, 0, "switched although it contracted fast");
+}
+
+#[test]
+fn a_poor_cheap_tangent_is_replaced_by_the_exact_one() {
+    // Twice the exact derivative: contraction ≈ ½ near the root, so Newton
+    // switches and converges quadratically from there. (A slow contraction
+    // far from the root switches too, even where the exact tangent would
+    // contract as slowly: the safe choice.)
+    let mut sys = Cubic::new(2.0);
+    let report = run(&mut sys, false);
+    assert!(sys.exact_count > 0, "never switched");
+    let slow = report
+        .history
+        .windows(2)
+        .filter(|w| w[1] > INEXACT_CONTRACTION * w[0])
+        .count();
+    assert!(slow <= 2, "history {:?}", report.history);
+    // The same solve with the exact tangent throughout never uses the
+    // cheap one.
+    let mut exact = Cubic::new(2.0);
+    run(&mut exact, true);
+    assert_eq!(exact.cheap_count, 0);
+}
