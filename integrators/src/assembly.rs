@@ -23,6 +23,11 @@ struct Slots {
     /// local equation, `(element dof, local index)`: its reduced tangent is
     /// a gather of the element tangent, with no products with node maps.
     direct: Option<Vec<(usize, usize)>>,
+    /// For a direct element, `(entry of the element tangent (column-major),
+    /// position in the CSC value array)`: its tangent is summed into the
+    /// values straight from the kernel's buffer, in the same order per
+    /// position as through `pos` (so the sums are bitwise the same).
+    direct_scatter: Vec<(usize, usize)>,
 }
 
 /// The `(element dof, local index)` pairs of an element whose nodes are all
@@ -101,6 +106,7 @@ impl Assembler {
                 eqs,
                 pos: Vec::new(),
                 direct,
+                direct_scatter: Vec::new(),
             });
         }
         let mut extra: Vec<Slots> = Vec::with_capacity(blocks.len());
@@ -112,6 +118,7 @@ impl Assembler {
                 eqs: eqs.clone(),
                 pos: Vec::new(),
                 direct: None,
+                direct_scatter: Vec::new(),
             });
         }
         let mut col_ptr = Vec::with_capacity(n + 1);
@@ -133,6 +140,17 @@ impl Assembler {
                         .binary_search(&ri)
                         .expect("pattern contains every element pair");
                     s.pos.push(col_ptr[cj] + p);
+                }
+            }
+        }
+        for (s, el) in slots.iter_mut().zip(&mesh.elements) {
+            let (Some(pairs), d, m) = (&s.direct, el.dofs(), s.eqs.len()) else {
+                continue;
+            };
+            // Column-major over the local pairs, as `pos` (and the sums).
+            for &(ec, lc) in pairs {
+                for &(er, lr) in pairs {
+                    s.direct_scatter.push((ec * d + er, s.pos[lc * m + lr]));
                 }
             }
         }
@@ -171,12 +189,7 @@ impl Assembler {
     {
         let element = |((w, (index, el)), s): ((&mut Work, (usize, &Element)), &Slots)| {
             kernel(el, index, w.r.as_mut_slice(), w.k.as_mut_slice());
-            if let Some(pairs) = &s.direct {
-                for &(lc, c) in pairs {
-                    for &(lr, r) in pairs {
-                        w.k_red[(r, c)] = w.k[(lr, lc)];
-                    }
-                }
+            if s.direct.is_some() {
                 return;
             }
             w.g.fill(0.0);
@@ -222,8 +235,15 @@ impl Assembler {
         self.values.iter_mut().for_each(|v| *v = 0.0);
         self.scatter_forces(mesh);
         for (w, s) in self.work.iter().zip(&self.slots) {
-            for (&p, &v) in s.pos.iter().zip(w.k_red.as_slice()) {
-                self.values[p] += v;
+            if s.direct.is_some() {
+                let k = w.k.as_slice();
+                for &(e, p) in &s.direct_scatter {
+                    self.values[p] += k[e];
+                }
+            } else {
+                for (&p, &v) in s.pos.iter().zip(w.k_red.as_slice()) {
+                    self.values[p] += v;
+                }
             }
         }
     }

@@ -62,10 +62,12 @@ pub trait NewtonSystem {
     /// solver's value array at the current iterate; returns the force scale.
     fn evaluate(&mut self, r: &mut [f64]) -> f64;
     /// The residual only, at the current iterate (into `r`; returns the
-    /// force scale). Newton calls it first at every iterate and brings the
-    /// tangent up to date ([`NewtonSystem::update_tangent`]) only where a
-    /// factorisation follows — not at the converged iterate. Default: the
-    /// whole [`NewtonSystem::evaluate`].
+    /// force scale). Newton calls it at every iterate after the first of a
+    /// full-Newton solve (which takes [`NewtonSystem::evaluate`]: a
+    /// factorisation all but certainly follows) and brings the tangent up to
+    /// date ([`NewtonSystem::update_tangent`]) only where a factorisation
+    /// follows — not at the converged iterate. Default: the whole
+    /// [`NewtonSystem::evaluate`].
     fn residual(&mut self, r: &mut [f64]) -> f64 {
         self.evaluate(r)
     }
@@ -156,7 +158,14 @@ fn iterate<S: NewtonSystem>(
     let mut previous_norm = f64::INFINITY;
     let mut factorizations = 0;
     for it in 0..=settings.max_iterations {
-        let scale = sys.residual(r);
+        // At the start of a full-Newton solve a factorisation all but
+        // certainly follows: residual and tangent in one pass.
+        let with_tangent = it == 0 && !settings.modified;
+        let scale = if with_tangent {
+            sys.evaluate(r)
+        } else {
+            sys.residual(r)
+        };
         let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
         let res = if norm == 0.0 {
             0.0
@@ -201,7 +210,9 @@ fn iterate<S: NewtonSystem>(
         }
         if !reuse {
             // dq is free until the solve below.
-            sys.update_tangent(dq);
+            if !with_tangent {
+                sys.update_tangent(dq);
+            }
             lu.factor(sys.tangent_values())
                 .map_err(NewtonFailure::LinearSolve)?;
             lu.set_key(sys.tangent_key());

@@ -321,7 +321,8 @@ impl StepTerms for NewmarkTerms {
         }
         // Translational inertia M q̈ₙ₊₁ from the pseudo-acceleration
         // aₙ₊₁ = (u − Δt vₙ − Δt²(½−β)aₙ)/(βΔt²); rotational
-        // Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), its tangent by AD in a spin of Rₙ₊₁.
+        // Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), its tangent in closed form in a spin of
+        // Rₙ₊₁ ([`inertial_moment_tangent`]).
         self.slots.add_inertia(
             &self.inertia,
             g,
