@@ -23,11 +23,13 @@ struct Slots {
     /// local equation, `(element dof, local index)`: its reduced tangent is
     /// a gather of the element tangent, with no products with node maps.
     direct: Option<Vec<(usize, usize)>>,
-    /// For a direct element, `(entry of the element tangent (column-major),
-    /// position in the CSC value array)`: its tangent is summed into the
-    /// values straight from the kernel's buffer, in the same order per
-    /// position as through `pos` (so the sums are bitwise the same).
-    direct_scatter: Vec<(usize, usize)>,
+    /// For a direct element, runs `(first entry of the element tangent
+    /// (column-major), first position in the CSC value array, length)` over
+    /// which both advance by one: its tangent is summed into the values
+    /// straight from the kernel's buffer, a run at a time (a chain's element
+    /// has one run of 12 per column), one addition per position as through
+    /// `pos` (so the sums are bitwise the same).
+    direct_runs: Vec<(usize, usize, usize)>,
 }
 
 /// The `(element dof, local index)` pairs of an element whose nodes are all
@@ -106,7 +108,7 @@ impl Assembler {
                 eqs,
                 pos: Vec::new(),
                 direct,
-                direct_scatter: Vec::new(),
+                direct_runs: Vec::new(),
             });
         }
         let mut extra: Vec<Slots> = Vec::with_capacity(blocks.len());
@@ -118,7 +120,7 @@ impl Assembler {
                 eqs: eqs.clone(),
                 pos: Vec::new(),
                 direct: None,
-                direct_scatter: Vec::new(),
+                direct_runs: Vec::new(),
             });
         }
         let mut col_ptr = Vec::with_capacity(n + 1);
@@ -147,10 +149,13 @@ impl Assembler {
             let (Some(pairs), d, m) = (&s.direct, el.dofs(), s.eqs.len()) else {
                 continue;
             };
-            // Column-major over the local pairs, as `pos` (and the sums).
             for &(ec, lc) in pairs {
                 for &(er, lr) in pairs {
-                    s.direct_scatter.push((ec * d + er, s.pos[lc * m + lr]));
+                    let (e, p) = (ec * d + er, s.pos[lc * m + lr]);
+                    match s.direct_runs.last_mut() {
+                        Some((e0, p0, len)) if *e0 + *len == e && *p0 + *len == p => *len += 1,
+                        _ => s.direct_runs.push((e, p, 1)),
+                    }
                 }
             }
         }
@@ -237,8 +242,11 @@ impl Assembler {
         for (w, s) in self.work.iter().zip(&self.slots) {
             if s.direct.is_some() {
                 let k = w.k.as_slice();
-                for &(e, p) in &s.direct_scatter {
-                    self.values[p] += k[e];
+                for &(e, p, len) in &s.direct_runs {
+                    let target = &mut self.values[p..p + len];
+                    for (t, v) in target.iter_mut().zip(&k[e..e + len]) {
+                        *t += v;
+                    }
                 }
             } else {
                 for (&p, &v) in s.pos.iter().zip(w.k_red.as_slice()) {
