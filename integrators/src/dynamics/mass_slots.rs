@@ -32,11 +32,12 @@ pub(crate) fn spin_derivative(
     (m.map(|v| v.re), k)
 }
 
-/// Tangent positions per translational mass entry `(i, j, m)` and per
-/// node's rotational inertia (`None` where a slave is involved: its maps
-/// change with the iterate, and the block goes through them).
+/// Tangent positions per translational mass entry `(i, j, m)` (its block
+/// is `c(m) I`: the diagonal's positions only) and per node's rotational
+/// inertia (`None` where a slave is involved: its maps change with the
+/// iterate, and the block goes through them).
 pub(crate) struct MassSlots {
-    translational: Vec<Option<Vec<(usize, usize, usize)>>>,
+    translational: Vec<Option<Vec<usize>>>,
     rotational: Vec<Option<Vec<(usize, usize, usize)>>>,
 }
 
@@ -46,7 +47,15 @@ impl MassSlots {
             translational: inertia
                 .mass
                 .iter()
-                .map(|&(i, j, _)| asm.node_block_slots(dofs, (i, 0), (j, 0)))
+                .map(|&(i, j, _)| {
+                    asm.node_block_slots(dofs, (i, 0), (j, 0)).map(|slots| {
+                        slots
+                            .into_iter()
+                            .filter(|&(_, a, b)| a == b)
+                            .map(|(p, _, _)| p)
+                            .collect()
+                    })
+                })
                 .collect(),
             rotational: (0..inertia.rotational.len())
                 .map(|i| asm.node_block_slots(dofs, (i, 3), (i, 3)))
@@ -54,18 +63,24 @@ impl MassSlots {
         }
     }
 
-    /// Adds `block` for mass entry `k = (i, j, m)` (translations of `i`, `j`).
+    /// Adds `c I` for mass entry `k = (i, j, m)` (translations of `i`, `j`).
     pub(crate) fn add_translational(
         &self,
         asm: &mut Assembler,
         dofs: &DofMap,
         k: usize,
         (i, j): (usize, usize),
-        block: &Matrix3<f64>,
+        c: f64,
     ) {
         match &self.translational[k] {
-            Some(at) => asm.add_node_block_at(at, block),
-            None => asm.add_node_block(dofs, (i, 0), (j, 0), block),
+            Some(diagonal) => {
+                if c != 0.0 {
+                    for &p in diagonal {
+                        asm.values[p] += c;
+                    }
+                }
+            }
+            None => asm.add_node_block(dofs, (i, 0), (j, 0), &(Matrix3::identity() * c)),
         }
     }
 
@@ -108,8 +123,7 @@ impl MassSlots {
                 abs[6 * i + c] += f[c].abs();
             }
             if let Some((asm, dofs)) = tangent.as_mut() {
-                let block = Matrix3::identity() * coefficient(m);
-                self.add_translational(asm, dofs, k, (i, j), &block);
+                self.add_translational(asm, dofs, k, (i, j), coefficient(m));
             }
         }
         for (i, j0) in inertia.rotational.iter().enumerate() {
