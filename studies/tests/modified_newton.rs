@@ -29,6 +29,20 @@ fn run(model: &str, integrator: &str, newton: &str) -> (PathBuf, tempfile::TempD
     (file, dir)
 }
 
+/// The largest difference of any stored position between two result files
+/// of the same model (which must have the same steps).
+fn largest_position_difference(a: &Path, b: &Path) -> f64 {
+    let (a, b) = (
+        read::<f64>(a, "/configuration/position"),
+        read::<f64>(b, "/configuration/position"),
+    );
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
 /// Newton's tolerance (1e-11 in the chain's file) accumulated over 100
 /// steps, on positions of size 1: well below this; an approximate
 /// solution (a step accepted before convergence) would be far above.
@@ -39,16 +53,7 @@ fn the_free_chain_follows_full_newton_with_every_joint_kind() {
     for integrator in ["newmark", "momentum", "energy-momentum"] {
         let (full, _d1) = run("dynamics/free_chain.toml", integrator, "full");
         let (modified, _d2) = run("dynamics/free_chain.toml", integrator, "modified");
-        let (a, b) = (
-            read::<f64>(&full, "/configuration/position"),
-            read::<f64>(&modified, "/configuration/position"),
-        );
-        assert_eq!(a.len(), b.len());
-        let worst = a
-            .iter()
-            .zip(&b)
-            .map(|(x, y)| (x - y).abs())
-            .fold(0.0, f64::max);
+        let worst = largest_position_difference(&full, &modified);
         let steps = read::<u64>(&modified, "/solver/iterations").len() - 1;
         let factorizations: u64 = read::<u64>(&modified, "/solver/factorizations")
             .iter()
@@ -128,16 +133,7 @@ fn exact_and_full_newton_reach_the_same_energy_momentum_solution() {
     // closed-form tangent, "exact" uses the discrete gradient's own.
     let (full, _d1) = run("dynamics/free_chain.toml", "energy-momentum", "full");
     let (exact, _d2) = run("dynamics/free_chain.toml", "energy-momentum", "exact");
-    let (a, b) = (
-        read::<f64>(&full, "/configuration/position"),
-        read::<f64>(&exact, "/configuration/position"),
-    );
-    assert_eq!(a.len(), b.len());
-    let worst = a
-        .iter()
-        .zip(&b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max);
+    let worst = largest_position_difference(&full, &exact);
     let iterations = |f: &Path| read::<u64>(f, "/solver/iterations").iter().sum::<u64>();
     eprintln!(
         "positions differ by {worst:.1e}; iterations full {} / exact {}",
