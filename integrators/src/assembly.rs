@@ -19,21 +19,20 @@ struct Slots {
     /// Position in the CSC value array of local pair (i, j), column-major `j·m + i`.
     pos: Vec<usize>,
     /// For an element whose nodes are all independent (no joint touches
-    /// it: every node map column is a unit vector), the element DOF of each
-    /// local equation, `(element dof, local index)`: its reduced tangent is
-    /// a gather of the element tangent, with no products with node maps.
-    direct: Option<Vec<(usize, usize)>>,
-    /// For a direct element, runs `(first entry of the element tangent
-    /// (column-major), first position in the CSC value array, length)` over
-    /// which both advance by one: its tangent is summed into the values
-    /// straight from the kernel's buffer, a run at a time (a chain's element
-    /// has one run of 12 per column), one addition per position as through
-    /// `pos` (so the sums are bitwise the same).
-    direct_runs: Vec<(usize, usize, usize)>,
+    /// it: every node map column is a unit vector), its reduced tangent is a
+    /// gather of the element tangent, with no products with node maps: runs
+    /// `(first entry of the element tangent (column-major), first position
+    /// in the CSC value array, length)` over which both advance by one, so
+    /// that the tangent is summed into the values straight from the kernel's
+    /// buffer, a run at a time (a chain's element has one run of 12 per
+    /// column), one addition per position as through `pos` (so the sums are
+    /// bitwise the same).
+    direct: Option<Vec<(usize, usize, usize)>>,
 }
 
 /// The `(element dof, local index)` pairs of an element whose nodes are all
-/// independent (see [`Slots::direct`]), or `None`.
+/// independent (see [`Slots::direct`]; the local index is into the sorted
+/// equation list `eqs`), or `None`.
 fn direct_pairs(el: &Element, dofs: &DofMap, eqs: &[usize]) -> Option<Vec<(usize, usize)>> {
     let mut pairs = Vec::with_capacity(eqs.len());
     for (a, &nd) in el.nodes().iter().enumerate() {
@@ -82,6 +81,7 @@ impl Assembler {
             c.push(e);
         }
         let mut slots = Vec::with_capacity(mesh.elements.len());
+        let mut direct = Vec::with_capacity(mesh.elements.len());
         let mut work = Vec::with_capacity(mesh.elements.len());
         for el in &mesh.elements {
             let mut eqs: Vec<usize> = el
@@ -103,12 +103,11 @@ impl Assembler {
                 tmp: DMatrix::zeros(d, m),
                 k_red: DMatrix::zeros(m, m),
             });
-            let direct = direct_pairs(el, dofs, &eqs);
+            direct.push(direct_pairs(el, dofs, &eqs));
             slots.push(Slots {
                 eqs,
                 pos: Vec::new(),
-                direct,
-                direct_runs: Vec::new(),
+                direct: None,
             });
         }
         let mut extra: Vec<Slots> = Vec::with_capacity(blocks.len());
@@ -120,7 +119,6 @@ impl Assembler {
                 eqs: eqs.clone(),
                 pos: Vec::new(),
                 direct: None,
-                direct_runs: Vec::new(),
             });
         }
         let mut col_ptr = Vec::with_capacity(n + 1);
@@ -145,19 +143,21 @@ impl Assembler {
                 }
             }
         }
-        for (s, el) in slots.iter_mut().zip(&mesh.elements) {
-            let (Some(pairs), d, m) = (&s.direct, el.dofs(), s.eqs.len()) else {
+        for ((s, el), pairs) in slots.iter_mut().zip(&mesh.elements).zip(&direct) {
+            let (Some(pairs), d, m) = (pairs, el.dofs(), s.eqs.len()) else {
                 continue;
             };
+            let mut runs: Vec<(usize, usize, usize)> = Vec::new();
             for &(ec, lc) in pairs {
                 for &(er, lr) in pairs {
                     let (e, p) = (ec * d + er, s.pos[lc * m + lr]);
-                    match s.direct_runs.last_mut() {
+                    match runs.last_mut() {
                         Some((e0, p0, len)) if *e0 + *len == e && *p0 + *len == p => *len += 1,
-                        _ => s.direct_runs.push((e, p, 1)),
+                        _ => runs.push((e, p, 1)),
                     }
                 }
             }
+            s.direct = Some(runs);
         }
         let nnz = row_idx.len();
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
@@ -240,9 +240,9 @@ impl Assembler {
         self.values.iter_mut().for_each(|v| *v = 0.0);
         self.scatter_forces(mesh);
         for (w, s) in self.work.iter().zip(&self.slots) {
-            if s.direct.is_some() {
+            if let Some(runs) = &s.direct {
                 let k = w.k.as_slice();
-                for &(e, p, len) in &s.direct_runs {
+                for &(e, p, len) in runs {
                     let target = &mut self.values[p..p + len];
                     for (t, v) in target.iter_mut().zip(&k[e..e + len]) {
                         *t += v;
