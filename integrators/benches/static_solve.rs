@@ -1,11 +1,13 @@
 //! Static solve of a 1000-element cantilever bent through a half turn by an
-//! end moment (10 load steps), and one assembly of it.
+//! end moment (10 load steps), one assembly of it, and one factorisation and
+//! one solve of its tangent by the band LU the solvers choose for it.
 //! `cargo bench -p flexmech-integrators --bench static_solve`
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexmech_core::{Configuration, Mesh, Section};
 use flexmech_integrators::assembly::Assembler;
 use flexmech_integrators::dofs::DofMap;
+use flexmech_integrators::linsolve::SparseLu;
 use flexmech_integrators::{
     solve_static, Mechanism, NewtonSettings, NodalLoad, Schedule, StaticSettings,
 };
@@ -58,6 +60,25 @@ fn bench(c: &mut Criterion) {
     let config = Configuration::initial(&mech.mesh.positions);
     group.bench_function("one assembly (residual + tangent)", |b| {
         b.iter(|| asm.assemble(&mech.mesh, &dofs, black_box(&config)))
+    });
+    let mut lu = SparseLu::new(asm.pattern().clone()).expect("pattern");
+    assert!(lu.is_band(), "a chain's tangent takes the band LU");
+    // The tangent at the initial configuration (whether or not the
+    // assembly bench ran).
+    asm.assemble(&mech.mesh, &dofs, &config);
+    group.bench_function("band LU factorisation of the tangent", |b| {
+        b.iter(|| lu.factor(black_box(&asm.values)).expect("factorises"))
+    });
+    lu.factor(&asm.values).expect("factorises");
+    let rhs: Vec<f64> = (0..asm.pattern().nrows())
+        .map(|i| (i as f64).sin())
+        .collect();
+    group.bench_function("band LU solve", |b| {
+        b.iter(|| {
+            let mut x = rhs.clone();
+            lu.solve(black_box(&mut x)).expect("solves");
+            x
+        })
     });
     group.finish();
 }

@@ -7,13 +7,54 @@
 //! pattern `A + Aᵀ`), the permuted matrix `P A Pᵀ` is stored as a dense band
 //! in LAPACK's `gbtrf` layout (lower bandwidth `kl`, upper `ku`, `kl` extra
 //! rows for the fill of row interchanges) and factorised column by column
-//! with partial pivoting within the band: `O(n kl (kl + ku))` operations and
-//! no symbolic work per factorisation. For the tangents of beam models this
-//! is several times faster than a general sparse LU; wider patterns keep the
-//! general one ([`crate::linsolve::SparseLu`] chooses).
+//! with threshold partial pivoting within the band: `O(n kl (kl + ku))`
+//! operations at most and no symbolic work per factorisation. For the
+//! tangents of beam models this is several times faster than a general
+//! sparse LU; wider patterns keep the general one
+//! ([`crate::linsolve::SparseLu`] chooses).
+//!
+//! Pivots are chosen on the symmetrically equilibrated matrix `B = D A D`,
+//! `dᵢ = |aᵢᵢ|^-½` ([`equilibrating_scale`]), so that the mixed units of
+//! translations and rotations do not decide them, and a column keeps its
+//! diagonal pivot unless an entry below it is more than `1/`[`PIVOT_THRESHOLD`]
+//! times larger (threshold pivoting, as the general sparse LU codes do). The
+//! elimination of `B` and of `A` differ only by the scales (`P B = L' U'` ⇔
+//! `P A = (P D⁻¹ Pᵀ L' P D Pᵀ)(P D⁻¹ Pᵀ U' D⁻¹)`), so `A` itself is factorised
+//! and only the comparison of candidates sees `dᵢ |aᵢⱼ|`. The tangents of beam
+//! mechanisms then need almost no row interchanges, and without them the
+//! factors keep the upper bandwidth `ku` instead of `kl + ku` — half the
+//! work. Each interchange still bounds the growth of the (equilibrated)
+//! entries by `1 + 1/τ`.
 
 use faer::sparse::SymbolicSparseColMat;
 use std::collections::VecDeque;
+
+use crate::tolerances::TOLERANCES;
+
+/// A column keeps its diagonal pivot while `|bⱼⱼ| ≥ τ maxᵢ |bᵢⱼ|` on the
+/// equilibrated matrix: `τ = 0.1`.
+pub const PIVOT_THRESHOLD: f64 = TOLERANCES.pivot_threshold;
+
+/// The symmetric equilibrating scale of a matrix with diagonal magnitudes
+/// `diag`: `dᵢ = |aᵢᵢ|^-½`, the mean diagonal standing in for a zero (or
+/// non-finite) one, and `1` where the whole diagonal vanishes.
+pub fn equilibrating_scale(diag: &[f64]) -> Vec<f64> {
+    let finite = diag.iter().filter(|a| a.is_finite());
+    let (sum, count) = finite.fold((0.0, 0usize), |(s, c), &a| (s + a.abs(), c + 1));
+    let mean = if count > 0 { sum / count as f64 } else { 0.0 };
+    diag.iter()
+        .map(|&a| {
+            let a = a.abs();
+            if a > 0.0 && a.is_finite() {
+                1.0 / a.sqrt()
+            } else if mean > 0.0 && mean.is_finite() {
+                1.0 / mean.sqrt()
+            } else {
+                1.0
+            }
+        })
+        .collect()
+}
 
 /// The renumbering and band structure of a square pattern.
 #[derive(Debug, Clone)]
@@ -105,6 +146,20 @@ pub struct BandLu {
     piv: Vec<usize>,
     /// Position in `ab` of each stored entry of the CSC pattern.
     slot: Vec<usize>,
+    /// For each column of the band storage, the range of its entries in the
+    /// CSC values (the column it is renumbered from).
+    columns: Vec<std::ops::Range<usize>>,
+    /// Position in the CSC values of each unknown's diagonal entry.
+    diagonal: Vec<Option<usize>>,
+    /// Equilibrating scale of each row of the band storage, following the
+    /// row interchanges during a factorisation.
+    row_scale: Vec<f64>,
+    /// Upper bandwidth of the last factors: `ku` plus the farthest row
+    /// interchange.
+    u_width: usize,
+    /// Whether the last factorisation wrote into the rows kept for the fill
+    /// of interchanges (they must be cleared before the next).
+    fill_dirty: bool,
     /// Scratch for the permuted right-hand side.
     work: Vec<f64>,
 }
@@ -117,10 +172,16 @@ impl BandLu {
         let kv = band.kl + band.ku;
         let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
         let mut slot = Vec::with_capacity(row_idx.len());
+        let mut diagonal = vec![None; n];
+        let mut columns = vec![0..0; n];
         for j in 0..n {
-            for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+            columns[band.perm[j]] = col_ptr[j]..col_ptr[j + 1];
+            for (k, &i) in row_idx[col_ptr[j]..col_ptr[j + 1]].iter().enumerate() {
                 let (r, c) = (band.perm[i], band.perm[j]);
                 slot.push(c * ld + kv + r - c);
+                if i == j {
+                    diagonal[j] = Some(col_ptr[j] + k);
+                }
             }
         }
         Self {
@@ -128,42 +189,82 @@ impl BandLu {
             ab: vec![0.0; ld * n],
             piv: vec![0; n],
             slot,
+            columns,
+            diagonal,
+            row_scale: vec![1.0; n],
+            u_width: band.ku,
+            fill_dirty: false,
             work: vec![0.0; n],
             band,
         }
     }
 
-    /// Factorises the matrix with the pattern's `values` (CSC order).
-    /// A zero pivot leaves its column unfactorised; the solves then give
-    /// non-finite values, which the caller reports.
+    /// The equilibrating scale of the rows of `A` (renumbered).
+    fn scale_rows(&mut self, values: &[f64]) {
+        let diag: Vec<f64> = self
+            .diagonal
+            .iter()
+            .map(|k| k.map_or(0.0, |k| values[k]))
+            .collect();
+        for (&p, d) in self.band.perm.iter().zip(equilibrating_scale(&diag)) {
+            self.row_scale[p] = d;
+        }
+    }
+
+    /// Factorises the matrix with the pattern's `values` (CSC order):
+    /// `P A = L U` after the renumbering. A zero pivot leaves its column
+    /// unfactorised; the solves then give non-finite values, which the
+    /// caller reports. Each column is loaded into the band storage just
+    /// before the first elimination step that can reach it (`kl + ku`
+    /// steps ahead), so the working set stays a window of columns.
     pub fn factor(&mut self, values: &[f64]) {
+        self.scale_rows(values);
         let n = self.piv.len();
         let (kl, ku, ld) = (self.band.kl, self.band.ku, self.ld);
         let kv = kl + ku;
-        self.ab.iter_mut().for_each(|v| *v = 0.0);
-        for (&s, &v) in self.slot.iter().zip(values) {
-            self.ab[s] += v;
-        }
-        let ab = &mut self.ab;
+        // Rows kept for the fill of interchanges are still zero unless the
+        // last factorisation interchanged rows.
+        let from = if self.fill_dirty { 0 } else { kl };
+        let (ab, d, slot, columns) = (&mut self.ab, &mut self.row_scale, &self.slot, &self.columns);
+        let mut loaded = 0;
         // Highest column the interchanges so far have touched (LAPACK's ju).
         let mut ju = 0usize;
+        let mut farthest = 0usize;
         for j in 0..n {
+            while loaded < (j + kv + 1).min(n) {
+                ab[loaded * ld + from..(loaded + 1) * ld]
+                    .iter_mut()
+                    .for_each(|v| *v = 0.0);
+                for k in columns[loaded].clone() {
+                    ab[slot[k]] = values[k];
+                }
+                loaded += 1;
+            }
             let km = kl.min(n - 1 - j);
             let col = j * ld + kv;
-            // Pivot: the largest entry of column j on and below the diagonal.
+            // Pivot: the diagonal unless an equilibrated entry below it is
+            // more than 1/τ times larger, then the largest.
+            let diagonal = ab[col].abs() * d[j];
+            let below = &ab[col + 1..=col + km];
+            let largest = below
+                .iter()
+                .zip(&d[j + 1..=j + km])
+                .fold(0.0f64, |m, (a, di)| m.max(a.abs() * di));
             let mut jp = 0;
-            let mut best = ab[col].abs();
-            for i in 1..=km {
-                let a = ab[col + i].abs();
-                if a > best {
-                    best = a;
-                    jp = i;
+            let mut best = diagonal;
+            if diagonal < PIVOT_THRESHOLD * largest {
+                for (i, (a, di)) in below.iter().zip(&d[j + 1..=j + km]).enumerate() {
+                    if a.abs() * di > best {
+                        best = a.abs() * di;
+                        jp = i + 1;
+                    }
                 }
             }
             self.piv[j] = j + jp;
             if best == 0.0 {
                 continue;
             }
+            farthest = farthest.max(jp);
             ju = ju.max((j + ku + jp).min(n - 1));
             if jp != 0 {
                 // Swap rows j and j + jp in columns j..=ju.
@@ -172,9 +273,12 @@ impl BandLu {
                     let (a, b) = (base + j - c, base + j + jp - c);
                     ab.swap(a, b);
                 }
+                d.swap(j, j + jp);
             }
-            let pivot = ab[col];
-            ab[col + 1..=col + km].iter_mut().for_each(|v| *v /= pivot);
+            let reciprocal = 1.0 / ab[col];
+            ab[col + 1..=col + km]
+                .iter_mut()
+                .for_each(|v| *v *= reciprocal);
             // Rank-one update of columns j+1..=ju, on slices (vectorised):
             // the multipliers live in column j, before the split.
             let (left, right) = ab.split_at_mut((j + 1) * ld);
@@ -183,14 +287,14 @@ impl BandLu {
                 // Row j of column c, relative to `right`.
                 let top = (c - j - 1) * ld + kv + j - c;
                 let u = right[top];
-                if u != 0.0 {
-                    let target = &mut right[top + 1..=top + km];
-                    for (t, &l) in target.iter_mut().zip(multipliers) {
-                        *t -= l * u;
-                    }
+                let target = &mut right[top + 1..=top + km];
+                for (t, &l) in target.iter_mut().zip(multipliers) {
+                    *t -= l * u;
                 }
             }
         }
+        self.u_width = ku + farthest;
+        self.fill_dirty = farthest > 0;
     }
 
     /// Solves `A x = rhs` in place with the last factorisation.
@@ -216,12 +320,12 @@ impl BandLu {
                 *bi -= l * bj;
             }
         }
-        // U: upper bandwidth kl + ku after the interchanges.
+        // U: upper bandwidth ku plus the farthest interchange (≤ kl + ku).
         for j in (0..n).rev() {
             let col = j * ld + kv;
             b[j] /= self.ab[col];
             let bj = b[j];
-            let top = j.saturating_sub(kv);
+            let top = j.saturating_sub(self.u_width);
             let column = &self.ab[col + top - j..col];
             for (bi, a) in b[top..j].iter_mut().zip(column) {
                 *bi -= a * bj;
@@ -337,6 +441,75 @@ mod tests {
         }
         let arrow = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         assert!(!SparseLu::new(arrow).unwrap().is_band());
+    }
+
+    /// `A x` for a CSC matrix.
+    fn product(pattern: &SymbolicSparseColMat<usize>, values: &[f64], x: &[f64]) -> Vec<f64> {
+        let mut b = vec![0.0; x.len()];
+        let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
+        for j in 0..x.len() {
+            for k in cp[j]..cp[j + 1] {
+                b[ri[k]] += values[k] * x[j];
+            }
+        }
+        b
+    }
+
+    #[test]
+    fn mixed_units_keep_the_diagonal_pivots_and_small_diagonals_interchange() {
+        // A symmetric positive definite band matrix (diagonally dominant)
+        // whose odd unknowns are in units a million times larger: partial
+        // pivoting on the raw entries would interchange rows at every odd
+        // column, the equilibrated comparison none.
+        let (pattern, raw) = scrambled(120, 5, 7);
+        let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
+        let unit = |i: usize| if i % 2 == 1 { 1e3 } else { 1e-3 };
+        let mut values = vec![0.0; raw.len()];
+        for j in 0..120 {
+            for k in cp[j]..cp[j + 1] {
+                let i = ri[k];
+                // Symmetric part of the random entries, a dominant diagonal.
+                let v = if i == j {
+                    20.0
+                } else {
+                    0.5 + 0.25 * ((i + j) % 3) as f64
+                };
+                values[k] = v * unit(i) * unit(j);
+            }
+        }
+        let band = BandStructure::of(&pattern);
+        let ku = band.ku;
+        let mut lu = BandLu::new(&pattern, band);
+        lu.factor(&values);
+        assert_eq!(lu.u_width, ku, "no interchange");
+        let x: Vec<f64> = (0..120)
+            .map(|i| (i as f64 * 0.37).sin() / unit(i))
+            .collect();
+        let mut b = product(&pattern, &values, &x);
+        lu.solve(&mut b);
+        for (got, want) in b.iter().zip(&x) {
+            assert!(
+                (got - want).abs() <= 1e-10 * want.abs().max(1e-3),
+                "{got} {want}"
+            );
+        }
+        // Tiny diagonals (the scrambled matrix as it is) still interchange.
+        let band = BandStructure::of(&pattern);
+        let ku = band.ku;
+        let mut lu = BandLu::new(&pattern, band);
+        lu.factor(&raw);
+        assert!(lu.u_width > ku, "interchanges where the diagonal is small");
+        // And a matrix factorised after one with interchanges is right too
+        // (the fill rows are cleared).
+        lu.factor(&values);
+        let mut b = product(&pattern, &values, &x);
+        lu.solve(&mut b);
+        for (got, want) in b.iter().zip(&x) {
+            assert!(
+                (got - want).abs() <= 1e-10 * want.abs().max(1e-3),
+                "{got} {want}"
+            );
+        }
     }
 
     #[test]

@@ -12,7 +12,7 @@ use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par};
 
-use crate::band_lu::{BandLu, BandStructure};
+use crate::band_lu::{equilibrating_scale, BandLu, BandStructure};
 
 /// A matrix in a solver's pattern: its values with the pattern.
 #[derive(Clone, Copy)]
@@ -25,7 +25,7 @@ pub struct TangentRef<'a> {
 
 impl TangentRef<'_> {
     /// The equilibrating scale `dᵢ = |aᵢᵢ|^-½` (the mean diagonal where a
-    /// diagonal entry is zero).
+    /// diagonal entry is zero; see [`equilibrating_scale`]).
     pub fn equilibration(&self) -> Vec<f64> {
         let n = self.pattern.nrows();
         let (col_ptr, row_idx) = (self.pattern.col_ptr(), self.pattern.row_idx());
@@ -33,20 +33,10 @@ impl TangentRef<'_> {
         for (j, d) in diag.iter_mut().enumerate() {
             let range = col_ptr[j]..col_ptr[j + 1];
             if let Some(k) = row_idx[range.clone()].iter().position(|&r| r == j) {
-                *d = self.values[range.start + k].abs();
+                *d = self.values[range.start + k];
             }
         }
-        let mean = diag.iter().sum::<f64>() / n.max(1) as f64;
-        diag.iter()
-            .map(|&a| {
-                1.0 / if a > 0.0 {
-                    a
-                } else {
-                    mean.max(f64::MIN_POSITIVE)
-                }
-                .sqrt()
-            })
-            .collect()
+        equilibrating_scale(&diag)
     }
 
     /// `‖D A D‖∞` for the scale `d` of [`TangentRef::equilibration`].
@@ -100,6 +90,9 @@ pub struct SparseLu {
     pattern: SymbolicSparseColMat<usize>,
     backend: Backend,
     factored: bool,
+    /// Whether the current factorisation passed a singularity check (see
+    /// [`SparseLu::checked_regular`]).
+    regular: bool,
     /// The key of the factorised matrix's form (see [`SparseLu::key`]).
     key: f64,
 }
@@ -138,6 +131,7 @@ impl SparseLu {
             pattern,
             backend,
             factored: false,
+            regular: false,
             key: f64::NAN,
         }
     }
@@ -155,6 +149,7 @@ impl SparseLu {
     /// Numeric factorisation of the matrix with this pattern and `values`.
     pub fn factor(&mut self, values: &[f64]) -> Result<(), String> {
         self.factored = false;
+        self.regular = false;
         self.key = f64::NAN;
         match &mut self.backend {
             Backend::Band(lu) => lu.factor(values),
@@ -181,6 +176,20 @@ impl SparseLu {
     /// same key (`NaN` never matches).
     pub fn key(&self) -> Option<f64> {
         (self.factored && !self.key.is_nan()).then_some(self.key)
+    }
+
+    /// Whether the current factorisation was found regular by its owner
+    /// ([`SparseLu::set_regular`]; no after a new [`SparseLu::factor`]).
+    /// Newton uses it to skip the singularity check at the start of a solve
+    /// that follows one whose solution was checked: see
+    /// [`crate::newton::solve`].
+    pub fn checked_regular(&self) -> bool {
+        self.factored && self.regular
+    }
+
+    /// Records that the current factorisation passed a singularity check.
+    pub fn set_regular(&mut self) {
+        self.regular = true;
     }
 
     /// Attaches `key` to the current factorisation.

@@ -126,10 +126,14 @@ pub struct NewtonReport {
 
 /// Runs Newton's method from the system's current iterate. `r` and `dq` are
 /// caller-owned scratch vectors of length `n_eq`. A singular tangent at the
-/// start of the solve or at the converged iterate ends it in
-/// [`NewtonFailure::Singular`] (two triangular solves estimate its condition number); one met on the way
-/// (a wild iterate) is left to the failure it causes, which step control
-/// can cure.
+/// converged iterate ends it in [`NewtonFailure::Singular`] (two triangular
+/// solves estimate its condition number), and so does one at the start of
+/// the solve — checked unless `lu` holds a factorisation checked regular
+/// by the previous solve ([`SparseLu::checked_regular`]: the solution it
+/// starts from was regular, and a tangent that turned singular since then
+/// fails the solve, whose retry from a smaller step is checked). One met
+/// on the way (a wild iterate) is left to the failure it causes, which step
+/// control can cure.
 pub fn solve<S: NewtonSystem>(
     sys: &mut S,
     lu: &mut SparseLu,
@@ -139,7 +143,8 @@ pub fn solve<S: NewtonSystem>(
 ) -> Result<NewtonReport, NewtonFailure> {
     let mut factored = false;
     sys.set_exact_tangent(settings.exact_tangent);
-    let report = iterate(sys, lu, settings, r, dq, &mut factored)?;
+    let start_checked = lu.checked_regular();
+    let report = iterate(sys, lu, settings, start_checked, r, dq, &mut factored)?;
     if !settings.modified {
         check_regular(sys, lu, factored, true)?;
     }
@@ -150,6 +155,7 @@ fn iterate<S: NewtonSystem>(
     sys: &mut S,
     lu: &mut SparseLu,
     settings: &NewtonSettings,
+    start_checked: bool,
     r: &mut [f64],
     dq: &mut [f64],
     factored: &mut bool,
@@ -217,9 +223,10 @@ fn iterate<S: NewtonSystem>(
                 .map_err(NewtonFailure::LinearSolve)?;
             lu.set_key(sys.tangent_key());
             factorizations += 1;
-            // Full Newton checks the start of the solve (and the converged
-            // iterate, in `solve`); modified Newton every tangent it keeps.
-            if it == 0 || settings.modified {
+            // Full Newton checks the start of the solve (unless the previous
+            // solution was checked) and the converged iterate (in `solve`);
+            // modified Newton every tangent it keeps.
+            if (it == 0 && !start_checked) || settings.modified {
                 check_regular(sys, lu, true, false)?;
             }
         }
@@ -256,7 +263,9 @@ pub(crate) fn check_regular<S: NewtonSystem>(
             .map_err(NewtonFailure::LinearSolve)?;
     }
     let (condition, mode) = lu.condition_estimate(sys.tangent_values());
-    if condition > SINGULAR_CONDITION {
+    if condition <= SINGULAR_CONDITION {
+        lu.set_regular();
+    } else {
         return Err(NewtonFailure::Singular {
             condition,
             motion: Box::new(sys.free_motion(

@@ -110,3 +110,94 @@ fn a_poor_cheap_tangent_is_replaced_by_the_exact_one() {
     run(&mut exact, true);
     assert_eq!(exact.cheap_count, 0);
 }
+
+/// `rᵢ(q) = qᵢ² − 1`, two uncoupled unknowns: the tangent `2qᵢ` is singular
+/// where an unknown is zero.
+struct Square {
+    q: [f64; 2],
+    values: Vec<f64>,
+}
+
+impl NewtonSystem for Square {
+    fn evaluate(&mut self, r: &mut [f64]) -> f64 {
+        for ((ri, vi), &q) in r.iter_mut().zip(&mut self.values).zip(&self.q) {
+            *ri = q * q - 1.0;
+            *vi = 2.0 * q;
+        }
+        1.0
+    }
+    fn tangent_values(&self) -> &[f64] {
+        &self.values
+    }
+    fn apply(&mut self, dq: &[f64]) {
+        self.q[0] += dq[0];
+        self.q[1] += dq[1];
+    }
+    fn free_motion(&self, _mode: &[f64], _tangent: TangentRef) -> FreeMotion {
+        FreeMotion::default()
+    }
+}
+
+#[test]
+fn the_start_check_is_skipped_only_after_a_checked_solution() {
+    let pattern = SymbolicSparseColMat::new_checked(2, 2, vec![0, 1, 2], None, vec![0, 1]);
+    let settings = NewtonSettings {
+        tolerance: 1e-12,
+        max_iterations: 40,
+        modified: false,
+        exact_tangent: true,
+    };
+    let (mut r, mut dq) = (vec![0.0; 2], vec![0.0; 2]);
+    let singular_start = |lu: &mut SparseLu, r: &mut [f64], dq: &mut [f64]| {
+        let mut sys = Square {
+            q: [0.0, 2.0],
+            values: vec![0.0; 2],
+        };
+        solve(&mut sys, lu, &settings, r, dq)
+    };
+    // A first solve from a singular start: refused as singular at the start.
+    let mut lu = SparseLu::new(pattern.clone()).expect("pattern");
+    assert!(!lu.checked_regular());
+    let first = singular_start(&mut lu, &mut r, &mut dq);
+    assert!(
+        matches!(
+            first,
+            Err(NewtonFailure::Singular {
+                converged: false,
+                ..
+            })
+        ),
+        "{first:?}"
+    );
+    // A regular solve leaves its factorisation checked ...
+    let mut lu = SparseLu::new(pattern).expect("pattern");
+    let mut sys = Square {
+        q: [0.5, 2.0],
+        values: vec![0.0; 2],
+    };
+    solve(&mut sys, &mut lu, &settings, &mut r, &mut dq).expect("converges");
+    assert!(lu.checked_regular());
+    // ... so the next solve does not check its start: a tangent turned
+    // singular fails it (a zero pivot), and the retry, whose start is
+    // checked again, names the singularity.
+    let next = singular_start(&mut lu, &mut r, &mut dq);
+    assert!(
+        matches!(
+            next,
+            Err(NewtonFailure::LinearSolve(_) | NewtonFailure::NotFinite { .. })
+        ),
+        "{next:?}"
+    );
+    assert!(!lu.checked_regular());
+    let retry = singular_start(&mut lu, &mut r, &mut dq);
+    assert!(
+        matches!(
+            retry,
+            Err(NewtonFailure::Singular {
+                converged: false,
+                ..
+            })
+        ),
+        "{retry:?}"
+    );
+}

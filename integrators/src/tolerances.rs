@@ -21,6 +21,11 @@ pub struct Tolerances {
     /// (the exact tangent's quadratic convergence then wins within the
     /// iterations a step usually takes).
     pub inexact_contraction: f64,
+    /// The band LU keeps a column's diagonal pivot while it is at least this
+    /// fraction of the column's largest entry on the equilibrated matrix:
+    /// `1/10` (threshold partial pivoting; the growth of the entries per
+    /// interchange is then at most `1 + 1/τ`).
+    pub pivot_threshold: f64,
     /// Condition number of the equilibrated tangent above which a solution
     /// is not unique (a mechanism): `1/(100 ε)`. A null direction gives
     /// `κ ≳ 1/ε`; a slender cantilever of a thousand elements with
@@ -47,6 +52,7 @@ pub const TOLERANCES: Tolerances = Tolerances {
     stall_ratio: 0.5,
     modified_contraction: 0.5,
     inexact_contraction: 0.05,
+    pivot_threshold: 0.1,
     singular_condition: 1.0 / (100.0 * f64::EPSILON),
     end_of_run: 1e-12,
     level_snap: 1e-9,
