@@ -63,48 +63,67 @@ impl BeamElement<2> {
         let n = cn * (am * a / l - g0);
         let m = cm * (phi / l - k0);
         let aa: [Vector3<f64>; 3] = std::array::from_fn(|i| da[i] * a);
-        // e and ∂²E/∂z² in z = (φ, a).
-        let mut e = SVector::<f64, 6>::zeros();
-        let mut hess = SMatrix::<f64, 6, 6>::zeros();
+        // e = ∂E/∂z and the blocks of ∂²E/∂z² in z = (φ, a).
+        let mut e_phi = Vector3::zeros();
+        let mut h_pp = Matrix3::zeros();
+        let mut h_pa = Matrix3::zeros();
         for i in 0..3 {
-            e[i] = 0.5 * n.dot(&aa[i]) + m[i];
+            e_phi[i] = 0.5 * n.dot(&aa[i]) + m[i];
             for j in 0..3 {
-                hess[(i, j)] = 0.25 * (aa[j].dot(&(cn * aa[i])) / l + n.dot(&(dda[i][j] * a)))
+                h_pp[(i, j)] = 0.25 * (aa[j].dot(&(cn * aa[i])) / l + n.dot(&(dda[i][j] * a)))
                     + cm[(i, j)] / l;
             }
             let phi_a = (da[i].transpose() * n + am.transpose() * (cn * aa[i]) / l) * 0.5;
-            for k in 0..3 {
-                hess[(i, 3 + k)] = phi_a[k];
-                hess[(3 + k, i)] = phi_a[k];
-            }
+            h_pa.set_row(i, &phi_a.transpose());
         }
         let ea = am.transpose() * n;
-        e.fixed_rows_mut::<3>(3).copy_from(&ea);
-        hess.fixed_view_mut::<3, 3>(3, 3)
-            .copy_from(&(am.transpose() * cn * am / l));
-        // J = ∂z/∂(η₁, ε₁, η₂, ε₂).
+        let h_aa = am.transpose() * cn * am / l;
+        // J = ∂z/∂(η₁, ε₁, η₂, ε₂) has the column blocks
+        // c₁ = −P, c₂ = −Q + P d̂, c₃ = P, c₄ = Q with P = (0; Λ₁ᵀ),
+        // Q = (S; 0): Jᵀ(∂²E/∂z²)J from the four products of P and Q
+        // (d̂ᵀ = −d̂), in 3 × 3 blocks.
         let s = tangent_inverse(&phi) * lt;
-        let mut j = SMatrix::<f64, 6, 12>::zeros();
-        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-s));
-        j.fixed_view_mut::<3, 3>(0, 9).copy_from(&s);
-        j.fixed_view_mut::<3, 3>(3, 0).copy_from(&(-lt));
-        j.fixed_view_mut::<3, 3>(3, 6).copy_from(&lt);
-        j.fixed_view_mut::<3, 3>(3, 3)
-            .copy_from(&(lt * d.cross_matrix()));
-        let r = j.transpose() * e;
-        let mut k = j.transpose() * hess * j;
-        // G: the derivative of Jᵀe with e held.
-        let e_phi = Vector3::new(e[0], e[1], e[2]);
+        let dh = d.cross_matrix();
+        let pp = lam[0] * h_aa * lt;
+        let qq = s.transpose() * h_pp * s;
+        let qp = s.transpose() * h_pa * lt;
+        let pq = qp.transpose();
+        let (pp_d, qp_d, d_pp, d_pq) = (pp * dh, qp * dh, dh * pp, dh * pq);
+        let k21 = pp_d - pq; // c₃ᵀHc₂
+        let k41 = qp_d - qq; // c₄ᵀHc₂
+        let k12 = -qp - d_pp; // c₂ᵀHc₃
+        let k14 = -qq - d_pq; // c₂ᵀHc₄
+        let k11 = qq - qp_d + d_pq - d_pp * dh; // c₂ᵀHc₂
+        let blocks = [
+            [pp, -k21, -pp, -pq],
+            [-k12, k11, k12, k14],
+            [-pp, k21, pp, pq],
+            [-qp, k41, qp, qq],
+        ];
+        let mut k = SMatrix::<f64, 12, 12>::zeros();
+        for (a, row) in blocks.iter().enumerate() {
+            for (b, blk) in row.iter().enumerate() {
+                k.fixed_view_mut::<3, 3>(3 * a, 3 * b).copy_from(blk);
+            }
+        }
+        // r = Jᵀe.
         let u = s.transpose() * e_phi;
+        let b = lam[0] * ea;
+        let mut r = SVector::<f64, 12>::zeros();
+        r.fixed_rows_mut::<3>(0).copy_from(&(-b));
+        r.fixed_rows_mut::<3>(3).copy_from(&(-u - dh * b));
+        r.fixed_rows_mut::<3>(6).copy_from(&b);
+        r.fixed_rows_mut::<3>(9).copy_from(&u);
+        // G: the derivative of Jᵀe with e held.
         let mphi = lam[0] * tangent_inverse_transpose_derivative(&phi, &e_phi) * s;
-        let b_hat = (lam[0] * ea).cross_matrix();
+        let b_hat = b.cross_matrix();
         let mut add = |row: usize, col: usize, blk: Matrix3<f64>| {
             let mut v = k.fixed_view_mut::<3, 3>(row, col);
             v += blk;
         };
         add(9, 3, -u.cross_matrix() - mphi);
         add(9, 9, mphi);
-        add(3, 3, u.cross_matrix() + mphi + d.cross_matrix() * b_hat);
+        add(3, 3, u.cross_matrix() + mphi + dh * b_hat);
         add(3, 9, -mphi);
         add(0, 3, b_hat);
         add(6, 3, -b_hat);

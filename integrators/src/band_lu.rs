@@ -283,12 +283,16 @@ impl BandLu {
             // the multipliers live in column j, before the split.
             let (left, right) = ab.split_at_mut((j + 1) * ld);
             let multipliers = &left[col + 1..=col + km];
-            for c in j + 1..=ju {
-                // Row j of column c, relative to `right`.
-                let top = (c - j - 1) * ld + kv + j - c;
-                let u = right[top];
-                let target = &mut right[top + 1..=top + km];
-                for (t, &l) in target.iter_mut().zip(multipliers) {
+            // Row j of column c sits at (c − j − 1) ld + kv + j − c in
+            // `right`: one stride of ld − 1 per column from kv − 1, the
+            // column's entries below it following.
+            if ju == j {
+                continue;
+            }
+            let columns = right[kv - 1..].chunks_mut(ld - 1).take(ju - j);
+            for column in columns {
+                let (&mut u, below) = column.split_first_mut().expect("ld > 1");
+                for (t, &l) in below[..km].iter_mut().zip(multipliers) {
                     *t -= l * u;
                 }
             }
