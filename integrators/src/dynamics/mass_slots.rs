@@ -32,55 +32,57 @@ pub(crate) fn spin_derivative(
     (m.map(|v| v.re), k)
 }
 
-/// Tangent positions per translational mass entry `(i, j, m)` (its block
-/// is `c(m) I`: the diagonal's positions only) and per node's rotational
-/// inertia (`None` where a slave is involved: its maps change with the
-/// iterate, and the block goes through them).
+/// Where the mass and inertia blocks land in the tangent values. The
+/// translational mass `Σ m_ij I` is constant: the diagonal positions of the
+/// blocks whose nodes are independent, with their masses, are listed once,
+/// in the order of the values, so that each tangent assembly adds
+/// `c m_ij` along them in one sweep; entries involving a slave (whose maps
+/// change with the iterate) go through the maps. Rotational inertia: per
+/// node, its block's positions (`None` where the node is a slave).
 pub(crate) struct MassSlots {
-    translational: Vec<Option<Vec<usize>>>,
+    /// `(position in the tangent values, m_ij)`, sorted by position.
+    translational: Vec<(usize, f64)>,
+    /// Mass entries (indices into [`Inertia::mass`]) that involve a slave.
+    through_maps: Vec<usize>,
     rotational: Vec<Option<Vec<(usize, usize, usize)>>>,
 }
 
 impl MassSlots {
     pub(crate) fn new(asm: &Assembler, dofs: &DofMap, inertia: &Inertia) -> Self {
+        let mut translational = Vec::new();
+        let mut through_maps = Vec::new();
+        for (k, &(i, j, m)) in inertia.mass.iter().enumerate() {
+            match asm.node_block_slots(dofs, (i, 0), (j, 0)) {
+                Some(slots) => translational.extend(
+                    slots
+                        .into_iter()
+                        .filter(|&(_, a, b)| a == b)
+                        .map(|(p, _, _)| (p, m)),
+                ),
+                None => through_maps.push(k),
+            }
+        }
+        translational.sort_by_key(|&(p, _)| p);
         Self {
-            translational: inertia
-                .mass
-                .iter()
-                .map(|&(i, j, _)| {
-                    asm.node_block_slots(dofs, (i, 0), (j, 0)).map(|slots| {
-                        slots
-                            .into_iter()
-                            .filter(|&(_, a, b)| a == b)
-                            .map(|(p, _, _)| p)
-                            .collect()
-                    })
-                })
-                .collect(),
+            translational,
+            through_maps,
             rotational: (0..inertia.rotational.len())
                 .map(|i| asm.node_block_slots(dofs, (i, 3), (i, 3)))
                 .collect(),
         }
     }
 
-    /// Adds `c I` for mass entry `k = (i, j, m)` (translations of `i`, `j`).
-    pub(crate) fn add_translational(
-        &self,
-        asm: &mut Assembler,
-        dofs: &DofMap,
-        k: usize,
-        (i, j): (usize, usize),
-        c: f64,
-    ) {
-        match &self.translational[k] {
-            Some(diagonal) => {
-                if c != 0.0 {
-                    for &p in diagonal {
-                        asm.values[p] += c;
-                    }
-                }
-            }
-            None => asm.add_node_block(dofs, (i, 0), (j, 0), &(Matrix3::identity() * c)),
+    /// Adds `c M` for the translational mass `M = Σ m_ij I`.
+    fn add_translational(&self, asm: &mut Assembler, dofs: &DofMap, inertia: &Inertia, c: f64) {
+        if c == 0.0 {
+            return;
+        }
+        for &(p, m) in &self.translational {
+            asm.values[p] += c * m;
+        }
+        for &k in &self.through_maps {
+            let (i, j, m) = inertia.mass[k];
+            asm.add_node_block(dofs, (i, 0), (j, 0), &(Matrix3::identity() * (c * m)));
         }
     }
 
@@ -102,7 +104,7 @@ impl MassSlots {
     /// magnitudes to `abs`) and, with `tangent`, their tangent blocks:
     /// `force(j, m)` is the force of mass entry `(i, j, m)` on node `i`,
     /// whose derivative with respect to node `j`'s translation is
-    /// `coefficient(m)·I`; `moment(i, J₀, tangent)` is node `i`'s inertial
+    /// `coefficient·m·I`; `moment(i, J₀, tangent)` is node `i`'s inertial
     /// moment and its derivative under a spin of its end rotation (nodes
     /// without rotary inertia are skipped).
     #[allow(clippy::too_many_arguments)]
@@ -113,18 +115,18 @@ impl MassSlots {
         abs: &mut [f64],
         mut tangent: Option<(&mut Assembler, &DofMap)>,
         force: impl Fn(usize, f64) -> Vector3<f64>,
-        coefficient: impl Fn(f64) -> f64,
+        coefficient: f64,
         moment: impl Fn(usize, &Matrix3<f64>, bool) -> (Vector3<f64>, Matrix3<f64>),
     ) {
-        for (k, &(i, j, m)) in inertia.mass.iter().enumerate() {
+        for &(i, j, m) in &inertia.mass {
             let f = force(j, m);
             for c in 0..3 {
                 g[6 * i + c] += f[c];
                 abs[6 * i + c] += f[c].abs();
             }
-            if let Some((asm, dofs)) = tangent.as_mut() {
-                self.add_translational(asm, dofs, k, (i, j), coefficient(m));
-            }
+        }
+        if let Some((asm, dofs)) = tangent.as_mut() {
+            self.add_translational(asm, dofs, inertia, coefficient);
         }
         for (i, j0) in inertia.rotational.iter().enumerate() {
             if *j0 == Matrix3::zeros() {

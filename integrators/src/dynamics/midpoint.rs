@@ -203,7 +203,7 @@ impl StepTerms for MidpointTerms {
                 let dv = (end.x[j] - start.x[j]) * (2.0 / dt) - self.v_n[j] * 2.0;
                 dv.map(|d| m * d / dt)
             },
-            |m| 2.0 * m / (dt * dt),
+            2.0 / (dt * dt),
             |i, j0, tangent| {
                 inertial_moment(j0, &start.rot[i], &end.rot[i], &self.w_n[i], dt, tangent)
             },

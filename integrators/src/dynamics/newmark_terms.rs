@@ -79,9 +79,10 @@ impl Coefficients {
         (a1 * c(1.0 - self.alpha_m) + history.map(c)) / c(1.0 - self.alpha_f)
     }
 
-    /// The mass `m` times `∂q̈ₙ₊₁/∂uₙ₊₁ = (1 − α_m)/((1 − α_f) β Δt²)`.
-    fn stiffness(&self, m: f64, dt: f64) -> f64 {
-        m * (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * dt * dt)
+    /// `∂q̈ₙ₊₁/∂uₙ₊₁ = (1 − α_m)/((1 − α_f) β Δt²)`: the tangent of the
+    /// inertial force per unit mass.
+    fn stiffness(&self, dt: f64) -> f64 {
+        (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * dt * dt)
     }
 }
 
@@ -332,7 +333,7 @@ impl StepTerms for NewmarkTerms {
                 let a1 = pseudo_acceleration(k, end.x[j] - start.x[j], &prev.v[j], &prev.a[j], dt);
                 k.acceleration(a1, &prev.a[j], &prev.acc[j]).map(|a| m * a)
             },
-            |m| k.stiffness(m, dt),
+            k.stiffness(dt),
             |i, j0, tangent| {
                 if tangent {
                     inertial_moment_tangent(k, j0, &start.rot[i], &end.rot[i], prev, i, dt)
