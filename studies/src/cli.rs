@@ -196,6 +196,11 @@ enum Command {
         /// Time steps per run.
         #[arg(long, default_value_t = 20)]
         steps: usize,
+        /// Rounds per size: the cases run this many times, interleaved,
+        /// and each keeps its fastest run (other work on a shared machine
+        /// only adds time).
+        #[arg(long, default_value_t = 3)]
+        rounds: usize,
         /// Output directory.
         #[arg(long, short, default_value = "bench")]
         out: PathBuf,
@@ -502,11 +507,12 @@ fn execute(cli: Cli) -> ExitCode {
         Command::Bench {
             elements,
             steps,
+            rounds,
             out,
         } => {
             use crate::bench;
             println!("{}", bench::machine());
-            let outcome = bench::bench(&elements, steps, &out, |t| {
+            let outcome = bench::bench(&elements, steps, rounds, &out, |t| {
                 println!(
                     "{:>6} elements  {:<26} {:>9.0} µs/step  {:>7.2} µs/(element·step)",
                     t.elements,

@@ -13,8 +13,12 @@ fn every_case_builds_runs_and_is_tabulated() {
     }
     let dir = tempfile::tempdir().unwrap();
     let mut seen = 0;
-    let timings = bench(&[4, 8], 3, dir.path(), |_| seen += 1).unwrap();
+    let timings = bench(&[4, 8], 3, 2, dir.path(), |_| seen += 1).unwrap();
+    // Two rounds, one kept timing per case and size, in the cases' order.
     assert_eq!((timings.len(), seen), (2 * CASES.len(), 2 * CASES.len()));
+    for (t, case) in timings.iter().zip(CASES.iter().cycle()) {
+        assert_eq!(t.case.label, case.label);
+    }
     for t in &timings {
         // Three steps of dt = 1e-3.
         assert_eq!(t.steps, 3, "{}", t.case.label);
