@@ -8,7 +8,11 @@
 //! in LAPACK's `gbtrf` layout (lower bandwidth `kl`, upper `ku`, `kl` extra
 //! rows for the fill of row interchanges) and factorised column by column
 //! with threshold partial pivoting within the band: `O(n kl (kl + ku))`
-//! operations at most and no symbolic work per factorisation. For the
+//! operations at most and no symbolic work per factorisation. The
+//! elimination is left-looking: a column is loaded when it is reached and
+//! takes the earlier steps' interchanges and multipliers then, so the
+//! entries being updated stay one column (LAPACK's `gbtf2` is
+//! right-looking; the factors are the same). For the
 //! tangents of beam models this is several times faster than a general
 //! sparse LU; wider patterns keep the general one
 //! ([`crate::linsolve::SparseLu`] chooses).
@@ -214,9 +218,7 @@ impl BandLu {
     /// Factorises the matrix with the pattern's `values` (CSC order):
     /// `P A = L U` after the renumbering. A zero pivot leaves its column
     /// unfactorised; the solves then give non-finite values, which the
-    /// caller reports. Each column is loaded into the band storage just
-    /// before the first elimination step that can reach it (`kl + ku`
-    /// steps ahead), so the working set stays a window of columns.
+    /// caller reports.
     pub fn factor(&mut self, values: &[f64]) {
         self.scale_rows(values);
         let n = self.piv.len();
@@ -225,77 +227,72 @@ impl BandLu {
         // Rows kept for the fill of interchanges are still zero unless the
         // last factorisation interchanged rows.
         let from = if self.fill_dirty { 0 } else { kl };
-        let (ab, d, slot, columns) = (&mut self.ab, &mut self.row_scale, &self.slot, &self.columns);
-        let mut loaded = 0;
-        // Highest column the interchanges so far have touched (LAPACK's ju).
-        let mut ju = 0usize;
+        let (ab, d, piv) = (&mut self.ab, &mut self.row_scale, &mut self.piv);
         let mut farthest = 0usize;
-        for j in 0..n {
-            while loaded < (j + kv + 1).min(n) {
-                ab[loaded * ld + from..(loaded + 1) * ld]
-                    .iter_mut()
-                    .for_each(|v| *v = 0.0);
-                for k in columns[loaded].clone() {
-                    ab[slot[k]] = values[k];
-                }
-                loaded += 1;
+        for c in 0..n {
+            // Row r of column c at kv + r − c of its storage.
+            let (done, rest) = ab.split_at_mut(c * ld);
+            let column = &mut rest[..ld];
+            column[from..].iter_mut().for_each(|v| *v = 0.0);
+            for k in self.columns[c].clone() {
+                column[self.slot[k] - c * ld] = values[k];
             }
-            let km = kl.min(n - 1 - j);
-            let col = j * ld + kv;
+            // The earlier steps that reach this column, in order: each
+            // step's interchange, then its multipliers times the entry of
+            // its pivot row. Rows above c − ku are reached only through
+            // interchanges.
+            for j in c.saturating_sub(ku + farthest)..c {
+                let rj = kv + j - c;
+                let jp = piv[j] - j;
+                if jp != 0 {
+                    column.swap(rj, rj + jp);
+                }
+                let u = column[rj];
+                if u == 0.0 {
+                    continue;
+                }
+                let km = kl.min(n - 1 - j);
+                let multipliers = &done[j * ld + kv + 1..=j * ld + kv + km];
+                for (t, &l) in column[rj + 1..=rj + km].iter_mut().zip(multipliers) {
+                    *t -= l * u;
+                }
+            }
+            let km = kl.min(n - 1 - c);
             // Pivot: the diagonal unless an equilibrated entry below it is
             // more than 1/τ times larger, then the largest.
-            let diagonal = ab[col].abs() * d[j];
-            let below = &ab[col + 1..=col + km];
+            let diagonal = column[kv].abs() * d[c];
+            let below = &column[kv + 1..=kv + km];
+            let scales = &d[c + 1..=c + km];
             let largest = below
                 .iter()
-                .zip(&d[j + 1..=j + km])
+                .zip(scales)
                 .fold(0.0f64, |m, (a, di)| m.max(a.abs() * di));
             let mut jp = 0;
             let mut best = diagonal;
             if diagonal < PIVOT_THRESHOLD * largest {
-                for (i, (a, di)) in below.iter().zip(&d[j + 1..=j + km]).enumerate() {
+                for (i, (a, di)) in below.iter().zip(scales).enumerate() {
                     if a.abs() * di > best {
                         best = a.abs() * di;
                         jp = i + 1;
                     }
                 }
             }
-            self.piv[j] = j + jp;
+            piv[c] = c + jp;
             if best == 0.0 {
                 continue;
             }
-            farthest = farthest.max(jp);
-            ju = ju.max((j + ku + jp).min(n - 1));
             if jp != 0 {
-                // Swap rows j and j + jp in columns j..=ju.
-                for c in j..=ju {
-                    let base = c * ld + kv;
-                    let (a, b) = (base + j - c, base + j + jp - c);
-                    ab.swap(a, b);
-                }
-                d.swap(j, j + jp);
+                // The later columns take the interchange when they are
+                // reached; the multipliers of the earlier ones stay (the
+                // solve interchanges in the same order).
+                column.swap(kv, kv + jp);
+                d.swap(c, c + jp);
+                farthest = farthest.max(jp);
             }
-            let reciprocal = 1.0 / ab[col];
-            ab[col + 1..=col + km]
+            let reciprocal = 1.0 / column[kv];
+            column[kv + 1..=kv + km]
                 .iter_mut()
                 .for_each(|v| *v *= reciprocal);
-            // Rank-one update of columns j+1..=ju, on slices (vectorised):
-            // the multipliers live in column j, before the split.
-            let (left, right) = ab.split_at_mut((j + 1) * ld);
-            let multipliers = &left[col + 1..=col + km];
-            // Row j of column c sits at (c − j − 1) ld + kv + j − c in
-            // `right`: one stride of ld − 1 per column from kv − 1, the
-            // column's entries below it following.
-            if ju == j {
-                continue;
-            }
-            let columns = right[kv - 1..].chunks_mut(ld - 1).take(ju - j);
-            for column in columns {
-                let (&mut u, below) = column.split_first_mut().expect("ld > 1");
-                for (t, &l) in below[..km].iter_mut().zip(multipliers) {
-                    *t -= l * u;
-                }
-            }
         }
         self.u_width = ku + farthest;
         self.fill_dirty = farthest > 0;
