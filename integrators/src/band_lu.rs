@@ -159,11 +159,9 @@ pub struct BandLu {
     /// row interchanges during a factorisation.
     row_scale: Vec<f64>,
     /// Upper bandwidth of the last factors: `ku` plus the farthest row
-    /// interchange.
+    /// interchange (beyond `ku`, the last factorisation wrote into the rows
+    /// kept for the fill of interchanges, which the next must clear).
     u_width: usize,
-    /// Whether the last factorisation wrote into the rows kept for the fill
-    /// of interchanges (they must be cleared before the next).
-    fill_dirty: bool,
     /// Scratch for the permuted right-hand side.
     work: Vec<f64>,
 }
@@ -197,7 +195,6 @@ impl BandLu {
             diagonal,
             row_scale: vec![1.0; n],
             u_width: band.ku,
-            fill_dirty: false,
             work: vec![0.0; n],
             band,
         }
@@ -226,7 +223,7 @@ impl BandLu {
         let kv = kl + ku;
         // Rows kept for the fill of interchanges are still zero unless the
         // last factorisation interchanged rows.
-        let from = if self.fill_dirty { 0 } else { kl };
+        let from = if self.u_width > ku { 0 } else { kl };
         let (ab, d, piv) = (&mut self.ab, &mut self.row_scale, &mut self.piv);
         let mut farthest = 0usize;
         for c in 0..n {
@@ -295,7 +292,6 @@ impl BandLu {
                 .for_each(|v| *v *= reciprocal);
         }
         self.u_width = ku + farthest;
-        self.fill_dirty = farthest > 0;
     }
 
     /// Solves `A x = rhs` in place with the last factorisation.
