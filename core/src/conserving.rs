@@ -31,6 +31,26 @@ pub enum MidRotation {
 /// A configuration of one 2-node element: nodal positions and rotations.
 pub type Pose<T> = ([Vector3<T>; 2], [Matrix3<T>; 2]);
 
+/// The rotation pieces of one 2-node element pose (`Λᵢ = RᵢΛ₀ᵢ`):
+/// computed once per pose and shared by the resultants, the discrete
+/// gradient and the tangents, each of which needs the same logarithm and
+/// exponential.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Frames<T: Scalar> {
+    /// Nodal triads `Λ₁`, `Λ₂`.
+    pub(crate) lam: [Matrix3<T>; 2],
+    /// Relative rotation `Λ₁ᵀΛ₂ = exp(φ̂)`.
+    pub(crate) rel: Matrix3<T>,
+    /// `φ = log(Λ₁ᵀΛ₂)`.
+    pub(crate) phi: Vector3<T>,
+    /// `exp(½φ̂)`.
+    pub(crate) half: Matrix3<T>,
+    /// Reference rotation `Λ_r = Λ₁ exp(½φ̂)`.
+    pub(crate) lam_r: Matrix3<T>,
+    /// Chord `d = x₂ − x₁`.
+    pub(crate) d: Vector3<T>,
+}
+
 /// A configuration of one 3-node element: nodal positions and rotations.
 pub type Pose3<T> = ([Vector3<T>; 3], [Matrix3<T>; 3]);
 
@@ -53,15 +73,34 @@ impl BeamElement<2> {
         x: &[Vector3<T>; 2],
         rot: &[Matrix3<T>; 2],
     ) -> (Vector3<T>, Vector3<T>) {
-        let lam = self.triads(rot);
-        let phi = log(&mtm(&lam[0], &lam[1]));
-        let lam_r = mm(&lam[0], &exp(&(phi * cst::<T>(0.5))));
+        self.frame_resultants(&self.frames(&(*x, *rot)))
+    }
+
+    /// The rotation pieces of a pose every conserving kernel needs, each
+    /// computed once: triads, `Λ₁ᵀΛ₂`, `φ`, `exp(½φ̂)`, `Λ_r` and the chord.
+    pub(crate) fn frames<T: Scalar>(&self, pose: &Pose<T>) -> Frames<T> {
+        let lam = self.triads(&pose.1);
+        let rel = mtm(&lam[0], &lam[1]);
+        let phi = log(&rel);
+        let half = exp(&(phi * cst::<T>(0.5)));
+        Frames {
+            lam_r: mm(&lam[0], &half),
+            lam,
+            rel,
+            phi,
+            half,
+            d: pose.0[1] - pose.0[0],
+        }
+    }
+
+    /// [`Self::resultants`] of a pose's [`Frames`].
+    pub(crate) fn frame_resultants<T: Scalar>(&self, f: &Frames<T>) -> (Vector3<T>, Vector3<T>) {
         let l = cst::<T>(self.length);
         let (g0, k0) = self.initial_strains()[0];
         (
-            (mv(&lam_r.transpose(), &(x[1] - x[0])) / l - g0.map(cst::<T>))
+            (mv(&f.lam_r.transpose(), &f.d) / l - g0.map(cst::<T>))
                 .component_mul(&self.section.c_n.map(cst::<T>)),
-            (phi / l - k0.map(cst::<T>)).component_mul(&self.section.c_m.map(cst::<T>)),
+            (f.phi / l - k0.map(cst::<T>)).component_mul(&self.section.c_m.map(cst::<T>)),
         )
     }
 

@@ -34,7 +34,8 @@
 //!   (`w = Δθ/(|Δθ|² + ε²)`, `b_miss = δ − BΔθ`), and
 //!   `∂q/∂x₂ = −∂q/∂x₁ = ∂q/∂d₂`.
 
-use crate::conserving::Pose;
+use crate::conserving::{Frames, Pose};
+use crate::discrete_gradient::{dg_step_of, step_force};
 use crate::element::BeamElement;
 use crate::rotation::{exp, log, tangent, tangent_inverse};
 use nalgebra::{Const, Matrix3, SMatrix, SVector, Vector3, U1};
@@ -71,37 +72,7 @@ fn stack(
     (q, k)
 }
 
-/// The end-state pieces of a 2-node element both tangents need.
-struct EndState {
-    /// `φ = log(Λ₁ᵀΛ₂)`, `Λ₁`, the reference rotation `Λ_r`, the chord `d`.
-    phi: Vector3<f64>,
-    lam1: Matrix3<f64>,
-    lam_r: Matrix3<f64>,
-    d: Vector3<f64>,
-}
-
 impl BeamElement<2> {
-    fn end_state(&self, pose: &Pose<f64>) -> EndState {
-        let lam = self.nodal_triads(&pose.1);
-        let phi = log(&(lam[0].transpose() * lam[1]));
-        EndState {
-            lam_r: lam[0] * exp(&(phi * 0.5)),
-            lam1: lam[0],
-            phi,
-            d: pose.0[1] - pose.0[0],
-        }
-    }
-
-    /// Material resultants `(C_N(Λ_rᵀd/L − Γ₀), C_M(φ/L − K₀))` of a state.
-    fn state_resultants(&self, s: &EndState) -> (Vector3<f64>, Vector3<f64>) {
-        let (g0, k0) = self.initial_strains()[0];
-        let l = self.length;
-        (
-            (s.lam_r.transpose() * s.d / l - g0).component_mul(&self.section.c_n),
-            (s.phi / l - k0).component_mul(&self.section.c_m),
-        )
-    }
-
     /// The momentum scheme's element force `q_k(Nₙ₊½, Mₙ₊½)` with the
     /// geodesic mid rotation (equal to [`Self::midpoint_force`] with the
     /// averaged resultants) and its closed-form derivative under spatial
@@ -111,10 +82,35 @@ impl BeamElement<2> {
         start: &Pose<f64>,
         end: &Pose<f64>,
     ) -> (SVector<f64, 12>, SMatrix<f64, 12, 12>) {
+        self.momentum_tangent_of(&self.frames(start), &self.frames(end))
+    }
+
+    /// The energy–momentum scheme's element force (the discrete gradient,
+    /// [`Self::energy_momentum_force`]) with the cheap tangent: the momentum
+    /// scheme's closed-form derivative ([`Self::momentum_force_tangent`]),
+    /// which differs from the exact one by terms that vanish with the
+    /// step's rotation increment. Both from one set of the poses' rotation
+    /// pieces.
+    pub fn energy_momentum_force_cheap_tangent(
+        &self,
+        start: &Pose<f64>,
+        end: &Pose<f64>,
+    ) -> (SVector<f64, 12>, SMatrix<f64, 12, 12>) {
+        let (s0, s1) = (self.frames(start), self.frames(end));
+        let (nbar, mbar) = self.averaged_resultants(&s0, &s1);
+        let q = step_force(&dg_step_of(&s0, &s1), &nbar, &mbar).0;
+        (q, self.momentum_tangent_of(&s0, &s1).1)
+    }
+
+    /// [`Self::momentum_force_tangent`] from the poses' [`Frames`].
+    fn momentum_tangent_of(
+        &self,
+        s0: &Frames<f64>,
+        s1: &Frames<f64>,
+    ) -> (SVector<f64, 12>, SMatrix<f64, 12, 12>) {
         let l = self.length;
-        let (s0, s1) = (self.end_state(start), self.end_state(end));
-        let (n0, m0) = self.state_resultants(&s0);
-        let (n1, m1) = self.state_resultants(&s1);
+        let (n0, m0) = self.frame_resultants(s0);
+        let (n1, m1) = self.frame_resultants(s1);
         let (nbar, mbar) = ((n0 + n1) * 0.5, (m0 + m1) * 0.5);
         let omega = log(&(s1.lam_r * s0.lam_r.transpose()));
         let lt = exp(&(omega * 0.5)) * s0.lam_r;
@@ -124,8 +120,8 @@ impl BeamElement<2> {
         // Chain rule (module docs).
         let id = Matrix3::identity();
         let z = Matrix3::zeros();
-        let s = tangent_inverse(&s1.phi) * s1.lam1.transpose();
-        let p = s1.lam1 * tangent(&(s1.phi * 0.5)) * s * 0.5;
+        let s = tangent_inverse(&s1.phi) * s1.lam[0].transpose();
+        let p = s1.lam[0] * tangent(&(s1.phi * 0.5)) * s * 0.5;
         let g = tangent(&(omega * 0.5)) * tangent_inverse(&omega) * 0.5;
         let jd = jac([-id, z, id, z]);
         let jwr = jac([z, id - p, z, p]);
@@ -193,7 +189,7 @@ impl BeamElement<2> {
         nbar: &Vector3<f64>,
     ) -> SMatrix<f64, 12, 3> {
         let st = self.dg_step(start, end);
-        let lam_r1 = self.end_state(end).lam_r;
+        let lam_r1 = self.frames(end).lam_r;
         let a = st.lam_bar
             * Matrix3::from_diagonal(&(self.section.c_n * (0.5 / self.length)))
             * lam_r1.transpose();

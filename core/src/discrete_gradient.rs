@@ -62,7 +62,7 @@
 //! ([`BeamElement::internal_force`]) at second order. No
 //! scalar β and no bordered Newton system are needed.
 
-use crate::conserving::Pose;
+use crate::conserving::{Frames, Pose};
 use crate::element::BeamElement;
 use crate::rotation::{
     cayley, cayley_inverse, exp, log, mm, mmt, mtm, mv, skew, tangent, tangent_inverse,
@@ -106,13 +106,31 @@ fn cayley_tangent_inverse<T: Scalar>(c: &Vector3<T>) -> Matrix3<T> {
     Matrix3::identity() - skew(c) * cst::<T>(0.5) + c * c.transpose() * cst::<T>(0.25)
 }
 
-/// The smooth secant operators `(B, T)` of a step seen from one end: node 1's
-/// triad `lam1` and the relative rotation vector `phi0` at that end, `phi1` at
-/// the other, and the Cayley increments `th` of the nodes towards the other end.
+/// The smooth secant operators `(B, T)` of a step seen from one end, from
+/// that end's relative rotations: [`secant_operators_at`] with the
+/// exponentials computed here (for callers that hold rotation vectors only).
 pub(crate) fn secant_operators<T: Scalar>(
     lam1: &Matrix3<T>,
     phi0: &Vector3<T>,
     phi1: &Vector3<T>,
+    th: &[Vector3<T>; 2],
+) -> (Matrix3<T>, Matrix3<T>) {
+    let half = cst::<T>(0.5);
+    let half0 = exp(&(phi0 * half));
+    let g = cayley_inverse(&mmt(&exp(&(phi1 * half)), &half0));
+    secant_operators_at(lam1, &exp(phi0), &half0, &g, th)
+}
+
+/// The smooth secant operators `(B, T)` of a step seen from one end: node
+/// 1's triad `lam1`, that end's relative rotation `rel0 = exp(φ̂₀)` and its
+/// half `half0 = exp(½φ̂₀)`, the reference rotation's relative increment
+/// `g = cay⁻¹(exp(½φ̂₁) exp(−½φ̂₀))` towards the other end, and the Cayley
+/// increments `th` of the nodes towards the other end.
+pub(crate) fn secant_operators_at<T: Scalar>(
+    lam1: &Matrix3<T>,
+    rel0: &Matrix3<T>,
+    half0: &Matrix3<T>,
+    g: &Vector3<T>,
     th: &[Vector3<T>; 2],
 ) -> (Matrix3<T>, Matrix3<T>) {
     let half = cst::<T>(0.5);
@@ -124,19 +142,15 @@ pub(crate) fn secant_operators<T: Scalar>(
         / (T::one() + th[0].dot(&th[1]) * quarter);
     let c_half = mv(&to_rel, &dtheta) * half;
     // Jacobians of φ(c) = log(cay(c) exp(φ̂₀)) and g(c) at ½c (midpoint rule).
-    let exp_phi0_half = exp(&(phi0 * (-half)));
-    let phi_h = log(&mm(&cayley(&c_half), &exp(phi0)));
+    let phi_h = log(&mm(&cayley(&c_half), rel0));
     let dphi_dc = mm(&tangent_inverse(&phi_h), &cayley_tangent(&c_half));
-    let g_h = cayley_inverse(&mm(&exp(&(phi_h * half)), &exp_phi0_half));
+    let g_h = cayley_inverse(&mmt(&exp(&(phi_h * half)), half0));
     let dg_dc = mm(
         &mm(&cayley_tangent_inverse(&g_h), &tangent(&(phi_h * half))),
         &dphi_dc,
     ) * half;
     // θ_r − θ₁ = E b/(1 − ¼θ₁·b), b = Λ₁ g (Cayley composition).
-    let b = mv(
-        lam1,
-        &cayley_inverse(&mm(&exp(&(phi1 * half)), &exp_phi0_half)),
-    );
+    let b = mv(lam1, g);
     let e = (Matrix3::identity() + skew(&th[0]) * half + th[0] * th[0].transpose() * quarter)
         / (T::one() - th[0].dot(&b) * quarter);
     (
@@ -145,31 +159,34 @@ pub(crate) fn secant_operators<T: Scalar>(
     )
 }
 
+/// The discrete gradient's [`Step`] between two poses' [`Frames`].
+pub(crate) fn dg_step_of<T: Scalar>(s: &Frames<T>, e: &Frames<T>) -> Step<T> {
+    let half = cst::<T>(0.5);
+    let theta = [0, 1].map(|i| cayley_inverse(&mmt(&e.lam[i], &s.lam[i])));
+    let dtheta = theta[1] - theta[0];
+    let delta = cayley_inverse(&mmt(&e.lam_r, &s.lam_r)) - (theta[0] + theta[1]) * half;
+    // The average of the operators seen from both ends is symmetric in
+    // time, hence consistent at second order; seen from the end, the
+    // reference rotation's relative increment is the start's reversed.
+    let g = cayley_inverse(&mmt(&e.half, &s.half));
+    let (bf, tf) = secant_operators_at(&s.lam[0], &s.rel, &s.half, &g, &theta);
+    let (bb, tb) = secant_operators_at(&e.lam[0], &e.rel, &e.half, &(-g), &theta.map(|t| -t));
+    let (b, t) = ((bf + bb) * half, (tf + tb) * half);
+    let eps = (T::one() + theta[0].norm_squared() + theta[1].norm_squared()) * cst::<T>(RIGID_STEP);
+    Step {
+        lam_bar: (s.lam_r + e.lam_r) * half,
+        dbar: (e.d + s.d) * half,
+        b_miss: delta - b * dtheta,
+        t_miss: (e.phi - s.phi) - t * dtheta,
+        b,
+        t,
+        direction: dtheta / (dtheta.norm_squared() + eps * eps),
+    }
+}
+
 impl BeamElement<2> {
     pub(crate) fn dg_step<T: Scalar>(&self, start: &Pose<T>, end: &Pose<T>) -> Step<T> {
-        let half = cst::<T>(0.5);
-        let ends = [self.triads(&start.1), self.triads(&end.1)];
-        let phi = ends.map(|l| log(&mtm(&l[0], &l[1])));
-        let lam_r = [0, 1].map(|k| mm(&ends[k][0], &exp(&(phi[k] * half))));
-        let theta = [0, 1].map(|i| cayley_inverse(&mmt(&end.1[i], &start.1[i])));
-        let dtheta = theta[1] - theta[0];
-        let delta = cayley_inverse(&mmt(&lam_r[1], &lam_r[0])) - (theta[0] + theta[1]) * half;
-        // The average of the operators seen from both ends is symmetric in
-        // time, hence consistent at second order.
-        let (bf, tf) = secant_operators(&ends[0][0], &phi[0], &phi[1], &theta);
-        let (bb, tb) = secant_operators(&ends[1][0], &phi[1], &phi[0], &theta.map(|t| -t));
-        let (b, t) = ((bf + bb) * half, (tf + tb) * half);
-        let eps =
-            (T::one() + theta[0].norm_squared() + theta[1].norm_squared()) * cst::<T>(RIGID_STEP);
-        Step {
-            lam_bar: (lam_r[0] + lam_r[1]) * half,
-            dbar: (end.0[1] - end.0[0] + start.0[1] - start.0[0]) * half,
-            b_miss: delta - b * dtheta,
-            t_miss: (phi[1] - phi[0]) - t * dtheta,
-            b,
-            t,
-            direction: dtheta / (dtheta.norm_squared() + eps * eps),
-        }
+        dg_step_of(&self.frames(start), &self.frames(end))
     }
 
     /// The energy-consistent internal force between the poses at `n` and
@@ -195,27 +212,61 @@ impl BeamElement<2> {
         nbar: &Vector3<T>,
         mbar: &Vector3<T>,
     ) -> (SVector<T, 12>, SVector<T, 12>) {
-        let st = self.dg_step(start, end);
-        let half = cst::<T>(0.5);
-        let n = st.lam_bar * nbar;
-        let c = st.dbar.cross(&n);
-        // Moments of the smooth operators B, T.
-        let arm = c * (-half);
-        let bc = st.b.transpose() * c;
-        let tm = st.t.transpose() * mbar;
-        let mut q = SVector::<T, 12>::zeros();
-        q.fixed_rows_mut::<3>(0).copy_from(&(-n));
-        q.fixed_rows_mut::<3>(3).copy_from(&(arm + bc - tm));
-        q.fixed_rows_mut::<3>(6).copy_from(&n);
-        q.fixed_rows_mut::<3>(9).copy_from(&(arm - bc + tm));
-        // (v ⊗ w)ᵀ x = w (v·x), w = Δθ/(|Δθ|² + ε²).
-        let extra = st.direction * (mbar.dot(&st.t_miss) - c.dot(&st.b_miss));
-        let mut corr = SVector::<T, 12>::zeros();
-        corr.fixed_rows_mut::<3>(3).copy_from(&(-extra));
-        corr.fixed_rows_mut::<3>(9).copy_from(&extra);
-        q += corr;
-        (q, corr)
+        step_force(&self.dg_step(start, end), nbar, mbar)
     }
+
+    /// The energy–momentum scheme's element force: the discrete gradient
+    /// with the step averages `N̄ = ½(Nₙ + Nₙ₊₁)`, `M̄ = ½(Mₙ + Mₙ₊₁)` of the
+    /// element's own resultants ([`Self::resultants`]), every rotation
+    /// piece of the two poses computed once.
+    pub fn energy_momentum_force<T: Scalar>(
+        &self,
+        start: &Pose<T>,
+        end: &Pose<T>,
+    ) -> SVector<T, 12> {
+        let (s, e) = (self.frames(start), self.frames(end));
+        let (nbar, mbar) = self.averaged_resultants(&s, &e);
+        step_force(&dg_step_of(&s, &e), &nbar, &mbar).0
+    }
+
+    /// The step averages `(N̄, M̄)` of the resultants of two poses.
+    pub(crate) fn averaged_resultants<T: Scalar>(
+        &self,
+        s: &Frames<T>,
+        e: &Frames<T>,
+    ) -> (Vector3<T>, Vector3<T>) {
+        let half = cst::<T>(0.5);
+        let ((n0, m0), (n1, m1)) = (self.frame_resultants(s), self.frame_resultants(e));
+        ((n0 + n1) * half, (m0 + m1) * half)
+    }
+}
+
+/// The discrete gradient force of a [`Step`] for the resultants
+/// `(nbar, mbar)` and, separately, its rank-one corrections' part.
+pub(crate) fn step_force<T: Scalar>(
+    st: &Step<T>,
+    nbar: &Vector3<T>,
+    mbar: &Vector3<T>,
+) -> (SVector<T, 12>, SVector<T, 12>) {
+    let half = cst::<T>(0.5);
+    let n = st.lam_bar * nbar;
+    let c = st.dbar.cross(&n);
+    // Moments of the smooth operators B, T.
+    let arm = c * (-half);
+    let bc = st.b.transpose() * c;
+    let tm = st.t.transpose() * mbar;
+    let mut q = SVector::<T, 12>::zeros();
+    q.fixed_rows_mut::<3>(0).copy_from(&(-n));
+    q.fixed_rows_mut::<3>(3).copy_from(&(arm + bc - tm));
+    q.fixed_rows_mut::<3>(6).copy_from(&n);
+    q.fixed_rows_mut::<3>(9).copy_from(&(arm - bc + tm));
+    // (v ⊗ w)ᵀ x = w (v·x), w = Δθ/(|Δθ|² + ε²).
+    let extra = st.direction * (mbar.dot(&st.t_miss) - c.dot(&st.b_miss));
+    let mut corr = SVector::<T, 12>::zeros();
+    corr.fixed_rows_mut::<3>(3).copy_from(&(-extra));
+    corr.fixed_rows_mut::<3>(9).copy_from(&extra);
+    q += corr;
+    (q, corr)
 }
 
 #[cfg(test)]

@@ -255,9 +255,25 @@ pub fn cayley<T: Scalar>(theta: &Vector3<T>) -> Matrix3<T> {
     Matrix3::identity() + (skew(theta) + skew_squared(theta) * cst::<T>(0.5)) * f
 }
 
+/// Below this `1 + tr Λ` (rotations beyond 120°) [`cayley_inverse`] goes
+/// through the quaternion, whose largest component is then not `w`.
+const CAYLEY_DIRECT: f64 = 1.0;
+
 /// Inverse Cayley transform: the tangent-scaled vector `θ` with `cay(θ) = Λ`
-/// (`θ = 2v/w` from the quaternion; undefined for half turns).
+/// (undefined for half turns). From `cay(θ) = I + f(θ̂ + ½θ̂²)`,
+/// `f = 4/(4 + |θ|²) = ¼(1 + tr Λ)`: `θ = 2 vee(Λ − Λᵀ)/(1 + tr Λ)` directly
+/// (one division, no square root) while `1 + tr Λ ≥ 1`; beyond that,
+/// `θ = 2v/w` from the quaternion (Shepperd), accurate towards half turns.
 pub fn cayley_inverse<T: Scalar>(r: &Matrix3<T>) -> Vector3<T> {
+    let tr1 = T::one() + r[(0, 0)] + r[(1, 1)] + r[(2, 2)];
+    if tr1.value() >= CAYLEY_DIRECT {
+        let f = cst::<T>(2.0) / tr1;
+        return Vector3::new(
+            (r[(2, 1)] - r[(1, 2)]) * f,
+            (r[(0, 2)] - r[(2, 0)]) * f,
+            (r[(1, 0)] - r[(0, 1)]) * f,
+        );
+    }
     let q = quaternion_from_matrix(r);
     Vector3::new(q.y, q.z, q.w) * (cst::<T>(2.0) / q.x)
 }

@@ -100,6 +100,27 @@ proptest! {
     }
 
     #[test]
+    fn cayley_inverse_agrees_with_the_quaternion_route_and_its_derivative(
+        psi in rotation_vector(),
+        dir in (0.0..std::f64::consts::PI, 0.0..(2.0 * std::f64::consts::PI)),
+    ) {
+        // The direct formula (1 + tr Λ ≥ 1) and the quaternion (beyond) give
+        // θ = tan(|ψ|/2)/(|ψ|/2)·ψ; and, along a spatial spin, the same
+        // derivative as θ = 2v/w of the quaternion, on both sides of the switch.
+        prop_assume!(psi.norm() < 3.0);
+        let r = exp(&psi);
+        let th = tan_scaled(&psi);
+        prop_assert!((cayley_inverse(&r) - th).norm() <= 1e-13 * (1.0 + th.norm_squared()));
+        let w = unit(dir.0, dir.1).map(|d| Dual64::new(0.0, d));
+        let rd = exp(&w) * r.map(Dual64::from);
+        let q = quaternion_from_matrix(&rd);
+        let by_quaternion = Vector3::new(q.y, q.z, q.w) * (Dual64::from(2.0) / q.x);
+        let direct = cayley_inverse(&rd);
+        let (a, b) = (direct.map(|x| x.eps), by_quaternion.map(|x| x.eps));
+        prop_assert!((a - b).norm() <= 1e-12 * (1.0 + b.norm()));
+    }
+
+    #[test]
     fn cayley_is_exp_of_the_untangent_vector(theta in small_vector()) {
         // cay(θ) = exp(ω̂) iff θ = tan(|ω|/2)/(|ω|/2)·ω (check)
         let omega = untan_scaled(&theta);

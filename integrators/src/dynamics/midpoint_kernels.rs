@@ -115,12 +115,7 @@ pub(crate) fn element_kernel(
         Scheme::EnergyMomentum if exact => {
             e.energy_momentum_force_tangent(&pose(start), &pose(end))
         }
-        Scheme::EnergyMomentum => {
-            let (s, t) = (pose(start), pose(end));
-            let (nbar, mbar) = averaged_resultants(e, &s, &t);
-            let q = e.discrete_gradient_force(&s, &t, &nbar, &mbar);
-            (q, e.momentum_force_tangent(&s, &t).1)
-        }
+        Scheme::EnergyMomentum => e.energy_momentum_force_cheap_tangent(&pose(start), &pose(end)),
         Scheme::EnergyMomentumPaper => {
             type D = Dual12;
             let (s, sd, ed) = seeded_poses(e, start, end);
@@ -155,11 +150,11 @@ pub(crate) fn element_force(
     let q = match (el, scheme) {
         (Element::Linear(e), Scheme::Momentum | Scheme::EnergyMomentum) => {
             let (s, t) = (pose_of(e, start), pose_of(e, end));
-            let (nbar, mbar) = averaged_resultants(e, &s, &t);
             if scheme == Scheme::Momentum {
+                let (nbar, mbar) = averaged_resultants(e, &s, &t);
                 e.midpoint_force(&s, &t, &nbar, &mbar, MidRotation::Geodesic)
             } else {
-                e.discrete_gradient_force(&s, &t, &nbar, &mbar)
+                e.energy_momentum_force(&s, &t)
             }
         }
         (Element::Quadratic(e), _) => {
