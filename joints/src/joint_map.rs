@@ -2,6 +2,26 @@
 //! blanket-implemented for every [`JointKinematics`] by automatic
 //! differentiation — the variation map `N`, its transfer of slave residuals
 //! and the incremental map `Ñ` of a step.
+//!
+//! `N` and the transfer's derivative are closed form in the master's
+//! increments, with AD over the released coordinates only. With the slave
+//! `x_s = x_m + R_m r_R`, `R_s = R_m Λ_R`, `y = R_m r_R`, and the released
+//! placement's derivatives `u = ∂r_R/∂a`, `v = ∂r_R/∂b` (increments applied
+//! last and first) and spin `s` (`δΛ_R Λ_Rᵀ = (s δa)^`):
+//!
+//! ```text
+//! N = [ I  −ŷ  R_m u ]        Nᵀg = ( g_x,  ŷ g_x + g_φ,  uᵀR_mᵀg_x + sᵀR_mᵀg_φ )
+//!     [ 0   I  R_m s ]
+//! ∂(Nᵀg)/∂(x, φ, q) = [ 0  0                            0           ]
+//!                     [ 0  ĝ_x ŷ                        −ĝ_x R_m v  ]
+//!                     [ 0  uᵀR_mᵀĝ_x + sᵀR_mᵀĝ_φ        ∂²w/∂a∂b    ]
+//! ```
+//!
+//! with `w(a, b) = G_x·(r_R(a, b) − r_R(0, b)) + G_φ·spin(Λ_R(a, b)Λ_R(0, b)ᵀ)`,
+//! `G = R_mᵀg`, by hyper-dual AD over the (at most four) released lanes
+//! instead of all ten local ones. [`JointMap::variation_ad`] and
+//! [`JointMap::transfer_ad`] keep the full AD as the oracle the tests compare
+//! with.
 
 use crate::incremental::{JointStep, NodePose};
 use crate::kinematics::{
@@ -43,6 +63,23 @@ pub trait JointMap: Send + Sync + Debug {
     /// part of the reduced tangent, paper §2: "the linearisation must include
     /// the derivative of N").
     fn transfer(
+        &self,
+        x_m: &Vector3<f64>,
+        r_m: &Matrix3<f64>,
+        state: &ReleasedState,
+        g: &Vector6<f64>,
+    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>);
+    /// [`Self::variation`] by forward-mode AD over every local coordinate
+    /// (the oracle the closed form is tested against).
+    fn variation_ad(
+        &self,
+        x_m: &Vector3<f64>,
+        r_m: &Matrix3<f64>,
+        state: &ReleasedState,
+    ) -> SMatrix<f64, 6, LOCAL>;
+    /// [`Self::transfer`] by hyper-dual AD over every pair of local
+    /// coordinates (the oracle the closed form is tested against).
+    fn transfer_ad(
         &self,
         x_m: &Vector3<f64>,
         r_m: &Matrix3<f64>,
@@ -123,6 +160,102 @@ fn slave_increment<J: JointKinematics, T: Scalar>(
     (x1 - x0, spin)
 }
 
+/// The released placement `(r_R, Λ_R)` at a state and its first
+/// derivatives in the released increments: `u = ∂r_R/∂a` (increment applied
+/// last), `v = ∂r_R/∂b` (applied first) and the spin Jacobian `s`,
+/// `δΛ_R Λ_Rᵀ = (s δa)^` — by forward AD over the released lanes only
+/// (columns past the kind's count are zero).
+struct ReleasedDerivatives {
+    r: Vector3<f64>,
+    u: SMatrix<f64, 3, MAX_RELEASED>,
+    v: SMatrix<f64, 3, MAX_RELEASED>,
+    s: SMatrix<f64, 3, MAX_RELEASED>,
+}
+
+impl ReleasedDerivatives {
+    fn of<J: JointKinematics>(joint: &J, state: &ReleasedState) -> Self {
+        type D = DualSVec64<{ 2 * MAX_RELEASED }>;
+        let a: [D; MAX_RELEASED] = std::array::from_fn(|i| D::from_re(0.0).derivative(i));
+        let b: [D; MAX_RELEASED] =
+            std::array::from_fn(|i| D::from_re(0.0).derivative(MAX_RELEASED + i));
+        let (rr, lr) = joint.released_at_state(
+            state,
+            Increments {
+                first: &a,
+                second: &b,
+            },
+        );
+        let lanes = |x: &D| x.eps.unwrap_generic(Const::<{ 2 * MAX_RELEASED }>, U1);
+        let lr0 = lr.map(|x| x.re);
+        let mut d = Self {
+            r: rr.map(|x| x.re),
+            u: SMatrix::zeros(),
+            v: SMatrix::zeros(),
+            s: SMatrix::zeros(),
+        };
+        for k in 0..released_count::<J>() {
+            let dl = lr.map(|x| lanes(&x)[k]) * lr0.transpose();
+            d.s.set_column(
+                k,
+                &Vector3::new(
+                    0.5 * (dl[(2, 1)] - dl[(1, 2)]),
+                    0.5 * (dl[(0, 2)] - dl[(2, 0)]),
+                    0.5 * (dl[(1, 0)] - dl[(0, 1)]),
+                ),
+            );
+            d.u.set_column(k, &rr.map(|x| lanes(&x)[k]));
+            d.v.set_column(k, &rr.map(|x| lanes(&x)[MAX_RELEASED + k]));
+        }
+        d
+    }
+}
+
+/// The released block of the transfer in the master's frame: with
+/// `G_x = R_mᵀ g_x`, `G_φ = R_mᵀ g_φ` and
+/// `w(a, b) = G_x·(r_R(a, b) − r_R(0, b)) + G_φ·spin(Λ_R(a, b) Λ_R(0, b)ᵀ)`,
+/// `(∂w/∂a, ∂²w/∂a∂b)` at zero — hyper-dual AD over the released lanes only.
+fn released_transfer<J: JointKinematics>(
+    joint: &J,
+    state: &ReleasedState,
+    gx: &Vector3<f64>,
+    gp: &Vector3<f64>,
+) -> (
+    SVector<f64, MAX_RELEASED>,
+    SMatrix<f64, MAX_RELEASED, MAX_RELEASED>,
+) {
+    type H = HyperDualSVec64<MAX_RELEASED, MAX_RELEASED>;
+    let a: [H; MAX_RELEASED] = std::array::from_fn(|i| H::from_re(0.0).derivative1(i));
+    let b: [H; MAX_RELEASED] = std::array::from_fn(|i| H::from_re(0.0).derivative2(i));
+    let zero = [H::from_re(0.0); MAX_RELEASED];
+    let (r1, l1) = joint.released_at_state(
+        state,
+        Increments {
+            first: &a,
+            second: &b,
+        },
+    );
+    let (r0, l0) = joint.released_at_state(
+        state,
+        Increments {
+            first: &zero,
+            second: &b,
+        },
+    );
+    let m = l1 * l0.transpose();
+    let half = H::from_re(0.5);
+    let spin = Vector3::new(
+        (m[(2, 1)] - m[(1, 2)]) * half,
+        (m[(0, 2)] - m[(2, 0)]) * half,
+        (m[(1, 0)] - m[(0, 1)]) * half,
+    );
+    let w = (r1 - r0).dot(&gx.map(H::from_re)) + spin.dot(&gp.map(H::from_re));
+    (
+        w.eps1.unwrap_generic(Const::<MAX_RELEASED>, U1),
+        w.eps1eps2
+            .unwrap_generic(Const::<MAX_RELEASED>, Const::<MAX_RELEASED>),
+    )
+}
+
 impl<J: JointKinematics> JointMap for J {
     fn released_count(&self) -> usize {
         released_count::<J>()
@@ -159,6 +292,66 @@ impl<J: JointKinematics> JointMap for J {
         r_m: &Matrix3<f64>,
         state: &ReleasedState,
     ) -> SMatrix<f64, 6, LOCAL> {
+        let _ = x_m;
+        let d = ReleasedDerivatives::of(self, state);
+        let y = r_m * d.r;
+        let mut n = SMatrix::<f64, 6, LOCAL>::zeros();
+        n.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
+        n.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&(-y.cross_matrix()));
+        n.fixed_view_mut::<3, 3>(3, 3).fill_with_identity();
+        n.fixed_view_mut::<3, MAX_RELEASED>(0, 6)
+            .copy_from(&(r_m * d.u));
+        n.fixed_view_mut::<3, MAX_RELEASED>(3, 6)
+            .copy_from(&(r_m * d.s));
+        n
+    }
+
+    fn transfer(
+        &self,
+        x_m: &Vector3<f64>,
+        r_m: &Matrix3<f64>,
+        state: &ReleasedState,
+        g: &Vector6<f64>,
+    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>) {
+        let _ = x_m;
+        let (gx, gp) = (
+            g.fixed_rows::<3>(0).into_owned(),
+            g.fixed_rows::<3>(3).into_owned(),
+        );
+        let (gx_m, gp_m) = (r_m.transpose() * gx, r_m.transpose() * gp);
+        let d = ReleasedDerivatives::of(self, state);
+        let (ntg_q, k_qq) = released_transfer(self, state, &gx_m, &gp_m);
+        let y = r_m * d.r;
+        let (gxh, gph) = (gx.cross_matrix(), gp.cross_matrix());
+        let mut ntg = SVector::<f64, LOCAL>::zeros();
+        ntg.fixed_rows_mut::<3>(0).copy_from(&gx);
+        ntg.fixed_rows_mut::<3>(3).copy_from(&(y.cross(&gx) + gp));
+        ntg.fixed_rows_mut::<MAX_RELEASED>(6).copy_from(&ntg_q);
+        let mut k = SMatrix::<f64, LOCAL, LOCAL>::zeros();
+        k.fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&(gxh * y.cross_matrix()));
+        k.fixed_view_mut::<3, MAX_RELEASED>(3, 6)
+            .copy_from(&(-gxh * r_m * d.v));
+        k.fixed_view_mut::<MAX_RELEASED, 3>(6, 3).copy_from(
+            &(d.u.transpose() * r_m.transpose() * gxh + d.s.transpose() * r_m.transpose() * gph),
+        );
+        k.fixed_view_mut::<MAX_RELEASED, MAX_RELEASED>(6, 6)
+            .copy_from(&k_qq);
+        for c in 6 + released_count::<J>()..LOCAL {
+            ntg[c] = 0.0;
+            k.row_mut(c).fill(0.0);
+            k.column_mut(c).fill(0.0);
+        }
+        (ntg, k)
+    }
+
+    fn variation_ad(
+        &self,
+        x_m: &Vector3<f64>,
+        r_m: &Matrix3<f64>,
+        state: &ReleasedState,
+    ) -> SMatrix<f64, 6, LOCAL> {
         type D = DualSVec64<LOCAL>;
         let e: [D; LOCAL] = std::array::from_fn(|i| D::from_re(0.0).derivative(i));
         let h = [D::from_re(0.0); LOCAL];
@@ -177,7 +370,7 @@ impl<J: JointKinematics> JointMap for J {
         n
     }
 
-    fn transfer(
+    fn transfer_ad(
         &self,
         x_m: &Vector3<f64>,
         r_m: &Matrix3<f64>,

@@ -761,6 +761,36 @@ fn transfer_is_nt_g_and_its_derivative() {
     );
 }
 
+#[test]
+fn n_and_transfer_equal_their_ad_oracles() {
+    property(
+        "3b. N and the transfer (N^T g, d(N^T g)) vs AD over every local coordinate (rel. |N|, |N||g|, max(|K|,|g|))",
+        CASES,
+        (params(), pose(), released(), vec3(-1.0, 1.0), vec3(-1.0, 1.0)),
+        |(p, m, q, gf, gm), w| {
+            let gv = Vector6::new(gf.x, gf.y, gf.z, gm.x, gm.y, gm.z);
+            for kind in all_kinds(&p, &q) {
+                let n = kind.map.variation(&m.x, &m.r, &kind.state);
+                let na = kind.map.variation_ad(&m.x, &m.r, &kind.state);
+                w.check(&format!("{}: N", kind.name), (n - na).norm() / na.norm(), 1e-13)?;
+                let (ntg, k) = kind.map.transfer(&m.x, &m.r, &kind.state, &gv);
+                let (ntga, ka) = kind.map.transfer_ad(&m.x, &m.r, &kind.state, &gv);
+                w.check(
+                    &format!("{}: N^T g", kind.name),
+                    (ntg - ntga).norm() / (na.norm() * gv.norm()),
+                    1e-13,
+                )?;
+                w.check(
+                    &format!("{}: d(N^T g)", kind.name),
+                    (k - ka).norm() / ka.norm().max(gv.norm()),
+                    1e-12,
+                )?;
+            }
+            Ok(())
+        },
+    );
+}
+
 // ---------------------------------------------------------------------------
 // 4–6: f′, the secant G and the incremental map Ñ of the dependent joints.
 // ---------------------------------------------------------------------------
