@@ -4,10 +4,10 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use rayon::prelude::*;
 
 use super::charts::summary_charts;
 use super::figures::{read_figures, RunFigures};
+use super::schedule::{estimated_cost, longest_first, run_queue};
 use super::shard::Shard;
 use super::spec::StudySpec;
 use super::summary::{self, Summary};
@@ -124,14 +124,14 @@ pub fn run_study(spec: &StudySpec, options: &StudyOptions) -> Result<StudyReport
         Some(s) => format!("{} (shard {s})", spec.name),
         None => spec.name.clone(),
     });
-    let outcomes: Vec<Result<RunFigures, StudyError>> = selected
-        .par_iter()
-        .map(|(plan, model)| {
-            let outcome = run_one(spec, &runs_dir, plan, model);
-            bar.inc(1);
-            outcome
-        })
-        .collect();
+    // Longest first, one run at a time per free thread (see `schedule`).
+    let costs: Vec<f64> = selected.iter().map(|(_, m)| estimated_cost(m)).collect();
+    let outcomes: Vec<Result<RunFigures, StudyError>> = run_queue(&longest_first(&costs), |i| {
+        let (plan, model) = selected[i];
+        let outcome = run_one(spec, &runs_dir, plan, model);
+        bar.inc(1);
+        outcome
+    });
     bar.finish_and_clear();
 
     let cols = summary::columns(spec);

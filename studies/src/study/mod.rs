@@ -43,7 +43,8 @@
 //!
 //! Runs are numbered in grid order, the last key varying fastest: `run-0000`,
 //! `run-0001`, … (more digits past 10 000 runs). They execute in parallel
-//! (rayon), and each writes `<out>/<name>/runs/<run id>.h5` in the layout of
+//! (rayon), handed to the threads one at a time, the longest (by an estimate:
+//! nodes × steps × the scheme's relative step cost) first, and each writes `<out>/<name>/runs/<run id>.h5` in the layout of
 //! [`crate::results`]. A run whose solve fails still leaves its file with
 //! `status = "failed: …"` and is a failed row of the summary, not an error of
 //! the study (so is a run whose model cannot be built; it has no file and NaN
@@ -98,6 +99,7 @@ pub mod execute;
 pub mod figures;
 pub mod key_path;
 pub mod merge;
+mod schedule;
 pub mod shard;
 pub mod source;
 pub mod spec;
