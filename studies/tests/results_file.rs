@@ -481,7 +481,8 @@ fn failed_run_keeps_its_steps_and_status() {
 fn dropped_writer_leaves_a_readable_running_file() {
     let _serial = serial();
     let path = tmp_path("dropped.h5");
-    let writer = write_steps(&path, 2);
+    let mut writer = write_steps(&path, 2);
+    writer.flush().expect("write the held steps");
     drop(writer);
 
     let file = hdf5::File::open(&path).expect("reopen");
@@ -504,7 +505,8 @@ fn child_appends_then_waits_to_be_killed() {
     let Some(path) = std::env::var_os(CHILD_ENV) else {
         return;
     };
-    let writer = write_steps(Path::new(&path), 2);
+    let mut writer = write_steps(Path::new(&path), 2);
+    writer.flush().expect("write the held steps");
     println!("{CHILD_READY}");
     std::thread::sleep(std::time::Duration::from_secs(120));
     drop(writer);
@@ -538,6 +540,29 @@ fn killed_process_leaves_the_flushed_steps() {
     let file = hdf5::File::open(&path).expect("reopen the file of the killed process");
     check_series(&file, 2);
     assert_eq!(str_attr(&file, "status"), "running");
+}
+
+#[test]
+fn steps_written_in_several_batches_make_the_same_file() {
+    // Appends are held and written in batches; writes at uneven points
+    // (one step, none, five, the rest at finish) must give every row and
+    // the Newton history's offsets across the batches.
+    let _serial = serial();
+    let path = tmp_path("batches.h5");
+    let mut writer = ResultWriter::create(&path, &meta()).expect("create the writer");
+    for k in 0..9 {
+        writer.append(&record(k)).expect("append a step");
+        if matches!(k, 0 | 5) {
+            writer.flush().expect("write the held steps");
+            writer.flush().expect("an empty write");
+        }
+    }
+    assert_eq!(writer.steps_written(), 9);
+    writer
+        .finish(layout::STATUS_COMPLETED, 1.0)
+        .expect("finish");
+    let file = hdf5::File::open(&path).expect("reopen");
+    check_series(&file, 9);
 }
 
 #[test]

@@ -2,10 +2,12 @@
 //! [`StepRecord`](flexmech_integrators::record::StepRecord)s.
 //!
 //! [`ResultWriter::create`] writes the root attributes and empty datasets,
-//! [`ResultWriter::append`] adds one row to every dataset per converged step
-//! and flushes the file, and [`ResultWriter::finish`] records the outcome. A
-//! run that fails part-way (or a process that dies) therefore still leaves a
-//! valid file holding every step appended so far.
+//! [`ResultWriter::append`] takes one converged step (one row of every
+//! dataset), and [`ResultWriter::finish`] writes the steps still held and
+//! records the outcome. Steps are written in batches — at least once a second
+//! of the run, each dataset extended once per batch, then the file flushed —
+//! so a run that fails part-way leaves a valid file holding every step, and a
+//! process that dies one holding every step up to its last write.
 //!
 //! # Layout
 //!

@@ -1,5 +1,5 @@
 //! `/restart`: the exact state of a dynamic run at its last stored step
-//! ([`Checkpoint`]), rewritten in place at every stored step, so that
+//! ([`Checkpoint`]), rewritten in place with each write of stored steps, so that
 //! `flexmech run MODEL --restart RESULT.h5` can continue it.
 //!
 //! | path | shape | content |

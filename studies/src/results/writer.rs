@@ -10,6 +10,14 @@ use hdf5::{Dataset, Extent, File, H5Type, Location};
 
 use super::layout as names;
 
+/// Appended steps are held in memory and written together (one resize and
+/// one write per dataset, then one flush of the file) when the oldest held
+/// step is this old...
+const WRITE_INTERVAL: std::time::Duration = std::time::Duration::from_secs(1);
+/// ... or the held steps reach this many values (32 MiB), whichever first;
+/// [`ResultWriter::flush`] and [`ResultWriter::finish`] write them at once.
+const HELD_VALUES: usize = 1 << 22;
+
 /// Rows per chunk of the time series (`T`, `T×3`, `T×4`).
 const SERIES_CHUNK_ROWS: usize = 256;
 /// Elements per chunk of the flat Newton residual history and its offsets.
@@ -300,38 +308,47 @@ impl Series {
             .ctx(path, || format!("writing row {start} of {}", self.name))
     }
 
-    /// Extends a 1-D series to `t + 1` rows and writes `value` at row `t`.
-    fn push_scalar<T: H5Type>(&self, t: usize, value: T, path: &Path) -> Result<(), ResultError> {
-        self.set_rows(t + 1, path)?;
-        self.write_values(t, &[value], path)
-    }
-
-    /// Extends a `T×N` series to `t + 1` rows and writes `row` at row `t`.
-    fn push_row<const N: usize>(
+    /// Extends a 1-D series to `t + values.len()` rows and writes `values`
+    /// from row `t`.
+    fn push_scalars<T: H5Type>(
         &self,
         t: usize,
-        row: [f64; N],
+        values: &[T],
         path: &Path,
     ) -> Result<(), ResultError> {
-        self.set_rows(t + 1, path)?;
-        let rows = [row];
-        self.ds
-            .write_slice::<_, f64, _, _>(&rows[..], (t..t + 1, ..))
-            .ctx(path, || format!("writing row {t} of {}", self.name))
+        self.set_rows(t + values.len(), path)?;
+        self.write_values(t, values, path)
     }
 
-    /// Extends a `T×n×N` series to `t + 1` rows and writes `block` (n rows of
-    /// N) at row `t`.
-    fn push_block<const N: usize>(
+    /// Extends a `T×N` series to `t + rows.len()` rows and writes `rows` from
+    /// row `t`.
+    fn push_rows<const N: usize>(
         &self,
         t: usize,
-        block: &[[f64; N]],
+        rows: &[[f64; N]],
         path: &Path,
     ) -> Result<(), ResultError> {
-        self.set_rows(t + 1, path)?;
+        self.set_rows(t + rows.len(), path)?;
         self.ds
-            .write_slice::<_, f64, _, _>(block, (t, .., ..))
-            .ctx(path, || format!("writing row {t} of {}", self.name))
+            .write_slice::<_, f64, _, _>(rows, (t..t + rows.len(), ..))
+            .ctx(path, || format!("writing rows {t}.. of {}", self.name))
+    }
+
+    /// Extends a `T×n×N` series by `blocks.len()` rows from row `t`, each
+    /// block `n` rows of `N`.
+    fn push_blocks<const N: usize>(
+        &self,
+        t: usize,
+        blocks: &[&[[f64; N]]],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        self.set_rows(t + blocks.len(), path)?;
+        for (k, block) in blocks.iter().enumerate() {
+            self.ds
+                .write_slice::<_, f64, _, _>(*block, (t + k, .., ..))
+                .ctx(path, || format!("writing row {} of {}", t + k, self.name))?;
+        }
+        Ok(())
     }
 }
 
@@ -442,10 +459,19 @@ pub struct ResultWriter {
     sets: Datasets,
     initial_positions: Vec<[f64; 3]>,
     resultants: Option<super::resultants::ResultantsMeta>,
+    /// Steps in the file.
     steps: usize,
     newton_len: usize,
     /// An append failed part-way: some datasets may hold an extra row.
     inconsistent: bool,
+    /// Appended steps not yet in the file, and their size in values.
+    held: Vec<StepRecord>,
+    held_values: usize,
+    /// The restart state at the last appended step, written after the
+    /// steps it belongs to.
+    held_checkpoint: Option<flexmech_integrators::dynamics::Checkpoint>,
+    /// When the file was last written.
+    last_write: std::time::Instant,
 }
 
 impl std::fmt::Debug for ResultWriter {
@@ -875,21 +901,29 @@ impl ResultWriter {
             steps: 0,
             newton_len: 0,
             inconsistent: false,
+            held: Vec::new(),
+            held_values: 0,
+            held_checkpoint: None,
+            last_write: std::time::Instant::now(),
         })
     }
 
-    /// Appends one step: extends every dataset by one row (the Newton history
-    /// by `residual_history.len()` entries), writes the step, and flushes the
-    /// file so that the step survives a crash of the process.
+    /// Appends one step. Steps are written in batches: held in memory and
+    /// written together (each dataset extended once, then the file flushed)
+    /// once the oldest held step is [`WRITE_INTERVAL`] old or the held steps
+    /// reach [`HELD_VALUES`] values, and by [`Self::flush`] and
+    /// [`Self::finish`]. A process that dies therefore leaves a valid file
+    /// holding every step up to the last write — at most about a second of
+    /// the run is lost — and its restart state at the last of them.
     ///
     /// A record whose `positions`, `quaternions`, `joints` or (dynamics)
     /// velocities length differs
     /// from the [`RunMeta`] is rejected with [`ResultError::RecordLength`]
-    /// before anything is written. If HDF5 fails part-way, the next `append`
-    /// rewrites the same row and `finish` trims the file back to the steps
-    /// written successfully.
+    /// before anything is held or written. If HDF5 fails part-way through a
+    /// write, the steps stay held (the next write rewrites the same rows) and
+    /// `finish` trims the file back to the steps written successfully.
     pub fn append(&mut self, step: &StepRecord) -> Result<(), ResultError> {
-        let t = self.steps;
+        let t = self.steps + self.held.len();
         let n_nodes = self.initial_positions.len();
         let lengths = [
             ("positions", n_nodes, step.positions.len()),
@@ -923,103 +957,195 @@ impl ResultWriter {
                 });
             }
         }
-        match self.write_step(t, step) {
-            Ok(()) => {
-                self.steps += 1;
-                self.newton_len += step.residual_history.len();
-                self.inconsistent = false;
-                Ok(())
-            }
-            Err(e) => {
-                self.inconsistent = true;
-                Err(e)
-            }
+        if !self.held.is_empty()
+            && (self.held_values >= HELD_VALUES || self.last_write.elapsed() >= WRITE_INTERVAL)
+        {
+            self.flush()?;
         }
+        self.held_values += record_values(step);
+        self.held.push(step.clone());
+        Ok(())
     }
 
-    fn write_step(&self, t: usize, step: &StepRecord) -> Result<(), ResultError> {
+    /// Writes the held steps and the restart state, and flushes the file:
+    /// after it, the file holds every step appended so far.
+    pub fn flush(&mut self) -> Result<(), ResultError> {
+        if !self.held.is_empty() {
+            match self.write_steps(self.steps, &self.held) {
+                Ok(()) => {
+                    self.steps += self.held.len();
+                    self.newton_len += self
+                        .held
+                        .iter()
+                        .map(|r| r.residual_history.len())
+                        .sum::<usize>();
+                    self.inconsistent = false;
+                    self.held.clear();
+                    self.held_values = 0;
+                }
+                Err(e) => {
+                    self.inconsistent = true;
+                    return Err(e);
+                }
+            }
+        }
+        if let Some(checkpoint) = self.held_checkpoint.take() {
+            super::restart::write(&self.file, &checkpoint, &self.initial_positions)
+                .ctx(&self.path, || {
+                    "writing the restart state /restart".to_owned()
+                })?;
+        }
+        self.last_write = std::time::Instant::now();
+        self.file.flush().ctx(&self.path, || {
+            format!("flushing after step {}", self.steps.saturating_sub(1))
+        })
+    }
+
+    /// Writes `recs` as rows `t0..t0 + recs.len()` of every dataset.
+    fn write_steps(&self, t0: usize, recs: &[StepRecord]) -> Result<(), ResultError> {
         let path = self.path.as_path();
         let s = &self.sets;
-        s.time.push_scalar(t, step.time, path)?;
-        s.kinetic.push_scalar(t, step.energy.kinetic, path)?;
-        s.strain.push_scalar(t, step.energy.strain, path)?;
-        s.potential.push_scalar(t, step.energy.potential, path)?;
-        s.total.push_scalar(t, step.energy.total, path)?;
+        let scalars = |f: fn(&StepRecord) -> f64| recs.iter().map(f).collect::<Vec<f64>>();
+        let counts =
+            |f: fn(&StepRecord) -> usize| recs.iter().map(|r| f(r) as u64).collect::<Vec<u64>>();
+        s.time.push_scalars(t0, &scalars(|r| r.time), path)?;
+        s.kinetic
+            .push_scalars(t0, &scalars(|r| r.energy.kinetic), path)?;
+        s.strain
+            .push_scalars(t0, &scalars(|r| r.energy.strain), path)?;
+        s.potential
+            .push_scalars(t0, &scalars(|r| r.energy.potential), path)?;
+        s.total
+            .push_scalars(t0, &scalars(|r| r.energy.total), path)?;
         s.driver_work
-            .push_scalar(t, step.energy.driver_work, path)?;
-        s.dissipated.push_scalar(t, step.energy.dissipated, path)?;
-        s.momentum_linear.push_row(t, step.momentum_linear, path)?;
+            .push_scalars(t0, &scalars(|r| r.energy.driver_work), path)?;
+        s.dissipated
+            .push_scalars(t0, &scalars(|r| r.energy.dissipated), path)?;
+        let rows = |f: fn(&StepRecord) -> [f64; 3]| recs.iter().map(f).collect::<Vec<_>>();
+        s.momentum_linear
+            .push_rows(t0, &rows(|r| r.momentum_linear), path)?;
         s.momentum_angular
-            .push_row(t, step.momentum_angular, path)?;
-        s.iterations.push_scalar(t, step.iterations as u64, path)?;
+            .push_rows(t0, &rows(|r| r.momentum_angular), path)?;
+        s.iterations
+            .push_scalars(t0, &counts(|r| r.iterations), path)?;
         s.factorizations
-            .push_scalar(t, step.factorizations as u64, path)?;
-        s.dt.push_scalar(t, step.dt, path)?;
-        s.residual.push_scalar(t, step.residual, path)?;
-        s.beta.push_scalar(t, step.beta, path)?;
+            .push_scalars(t0, &counts(|r| r.factorizations), path)?;
+        s.dt.push_scalars(t0, &scalars(|r| r.dt), path)?;
+        s.residual
+            .push_scalars(t0, &scalars(|r| r.residual), path)?;
+        s.beta.push_scalars(t0, &scalars(|r| r.beta), path)?;
         if let Some(set) = &s.negative_pivots {
-            let count = step.negative_pivots.map_or(-1, |n| n as i64);
-            set.push_scalar(t, count, path)?;
+            let counts: Vec<i64> = recs
+                .iter()
+                .map(|r| r.negative_pivots.map_or(-1, |n| n as i64))
+                .collect();
+            set.push_scalars(t0, &counts, path)?;
         }
 
-        let history = &step.residual_history;
-        let end = self.newton_len + history.len();
+        let history: Vec<f64> = recs
+            .iter()
+            .flat_map(|r| r.residual_history.iter().copied())
+            .collect();
+        let mut end = self.newton_len;
+        let offsets: Vec<u64> = recs
+            .iter()
+            .map(|r| {
+                end += r.residual_history.len();
+                end as u64
+            })
+            .collect();
         s.newton_residuals.set_rows(end, path)?;
         s.newton_residuals
-            .write_values(self.newton_len, history, path)?;
-        s.newton_offsets.set_rows(t + 2, path)?;
-        s.newton_offsets.write_values(t + 1, &[end as u64], path)?;
+            .write_values(self.newton_len, &history, path)?;
+        s.newton_offsets.set_rows(t0 + recs.len() + 1, path)?;
+        s.newton_offsets.write_values(t0 + 1, &offsets, path)?;
 
         for node in &s.nodes {
-            let p = step.positions[node.index];
             let p0 = self.initial_positions[node.index];
-            node.position.push_row(t, p, path)?;
-            node.displacement
-                .push_row(t, [p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]], path)?;
-            node.rotation
-                .push_row(t, rotation_vector(step.quaternions[node.index]), path)?;
+            let p: Vec<[f64; 3]> = recs.iter().map(|r| r.positions[node.index]).collect();
+            let u: Vec<[f64; 3]> = p
+                .iter()
+                .map(|p| [p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]])
+                .collect();
+            let rot: Vec<[f64; 3]> = recs
+                .iter()
+                .map(|r| rotation_vector(r.quaternions[node.index]))
+                .collect();
+            node.position.push_rows(t0, &p, path)?;
+            node.displacement.push_rows(t0, &u, path)?;
+            node.rotation.push_rows(t0, &rot, path)?;
         }
-        for (joint, record) in s.joints.iter().zip(&step.joints) {
+        for (j, joint) in s.joints.iter().enumerate() {
+            let of = |r: &StepRecord| r.joints[j];
             if let Some(angle) = &joint.angle {
-                angle.push_scalar(t, record.angle, path)?;
+                let a: Vec<f64> = recs.iter().map(|r| of(r).angle).collect();
+                angle.push_scalars(t0, &a, path)?;
             }
-            joint
-                .released_translation
-                .push_row(t, record.released_translation, path)?;
-            joint
-                .constraint_error
-                .push_scalar(t, record.constraint_error, path)?;
-            let r = record.reaction;
-            joint.reaction_force.push_row(t, [r[0], r[1], r[2]], path)?;
-            joint
-                .reaction_moment
-                .push_row(t, [r[3], r[4], r[5]], path)?;
+            let released: Vec<[f64; 3]> = recs.iter().map(|r| of(r).released_translation).collect();
+            joint.released_translation.push_rows(t0, &released, path)?;
+            let error: Vec<f64> = recs.iter().map(|r| of(r).constraint_error).collect();
+            joint.constraint_error.push_scalars(t0, &error, path)?;
+            let force: Vec<[f64; 3]> = recs
+                .iter()
+                .map(|r| {
+                    let f = of(r).reaction;
+                    [f[0], f[1], f[2]]
+                })
+                .collect();
+            let moment: Vec<[f64; 3]> = recs
+                .iter()
+                .map(|r| {
+                    let f = of(r).reaction;
+                    [f[3], f[4], f[5]]
+                })
+                .collect();
+            joint.reaction_force.push_rows(t0, &force, path)?;
+            joint.reaction_moment.push_rows(t0, &moment, path)?;
         }
-        for ([force, moment], r) in s.supports.iter().zip(&step.support_reactions) {
-            force.push_row(t, [r[0], r[1], r[2]], path)?;
-            moment.push_row(t, [r[3], r[4], r[5]], path)?;
+        for (k, [force, moment]) in s.supports.iter().enumerate() {
+            let f: Vec<[f64; 3]> = recs
+                .iter()
+                .map(|r| {
+                    let v = r.support_reactions[k];
+                    [v[0], v[1], v[2]]
+                })
+                .collect();
+            let m: Vec<[f64; 3]> = recs
+                .iter()
+                .map(|r| {
+                    let v = r.support_reactions[k];
+                    [v[3], v[4], v[5]]
+                })
+                .collect();
+            force.push_rows(t0, &f, path)?;
+            moment.push_rows(t0, &m, path)?;
         }
-        s.config_position.push_block(t, &step.positions, path)?;
-        s.config_quaternion.push_block(t, &step.quaternions, path)?;
+        let blocks3 = |f: fn(&StepRecord) -> &[[f64; 3]]| recs.iter().map(f).collect::<Vec<_>>();
+        s.config_position
+            .push_blocks(t0, &blocks3(|r| &r.positions), path)?;
+        let quaternions: Vec<&[[f64; 4]]> = recs.iter().map(|r| &r.quaternions[..]).collect();
+        s.config_quaternion.push_blocks(t0, &quaternions, path)?;
         if let Some([v, w]) = &s.config_velocity {
-            v.push_block(t, &step.velocities, path)?;
-            w.push_block(t, &step.angular_velocities, path)?;
+            v.push_blocks(t0, &blocks3(|r| &r.velocities), path)?;
+            w.push_blocks(t0, &blocks3(|r| &r.angular_velocities), path)?;
         }
         if let (Some([n, m]), Some(meta)) = (&s.resultants, &self.resultants) {
-            let (force, moment) = meta.of(step);
-            n.push_block(t, &force, path)?;
-            m.push_block(t, &moment, path)?;
+            let (force, moment): (Vec<_>, Vec<_>) = recs.iter().map(|r| meta.of(r)).unzip();
+            let force: Vec<&[[f64; 3]]> = force.iter().map(Vec::as_slice).collect();
+            let moment: Vec<&[[f64; 3]]> = moment.iter().map(Vec::as_slice).collect();
+            n.push_blocks(t0, &force, path)?;
+            m.push_blocks(t0, &moment, path)?;
         }
-
-        self.file
-            .flush()
-            .ctx(path, || format!("flushing after step {t}"))
+        Ok(())
     }
 
     /// Sets the root attributes `status` (`"completed"` or `"failed:
     /// <reason>"`, see [`layout::failed_status`](super::layout::failed_status))
     /// and `wall_time_s`, and closes the file. Returns its path.
-    pub fn finish(self, status: &str, wall_time_s: f64) -> Result<PathBuf, ResultError> {
+    pub fn finish(mut self, status: &str, wall_time_s: f64) -> Result<PathBuf, ResultError> {
+        // A write that fails here leaves the file trimmed to the steps
+        // written before, with this status, and the error returned.
+        let flushed = self.flush();
         let Self {
             path,
             file,
@@ -1050,6 +1176,7 @@ impl ResultWriter {
             })?;
         drop(sets);
         file.close().ctx(&path, || "closing the file".to_owned())?;
+        flushed?;
         // The result is complete: release the lock and remove its file.
         if let Some((handle, lock_path)) = lock {
             drop(handle);
@@ -1081,16 +1208,18 @@ impl ResultWriter {
         Ok(())
     }
 
-    /// Rewrites `/restart` with the run's state at the step appended last
-    /// (see [`super::restart`]).
+    /// Sets the run's state at the step appended last as the restart state
+    /// `/restart` (see [`super::restart`]), written with that step.
     pub fn checkpoint(
         &mut self,
         checkpoint: &flexmech_integrators::dynamics::Checkpoint,
     ) -> Result<(), ResultError> {
-        super::restart::write(&self.file, checkpoint, &self.initial_positions)
-            .ctx(&self.path, || {
-                "writing the restart state /restart".to_owned()
-            })
+        self.held_checkpoint = Some(checkpoint.clone());
+        if self.held.is_empty() {
+            // Its step is in the file already.
+            return self.flush();
+        }
+        Ok(())
     }
 
     /// Sets the root attributes `restarted_from` (the result file this run
@@ -1114,15 +1243,26 @@ impl ResultWriter {
             })
     }
 
-    /// Number of steps appended successfully (`T`).
+    /// Number of steps appended (`T` once they are written; see
+    /// [`Self::append`]).
     pub fn steps_written(&self) -> usize {
-        self.steps
+        self.steps + self.held.len()
     }
 
     /// Path of the file being written.
     pub fn path(&self) -> &Path {
         &self.path
     }
+}
+
+/// Values a record holds, for the bound on held steps ([`HELD_VALUES`]).
+fn record_values(r: &StepRecord) -> usize {
+    32 + r.residual_history.len()
+        + 3 * r.positions.len()
+        + 4 * r.quaternions.len()
+        + 3 * (r.velocities.len() + r.angular_velocities.len())
+        + 6 * r.support_reactions.len()
+        + 11 * r.joints.len()
 }
 
 /// Takes the exclusive lock `<result>.lock` (an advisory lock the system
