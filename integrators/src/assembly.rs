@@ -13,6 +13,8 @@ use flexmech_core::{Configuration, Element, Mesh};
 use nalgebra::{DMatrix, DVector, Matrix3};
 use rayon::prelude::*;
 
+use crate::threads::sequential;
+
 struct Slots {
     /// Sorted, unique global equations the element touches.
     eqs: Vec<usize>,
@@ -224,7 +226,7 @@ impl Assembler {
         };
         // One thread asked for, or already on a worker (the runs of a study
         // are the parallel work): no hand-off at all.
-        if sequential() {
+        if sequential(mesh.elements.len()) {
             self.work
                 .iter_mut()
                 .zip(mesh.elements.iter().enumerate())
@@ -272,7 +274,7 @@ impl Assembler {
         F: Fn(&Element, &mut [f64]) + Sync,
     {
         let element = |(w, el): (&mut Work, &Element)| kernel(el, w.r.as_mut_slice());
-        if sequential() {
+        if sequential(mesh.elements.len()) {
             self.work.iter_mut().zip(&mesh.elements).for_each(element);
         } else {
             self.work
@@ -381,12 +383,4 @@ impl Assembler {
             .expect("entry in the sparsity pattern");
         self.values[cp[col] + p] += v;
     }
-}
-
-/// Whether assembly runs on the calling thread: when one thread is asked
-/// for (`RAYON_NUM_THREADS=1`), or when the caller is itself a rayon worker
-/// (a study's runs in parallel), where splitting each element loop again only
-/// adds hand-offs between the same threads.
-fn sequential() -> bool {
-    rayon::current_num_threads() == 1 || rayon::current_thread_index().is_some()
 }

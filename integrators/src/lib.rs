@@ -23,6 +23,7 @@ pub mod stability;
 pub mod statics;
 pub mod step_control;
 pub mod system;
+pub mod threads;
 pub mod tolerances;
 
 pub use constraints::{MechanismState, Topology};

@@ -6,18 +6,20 @@ use crate::constraints::{joint_records, MechanismState};
 use crate::mechanism::Mechanism;
 use crate::newton::NewtonReport;
 use crate::record::{Energies, StepRecord};
+use crate::threads::sequential;
 use flexmech_core::{Configuration, Inertia};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
 /// Strain energy of the whole mesh (element energies summed in element order).
 pub fn strain_energy(mech: &Mechanism, config: &Configuration) -> f64 {
-    let per: Vec<f64> = mech
-        .mesh
-        .elements
-        .par_iter()
-        .map(|e| e.energy(&config.x, &config.rot))
-        .collect();
+    let elements = &mech.mesh.elements;
+    let energy = |e: &flexmech_core::mesh::Element| e.energy(&config.x, &config.rot);
+    let per: Vec<f64> = if sequential(elements.len()) {
+        elements.iter().map(energy).collect()
+    } else {
+        elements.par_iter().map(energy).collect()
+    };
     per.iter().sum()
 }
 

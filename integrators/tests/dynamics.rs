@@ -267,7 +267,9 @@ fn tumbling_rigid_body_keeps_its_exact_energy_and_momentum() {
 #[test]
 fn energy_momentum_is_bitwise_deterministic_across_thread_counts() {
     use flexmech_integrators::dynamics::energy_momentum;
-    let (mech, motion, mut settings) = spinning_beam(MassKind::Consistent);
+    // Enough elements for the parallel loops (threads::PARALLEL_MIN_ELEMENTS).
+    let elements = flexmech_integrators::threads::PARALLEL_MIN_ELEMENTS;
+    let (mech, motion, mut settings) = spinning_beam_of(MassKind::Consistent, elements, 2);
     settings.dt = 0.2;
     settings.t_end = 2.0;
     let run = |threads: usize| {

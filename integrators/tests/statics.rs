@@ -159,7 +159,9 @@ fn newton_converges_quadratically() {
 
 #[test]
 fn assembly_is_bitwise_deterministic_across_thread_counts() {
-    let mech = cantilever(40, 3, 1.3 * std::f64::consts::PI * EI / L);
+    // Enough elements for the parallel assembly (threads::PARALLEL_MIN_ELEMENTS).
+    let elements = flexmech_integrators::threads::PARALLEL_MIN_ELEMENTS;
+    let mech = cantilever(elements, 3, 1.3 * std::f64::consts::PI * EI / L);
     let solve_with = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

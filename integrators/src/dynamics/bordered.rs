@@ -10,6 +10,7 @@ use crate::newton::{
     at_floor, check_regular, diverged, NewtonReport, NewtonSettings, NewtonSystem,
 };
 use crate::system::{ReducedSystem, StepTerms};
+use crate::threads::sequential;
 use crate::tolerances::TOLERANCES;
 use flexmech_core::conserving::MidRotation;
 use flexmech_core::rotation::cayley_inverse;
@@ -94,13 +95,18 @@ pub(super) fn solve_step<T: Bordered>(
         ];
         // Element terms in parallel, summed in element order (deterministic).
         let (start, end) = (&sys.start.config, &sys.end.config);
-        let terms: Vec<EnergyTerms> = sys
-            .mech
-            .mesh
-            .elements
-            .par_iter()
-            .map(|el| energy_terms(el, start, end))
-            .collect();
+        let elements = &sys.mech.mesh.elements;
+        let terms: Vec<EnergyTerms> = if sequential(elements.len()) {
+            elements
+                .iter()
+                .map(|el| energy_terms(el, start, end))
+                .collect()
+        } else {
+            elements
+                .par_iter()
+                .map(|el| energy_terms(el, start, end))
+                .collect()
+        };
         for (el, t) in sys.mech.mesh.elements.iter().zip(&terms) {
             e_tot += t.e;
             c_tot += t.c;

@@ -12,6 +12,7 @@ use crate::run::{run_model_to, RunError};
 use crate::study::execute::plans;
 use crate::study::sweep::{model_for, RunPlan};
 use crate::study::{Figure, StudySpec};
+use flexmech_integrators::threads::one_thread_each;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use toml::Value;
@@ -157,7 +158,7 @@ pub fn run_all(
     }
     let mut all: Vec<RunRecord> = jobs
         .par_iter()
-        .map(|job| run_one(job, &studies[job.study], out))
+        .map(|job| one_thread_each(|| run_one(job, &studies[job.study], out)))
         .collect::<Result<_, _>>()?;
     let half = all.split_off(all.len() - jobs.iter().filter(|j| j.half_step).count());
     Ok((all, half))
