@@ -30,6 +30,7 @@ if a.fast:
     sys.exudynFast = True          # must precede the import: no range checks, AVX2
 import numpy as np
 import exudyn as exu
+from twin import dynamic_settings
 from exudyn.itemInterface import (NodeRigidBodyRxyz, NodeRigidBodyEP, NodeRigidBodyRotVecLG,
     NodePointGround, ObjectGround, ObjectBeamGeometricallyExact, MarkerNodeCoordinate,
     MarkerNodeRigid, MarkerBodyRigid, CoordinateConstraint, GenericJoint, Force, SensorNode)
@@ -67,26 +68,12 @@ sTip = mbs.AddSensor(SensorNode(nodeNumber=nodes[-1], storeInternal=True, writeT
                                 outputVariableType=exu.OutputVariableType.Displacement))
 mbs.Assemble()
 
-s = exu.SimulationSettings()
-s.solution.file.write = False
-s.solution.sensors.writePeriod = 0.999 * a.dt      # record every step
-s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-s.parallel.numberOfThreads = 1
-s.show.globalTimers = False
+s = dynamic_settings(exu, a.dt, a.t_end, a.fast)
 t = s.timeIntegration
-t.endTime = a.t_end
-t.numberOfSteps = round(a.t_end / a.dt)
-t.adaptiveStep = False                              # fixed dt, as flexmech here
-t.verboseMode = 0
 t.generalizedAlpha.useNewmark = True
 t.generalizedAlpha.spectralRadius = 1.0
 t.generalizedAlpha.newmarkBeta = 0.25
 t.generalizedAlpha.newmarkGamma = 0.5
-t.generalizedAlpha.computeInitialAccelerations = True
-t.newton.useModifiedNewton = a.fast                 # default full Newton
-if a.fast:
-    s.linearSolver.reuseAnalyzedPattern = True
-    t.reuseConstantMassMatrix = True
 cpu1 = time.process_time()
 
 if a.static:

@@ -24,13 +24,7 @@ sed -e "0,/^name = .*/s//name = \"cantilever\"/" -e "s/^elements = .*/elements =
     "$here/../cantilever512.toml" > "$out/cantilever.toml"
 sed -e 's/^\[solver\]/[solver]\nnewton = "modified"/' "$out/cantilever.toml" > "$out/modified.toml"
 
-TIMEFORMAT='%U %S'
-cpu() {  # cpu LOGFILE CMD... : run CMD, its stdout to LOGFILE, print user+sys seconds
-    local log="$1"; shift; local t
-    t=$( { time "$@" > "$log" 2>&1; } 2>&1 ) || { cat "$log" >&2; exit 1; }
-    awk '{printf "%.3f", $1 + $2}' <<<"$t"
-}
-solve() { awk '/^cpu_solve_s/ {print $2}' "$1"; }
+. "$here/paired.sh"
 
 echo "cantilever: $ne elements, t_end $tend, dt 1e-3, $rounds rounds, one thread each"
 printf '%-6s %10s %10s | %10s %10s | %10s %10s\n' round "A flexmech" "M modified" "B solve" "B process" "C solve" "C process"
@@ -44,15 +38,7 @@ for r in $(seq 1 "$rounds"); do
     printf '%-6s %10s %10s | %10s %10s | %10s %10s\n' "$r" "$a" "$m" "$bs" "$b" "$cs" "$c"
     rows+=("$a $bs $b $cs $c $m")
 done
-printf '%s\n' "${rows[@]}" | awk '
-    function med(x, n,   i, j, t) { for (i = 1; i <= n; i++) for (j = i + 1; j <= n; j++)
-        if (x[j] < x[i]) { t = x[i]; x[i] = x[j]; x[j] = t } return x[int((n + 1) / 2)] }
-    { n++; r1[n] = $1 / $2; r2[n] = $1 / $3; r3[n] = $1 / $4; r4[n] = $1 / $5
-      r5[n] = $6 / $2; r6[n] = $6 / $3; r7[n] = $6 / $4; r8[n] = $6 / $5 }
-    END { printf "median ratio A flexmech-full/Exudyn-full        : %.3f (solve only)  %.3f (whole process)\n", med(r1, n), med(r2, n)
-          printf "median ratio A flexmech-full/Exudyn-fastest     : %.3f (solve only)  %.3f (whole process)\n", med(r3, n), med(r4, n)
-          printf "median ratio M flexmech-modified/Exudyn-full    : %.3f (solve only)  %.3f (whole process)\n", med(r5, n), med(r6, n)
-          printf "median ratio M flexmech-modified/Exudyn-fastest : %.3f (solve only)  %.3f (whole process)\n", med(r7, n), med(r8, n) }'
+printf '%s\n' "${rows[@]}" | medians
 echo "flexmech: $(head -1 "$out/a.log")"
 grep -h '^exudyn' "$out/b.log" "$out/c.log"
 

@@ -1085,38 +1085,12 @@ impl ResultWriter {
             joint.released_translation.push_rows(t0, &released, path)?;
             let error: Vec<f64> = recs.iter().map(|r| of(r).constraint_error).collect();
             joint.constraint_error.push_scalars(t0, &error, path)?;
-            let force: Vec<[f64; 3]> = recs
-                .iter()
-                .map(|r| {
-                    let f = of(r).reaction;
-                    [f[0], f[1], f[2]]
-                })
-                .collect();
-            let moment: Vec<[f64; 3]> = recs
-                .iter()
-                .map(|r| {
-                    let f = of(r).reaction;
-                    [f[3], f[4], f[5]]
-                })
-                .collect();
+            let (force, moment) = force_moment(recs.iter().map(|r| of(r).reaction));
             joint.reaction_force.push_rows(t0, &force, path)?;
             joint.reaction_moment.push_rows(t0, &moment, path)?;
         }
         for (k, [force, moment]) in s.supports.iter().enumerate() {
-            let f: Vec<[f64; 3]> = recs
-                .iter()
-                .map(|r| {
-                    let v = r.support_reactions[k];
-                    [v[0], v[1], v[2]]
-                })
-                .collect();
-            let m: Vec<[f64; 3]> = recs
-                .iter()
-                .map(|r| {
-                    let v = r.support_reactions[k];
-                    [v[3], v[4], v[5]]
-                })
-                .collect();
+            let (f, m) = force_moment(recs.iter().map(|r| r.support_reactions[k]));
             force.push_rows(t0, &f, path)?;
             moment.push_rows(t0, &m, path)?;
         }
@@ -1253,6 +1227,13 @@ impl ResultWriter {
     pub fn path(&self) -> &Path {
         &self.path
     }
+}
+
+/// Reactions `(force, moment)` split into the force rows and the moment rows.
+fn force_moment(reactions: impl Iterator<Item = [f64; 6]>) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    reactions
+        .map(|r| ([r[0], r[1], r[2]], [r[3], r[4], r[5]]))
+        .unzip()
 }
 
 /// Values a record holds, for the bound on held steps ([`HELD_VALUES`]).

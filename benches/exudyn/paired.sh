@@ -1,0 +1,29 @@
+# Shared by compare.sh and compare_slider_crank.sh (sourced): the CPU time of
+# one command and the median ratios of paired rounds.
+
+TIMEFORMAT='%U %S'
+
+# cpu LOGFILE CMD... : runs CMD with its output to LOGFILE, prints user+sys seconds
+cpu() {
+    local log="$1"; shift; local t
+    t=$( { time "$@" > "$log" 2>&1; } 2>&1 ) || { cat "$log" >&2; exit 1; }
+    awk '{printf "%.3f", $1 + $2}' <<<"$t"
+}
+
+# solve LOGFILE : the solve-only CPU seconds an Exudyn twin printed
+solve() { awk '/^cpu_solve_s/ {print $2}' "$1"; }
+
+# medians < ROWS : rows "A B_solve B_process C_solve C_process M" of the rounds
+# (A, M flexmech full and modified Newton; B, C Exudyn full and fastest);
+# prints the median of each per-round ratio
+medians() {
+    awk '
+    function med(x, n,   i, j, t) { for (i = 1; i <= n; i++) for (j = i + 1; j <= n; j++)
+        if (x[j] < x[i]) { t = x[i]; x[i] = x[j]; x[j] = t } return x[int((n + 1) / 2)] }
+    { n++; r1[n] = $1 / $2; r2[n] = $1 / $3; r3[n] = $1 / $4; r4[n] = $1 / $5
+      r5[n] = $6 / $2; r6[n] = $6 / $3; r7[n] = $6 / $4; r8[n] = $6 / $5 }
+    END { printf "median ratio A flexmech-full/Exudyn-full        : %.3f (solve only)  %.3f (whole process)\n", med(r1, n), med(r2, n)
+          printf "median ratio A flexmech-full/Exudyn-fastest     : %.3f (solve only)  %.3f (whole process)\n", med(r3, n), med(r4, n)
+          printf "median ratio M flexmech-modified/Exudyn-full    : %.3f (solve only)  %.3f (whole process)\n", med(r5, n), med(r6, n)
+          printf "median ratio M flexmech-modified/Exudyn-fastest : %.3f (solve only)  %.3f (whole process)\n", med(r7, n), med(r8, n) }'
+}
