@@ -27,18 +27,7 @@ sed -e 's/^\[solver\]/[solver]\nnewton = "modified"/' "$out/cantilever.toml" > "
 . "$here/paired.sh"
 
 echo "cantilever: $ne elements, t_end $tend, dt 1e-3, $rounds rounds, one thread each"
-printf '%-6s %10s %10s | %10s %10s | %10s %10s\n' round "A flexmech" "M modified" "B solve" "B process" "C solve" "C process"
-rows=()
-for r in $(seq 1 "$rounds"); do
-    a=$(cpu "$out/a.log" "$bin" run "$out/cantilever.toml" --out "$out/fm")
-    m=$(cpu "$out/m.log" "$bin" run "$out/modified.toml" --out "$out/fmm")
-    b=$(cpu "$out/b.log" python3 "$here/cantilever.py" --elements "$ne" --t-end "$tend" --csv "$out/full.csv")
-    c=$(cpu "$out/c.log" python3 "$here/cantilever.py" --elements "$ne" --t-end "$tend" --fast --csv "$out/fast.csv")
-    bs=$(solve "$out/b.log"); cs=$(solve "$out/c.log")
-    printf '%-6s %10s %10s | %10s %10s | %10s %10s\n' "$r" "$a" "$m" "$bs" "$b" "$cs" "$c"
-    rows+=("$a $bs $b $cs $c $m")
-done
-printf '%s\n' "${rows[@]}" | medians
+paired_rounds "$rounds" "$out/cantilever.toml" "$out/modified.toml" "$here/cantilever.py" --elements "$ne" --t-end "$tend"
 echo "flexmech: $(head -1 "$out/a.log")"
 grep -h '^exudyn' "$out/b.log" "$out/c.log"
 

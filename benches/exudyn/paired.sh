@@ -27,3 +27,24 @@ medians() {
           printf "median ratio M flexmech-modified/Exudyn-full    : %.3f (solve only)  %.3f (whole process)\n", med(r5, n), med(r6, n)
           printf "median ratio M flexmech-modified/Exudyn-fastest : %.3f (solve only)  %.3f (whole process)\n", med(r7, n), med(r8, n) }'
 }
+
+# paired_rounds ROUNDS FULL_TOML MODIFIED_TOML TWIN ARGS... : ROUNDS paired rounds of
+# A (flexmech FULL_TOML), M (flexmech MODIFIED_TOML), B (python3 TWIN ARGS, full
+# Newton) and C (the same with --fast), with $bin the flexmech binary and the logs,
+# results (fm, fmm) and twin CSVs (full.csv, fast.csv) in $out; prints each round
+# and the median ratios
+paired_rounds() {
+    local rounds="$1" full="$2" modified="$3"; shift 3
+    local rows=() r a m b c bs cs
+    printf '%-6s %10s %10s | %10s %10s | %10s %10s\n' round "A flexmech" "M modified" "B solve" "B process" "C solve" "C process"
+    for r in $(seq 1 "$rounds"); do
+        a=$(cpu "$out/a.log" "$bin" run "$full" --out "$out/fm")
+        m=$(cpu "$out/m.log" "$bin" run "$modified" --out "$out/fmm")
+        b=$(cpu "$out/b.log" python3 "$@" --csv "$out/full.csv")
+        c=$(cpu "$out/c.log" python3 "$@" --fast --csv "$out/fast.csv")
+        bs=$(solve "$out/b.log"); cs=$(solve "$out/c.log")
+        printf '%-6s %10s %10s | %10s %10s | %10s %10s\n' "$r" "$a" "$m" "$bs" "$b" "$cs" "$c"
+        rows+=("$a $bs $b $cs $c $m")
+    done
+    printf '%s\n' "${rows[@]}" | medians
+}
