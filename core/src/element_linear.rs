@@ -11,7 +11,7 @@
 //! E = ½L (Γ·C_N Γ + K·C_M K)
 //! ```
 //!
-//! nonlinear only through `A = exp(p̂)ᵀ`, `p = ½φ` (three hyper-dual lanes).
+//! nonlinear only through `A = exp(p̂)ᵀ`, `p = ½φ`.
 //! With `N = C_N Γ`, `M = C_M K`, `∂ᵢ = ∂/∂pᵢ`:
 //!
 //! ```text
@@ -36,7 +36,7 @@
 
 use crate::element::BeamElement;
 use crate::rotation::{log, tangent_inverse};
-use crate::rotation_derivatives::{exp_transpose, tangent_inverse_transpose_derivative};
+use crate::rotation_derivatives::{exp_transpose_first, tangent_inverse_transpose_derivative};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 impl BeamElement<2> {
@@ -53,8 +53,8 @@ impl BeamElement<2> {
         let phi = log(&(lt * lam[1]));
         let d = x[1] - x[0];
         let a = lt * d;
-        let ad = exp_transpose(&(phi * 0.5));
-        let (am, da, dda) = (ad.value, ad.d1, ad.d2);
+        let ad = exp_transpose_first(&(phi * 0.5));
+        let (am, da) = (ad.value, ad.d1);
         let (g0, k0) = self.initial_strains()[0];
         let (cn, cm) = (
             Matrix3::from_diagonal(&self.section.c_n),
@@ -63,6 +63,8 @@ impl BeamElement<2> {
         let n = cn * (am * a / l - g0);
         let m = cm * (phi / l - k0);
         let aa: [Vector3<f64>; 3] = std::array::from_fn(|i| da[i] * a);
+        // N·∂ᵢⱼA a, the only use of A's second derivatives.
+        let n_dda = ad.bilinear_hessian(&n, &a);
         // e = ∂E/∂z and the blocks of ∂²E/∂z² in z = (φ, a).
         let mut e_phi = Vector3::zeros();
         let mut h_pp = Matrix3::zeros();
@@ -70,8 +72,8 @@ impl BeamElement<2> {
         for i in 0..3 {
             e_phi[i] = 0.5 * n.dot(&aa[i]) + m[i];
             for j in 0..3 {
-                h_pp[(i, j)] = 0.25 * (aa[j].dot(&(cn * aa[i])) / l + n.dot(&(dda[i][j] * a)))
-                    + cm[(i, j)] / l;
+                h_pp[(i, j)] =
+                    0.25 * (aa[j].dot(&(cn * aa[i])) / l + n_dda[(i, j)]) + cm[(i, j)] / l;
             }
             let phi_a = (da[i].transpose() * n + am.transpose() * (cn * aa[i]) / l) * 0.5;
             h_pa.set_row(i, &phi_a.transpose());

@@ -134,8 +134,14 @@ pub fn tangent<T: Scalar>(psi: &Vector3<T>) -> Matrix3<T> {
 /// Inverse of [`tangent`]:
 /// `H⁻¹(ψ) = I − ½ψ̂ + ((1 − (ψ/2) cot(ψ/2))/ψ²) ψ̂²`, valid for `|ψ| < 2π`.
 pub fn tangent_inverse<T: Scalar>(psi: &Vector3<T>) -> Matrix3<T> {
-    let t2 = psi.norm_squared();
-    let d = if t2.value() < SERIES_LIMIT {
+    let d = tangent_inverse_coefficient(psi.norm_squared());
+    Matrix3::identity() - skew(psi) * cst::<T>(0.5) + skew_squared(psi) * d
+}
+
+/// The coefficient of `ψ̂²` in [`tangent_inverse`] as a function of
+/// `t = ψ²`: `D(t) = (1 − (ψ/2) cot(ψ/2))/ψ²`, by its series near zero.
+pub fn tangent_inverse_coefficient<T: Scalar>(t2: T) -> T {
+    if t2.value() < SERIES_LIMIT {
         series(
             t2,
             &[
@@ -149,8 +155,7 @@ pub fn tangent_inverse<T: Scalar>(psi: &Vector3<T>) -> Matrix3<T> {
     } else {
         let h = t2.sqrt() * cst::<T>(0.5);
         (T::one() - h * h.cos() / h.sin()) / t2
-    };
-    Matrix3::identity() - skew(psi) * cst::<T>(0.5) + skew_squared(psi) * d
+    }
 }
 
 /// Unit quaternion `(w, x, y, z)` of a rotation matrix, `w ≥ 0`

@@ -56,6 +56,20 @@ struct Work {
     k_red: DMatrix<f64>,
 }
 
+impl Work {
+    /// Buffers for an element of `d` unknowns over `m` equations.
+    fn new(d: usize, m: usize) -> Self {
+        Self {
+            r: DVector::zeros(d),
+            k: DMatrix::zeros(d, d),
+            g: DMatrix::zeros(d, m),
+            g_row: DMatrix::zeros(d, m),
+            tmp: DMatrix::zeros(d, m),
+            k_red: DMatrix::zeros(m, m),
+        }
+    }
+}
+
 /// Assembler bound to one mesh and one DOF map topology.
 pub struct Assembler {
     pattern: SymbolicSparseColMat<usize>,
@@ -63,6 +77,9 @@ pub struct Assembler {
     /// Extra dense blocks (joints' configuration-dependent terms).
     blocks: Vec<Slots>,
     work: Vec<Work>,
+    /// One buffer per element kind (its number of unknowns) for the
+    /// one-thread path, which sums each element as soon as it is evaluated.
+    scratch: Vec<Work>,
     /// CSC values of the reduced tangent after [`Assembler::assemble`].
     pub values: Vec<f64>,
     /// Internal nodal forces, 6 per node (force, spatial moment).
@@ -96,15 +113,7 @@ impl Assembler {
             for &j in &eqs {
                 cols[j].extend(eqs.iter().copied());
             }
-            let (d, m) = (el.dofs(), eqs.len());
-            work.push(Work {
-                r: DVector::zeros(d),
-                k: DMatrix::zeros(d, d),
-                g: DMatrix::zeros(d, m),
-                g_row: DMatrix::zeros(d, m),
-                tmp: DMatrix::zeros(d, m),
-                k_red: DMatrix::zeros(m, m),
-            });
+            work.push(Work::new(el.dofs(), eqs.len()));
             direct.push(direct_pairs(el, dofs, &eqs));
             slots.push(Slots {
                 eqs,
@@ -163,11 +172,19 @@ impl Assembler {
         }
         let nnz = row_idx.len();
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let mut scratch: Vec<Work> = Vec::new();
+        for el in &mesh.elements {
+            let d = el.dofs();
+            if scratch.iter().all(|w| w.r.len() != d) {
+                scratch.push(Work::new(d, 0));
+            }
+        }
         Self {
             pattern,
             slots,
             blocks: extra,
             work,
+            scratch,
             values: vec![0.0; nnz],
             nodal: vec![0.0; 6 * mesh.node_count()],
             nodal_abs: vec![0.0; 6 * mesh.node_count()],
@@ -194,68 +211,45 @@ impl Assembler {
     where
         F: Fn(&Element, usize, &mut [f64], &mut [f64]) + Sync,
     {
-        let element = |((w, (index, el)), s): ((&mut Work, (usize, &Element)), &Slots)| {
+        let element = |w: &mut Work, index: usize, el: &Element, s: &Slots| {
             kernel(el, index, w.r.as_mut_slice(), w.k.as_mut_slice());
-            if s.direct.is_some() {
-                return;
+            if s.direct.is_none() {
+                reduce_tangent(w, el, dofs, s);
             }
-            w.g.fill(0.0);
-            let split = el.nodes().iter().any(|&nd| dofs.nodes[nd].rows.is_some());
-            if split {
-                w.g_row.fill(0.0);
-            }
-            for (a, &nd) in el.nodes().iter().enumerate() {
-                let map = &dofs.nodes[nd];
-                for (k, (eq, col)) in map.eqs.iter().zip(&map.cols).enumerate() {
-                    let j = s
-                        .eqs
-                        .binary_search(eq)
-                        .expect("element equation list is complete");
-                    let row = &map.rows()[k];
-                    for d in 0..6 {
-                        w.g[(6 * a + d, j)] += col[d];
-                        if split {
-                            w.g_row[(6 * a + d, j)] += row[d];
-                        }
-                    }
-                }
-            }
-            w.tmp.gemm(1.0, &w.k, &w.g, 0.0);
-            let rows = if split { &w.g_row } else { &w.g };
-            w.k_red.gemm_tr(1.0, rows, &w.tmp, 0.0);
         };
-        // One thread asked for, or already on a worker (the runs of a study
-        // are the parallel work): no hand-off at all.
         if sequential(mesh.elements.len()) {
-            self.work
-                .iter_mut()
-                .zip(mesh.elements.iter().enumerate())
-                .zip(&self.slots)
-                .for_each(element);
-        } else {
-            self.work
-                .par_iter_mut()
-                .zip(mesh.elements.par_iter().enumerate())
-                .zip(self.slots.par_iter())
-                .for_each(element);
-        }
-        self.values.iter_mut().for_each(|v| *v = 0.0);
-        self.scatter_forces(mesh);
-        for (w, s) in self.work.iter().zip(&self.slots) {
-            if let Some(runs) = &s.direct {
-                let k = w.k.as_slice();
-                for &(e, p, len) in runs {
-                    let target = &mut self.values[p..p + len];
-                    for (t, v) in target.iter_mut().zip(&k[e..e + len]) {
-                        *t += v;
-                    }
-                }
-            } else {
-                for (&p, &v) in s.pos.iter().zip(w.k_red.as_slice()) {
-                    self.values[p] += v;
-                }
+            // One thread: each element is summed as soon as it is evaluated,
+            // from a buffer that stays in cache (the same sums in the same
+            // order as below).
+            self.clear();
+            for (index, (el, s)) in mesh.elements.iter().zip(&self.slots).enumerate() {
+                let w = match &s.direct {
+                    Some(_) => scratch_for(&mut self.scratch, el.dofs()),
+                    None => &mut self.work[index],
+                };
+                element(w, index, el, s);
+                add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
+                add_tangent(&mut self.values, w, s);
             }
+            return;
         }
+        self.work
+            .par_iter_mut()
+            .zip(mesh.elements.par_iter().enumerate())
+            .zip(self.slots.par_iter())
+            .for_each(|((w, (index, el)), s)| element(w, index, el, s));
+        self.clear();
+        for ((w, s), el) in self.work.iter().zip(&self.slots).zip(&mesh.elements) {
+            add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
+            add_tangent(&mut self.values, w, s);
+        }
+    }
+
+    /// Zeroes the tangent values and the nodal forces.
+    fn clear(&mut self) {
+        self.values.iter_mut().for_each(|v| *v = 0.0);
+        self.nodal.iter_mut().for_each(|v| *v = 0.0);
+        self.nodal_abs.iter_mut().for_each(|v| *v = 0.0);
     }
 
     /// The internal nodal forces only ([`Self::nodal`], [`Self::nodal_abs`];
@@ -273,30 +267,24 @@ impl Assembler {
     where
         F: Fn(&Element, &mut [f64]) + Sync,
     {
-        let element = |(w, el): (&mut Work, &Element)| kernel(el, w.r.as_mut_slice());
         if sequential(mesh.elements.len()) {
-            self.work.iter_mut().zip(&mesh.elements).for_each(element);
-        } else {
-            self.work
-                .par_iter_mut()
-                .zip(mesh.elements.par_iter())
-                .for_each(element);
+            self.nodal.iter_mut().for_each(|v| *v = 0.0);
+            self.nodal_abs.iter_mut().for_each(|v| *v = 0.0);
+            for el in &mesh.elements {
+                let w = scratch_for(&mut self.scratch, el.dofs());
+                kernel(el, w.r.as_mut_slice());
+                add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
+            }
+            return;
         }
-        self.scatter_forces(mesh);
-    }
-
-    /// Sums the elements' forces (in the work buffers) into the nodal forces.
-    fn scatter_forces(&mut self, mesh: &Mesh) {
+        self.work
+            .par_iter_mut()
+            .zip(mesh.elements.par_iter())
+            .for_each(|(w, el)| kernel(el, w.r.as_mut_slice()));
         self.nodal.iter_mut().for_each(|v| *v = 0.0);
         self.nodal_abs.iter_mut().for_each(|v| *v = 0.0);
         for (w, el) in self.work.iter().zip(&mesh.elements) {
-            for (a, &nd) in el.nodes().iter().enumerate() {
-                for d in 0..6 {
-                    let v = w.r[6 * a + d];
-                    self.nodal[6 * nd + d] += v;
-                    self.nodal_abs[6 * nd + d] += v.abs();
-                }
-            }
+            add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
         }
     }
 
@@ -383,4 +371,72 @@ impl Assembler {
             .expect("entry in the sparsity pattern");
         self.values[cp[col] + p] += v;
     }
+}
+
+/// `Gᵀ K G` of an element some joint touches, from the kernel's `K` in
+/// `w.k`, into `w.k_red` (`G` its node maps over the element's equations).
+fn reduce_tangent(w: &mut Work, el: &Element, dofs: &DofMap, s: &Slots) {
+    w.g.fill(0.0);
+    let split = el.nodes().iter().any(|&nd| dofs.nodes[nd].rows.is_some());
+    if split {
+        w.g_row.fill(0.0);
+    }
+    for (a, &nd) in el.nodes().iter().enumerate() {
+        let map = &dofs.nodes[nd];
+        for (k, (eq, col)) in map.eqs.iter().zip(&map.cols).enumerate() {
+            let j = s
+                .eqs
+                .binary_search(eq)
+                .expect("element equation list is complete");
+            let row = &map.rows()[k];
+            for d in 0..6 {
+                w.g[(6 * a + d, j)] += col[d];
+                if split {
+                    w.g_row[(6 * a + d, j)] += row[d];
+                }
+            }
+        }
+    }
+    w.tmp.gemm(1.0, &w.k, &w.g, 0.0);
+    let rows = if split { &w.g_row } else { &w.g };
+    w.k_red.gemm_tr(1.0, rows, &w.tmp, 0.0);
+}
+
+/// Adds an element's forces `r` (6 per node, ordered as its nodes) to the
+/// nodal forces and their absolute values to the scale.
+fn add_forces(nodal: &mut [f64], nodal_abs: &mut [f64], el: &Element, r: &DVector<f64>) {
+    for (a, &nd) in el.nodes().iter().enumerate() {
+        for d in 0..6 {
+            let v = r[6 * a + d];
+            nodal[6 * nd + d] += v;
+            nodal_abs[6 * nd + d] += v.abs();
+        }
+    }
+}
+
+/// Adds an element's tangent to the values: straight from the kernel's
+/// buffer along the direct runs, or its reduced tangent through `pos`.
+fn add_tangent(values: &mut [f64], w: &Work, s: &Slots) {
+    if let Some(runs) = &s.direct {
+        let k = w.k.as_slice();
+        for &(e, p, len) in runs {
+            for (t, v) in values[p..p + len].iter_mut().zip(&k[e..e + len]) {
+                *t += v;
+            }
+        }
+    } else {
+        for (&p, &v) in s.pos.iter().zip(w.k_red.as_slice()) {
+            values[p] += v;
+        }
+    }
+}
+
+/// The scratch buffer for elements of `dofs` unknowns (one per element
+/// kind, made with the assembler).
+fn scratch_for(scratch: &mut [Work], dofs: usize) -> &mut Work {
+    let i = scratch
+        .iter()
+        .position(|w| w.r.len() == dofs)
+        .unwrap_or_default();
+    &mut scratch[i]
 }

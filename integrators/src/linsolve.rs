@@ -103,7 +103,7 @@ impl SparseLu {
     /// entries, faer's general sparse LU otherwise.
     pub fn new(pattern: SymbolicSparseColMat<usize>) -> Result<Self, String> {
         let band = BandStructure::of(&pattern);
-        if band.storage() <= BAND_STORAGE_RATIO * pattern.row_idx().len().max(1) {
+        if band.fits() && band.storage() <= BAND_STORAGE_RATIO * pattern.row_idx().len().max(1) {
             let lu = BandLu::new(&pattern, band);
             return Ok(Self::with(pattern, Backend::Band(Box::new(lu))));
         }
