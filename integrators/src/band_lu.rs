@@ -320,45 +320,25 @@ impl BandLu {
         for (i, &p) in self.band.perm.iter().enumerate() {
             b[p] = rhs[i];
         }
-        if self.u_width == ku {
-            // No interchanges: row by row, each a running sum over the
-            // columns that reach it, in the order the column sweeps below
-            // take them (so the same sums), without their loads of entries
-            // just stored at an offset of one.
-            // Entry (i, j) of the factors at j ld + kv + i − j.
-            let ab = &self.ab;
-            for i in 0..n {
-                let lo = i.saturating_sub(kl);
-                let terms = b[lo..i].iter().zip(lo..);
-                b[i] = terms.fold(b[i], |t, (&bj, j)| t - ab[j * ld + kv + i - j] * bj);
+        // L: unit lower, multipliers below the diagonal, interchanges
+        // first.
+        for j in 0..n {
+            let l = self.piv[j];
+            if l != j {
+                b.swap(l, j);
             }
-            for i in (0..n).rev() {
-                let hi = (i + ku).min(n - 1);
-                let terms = b[i + 1..hi + 1].iter().zip(i + 1..hi + 1).rev();
-                let t = terms.fold(b[i], |t, (&bj, j)| t - ab[j * ld + kv + i - j] * bj);
-                b[i] = t / ab[i * ld + kv];
-            }
-        } else {
-            // L: unit lower, multipliers below the diagonal, interchanges
-            // first.
-            for j in 0..n {
-                let l = self.piv[j];
-                if l != j {
-                    b.swap(l, j);
-                }
-                let km = kl.min(n - 1 - j);
-                let col = j * ld + kv;
-                let bj = b[j];
-                subtract_multiple(&mut b[j + 1..=j + km], &self.ab[col + 1..=col + km], bj);
-            }
-            // U: upper bandwidth ku plus the farthest interchange (≤ kl + ku).
-            for j in (0..n).rev() {
-                let col = j * ld + kv;
-                b[j] /= self.ab[col];
-                let bj = b[j];
-                let top = j.saturating_sub(self.u_width);
-                subtract_multiple(&mut b[top..j], &self.ab[col + top - j..col], bj);
-            }
+            let km = kl.min(n - 1 - j);
+            let col = j * ld + kv;
+            let bj = b[j];
+            subtract_multiple(&mut b[j + 1..=j + km], &self.ab[col + 1..=col + km], bj);
+        }
+        // U: upper bandwidth ku plus the farthest interchange (≤ kl + ku).
+        for j in (0..n).rev() {
+            let col = j * ld + kv;
+            b[j] /= self.ab[col];
+            let bj = b[j];
+            let top = j.saturating_sub(self.u_width);
+            subtract_multiple(&mut b[top..j], &self.ab[col + top - j..col], bj);
         }
         for (i, &p) in self.band.perm.iter().enumerate() {
             rhs[i] = b[p];

@@ -186,7 +186,9 @@ enum Command {
     ///
     /// Prints the machine, then µs per step, µs per element-step and the
     /// ratio to Newmark with full Newton at the same size (ratios carry over
-    /// between machines; absolute times on a shared machine do not). Writes
+    /// between machines; absolute times on a shared machine do not), all of
+    /// the time steps alone; the set-up before the first step (patterns,
+    /// orderings, initial accelerations) in its own column. Writes
     /// `<out>/bench.md` and the runs' result files under `<out>/`. Set
     /// RAYON_NUM_THREADS=1 for one-thread figures.
     Bench {
