@@ -5,13 +5,19 @@
 use crate::assembly::Assembler;
 use crate::dofs::DofMap;
 use flexmech_core::Inertia;
-use nalgebra::{Const, Matrix3, Vector3, U1};
-use num_dual::DualSVec64;
+use nalgebra::{Matrix3, Vector3};
+#[cfg(test)]
+use {
+    nalgebra::{Const, U1},
+    num_dual::DualSVec64,
+};
 
 /// A nodal inertial moment `m(R)` at the end rotation `r_end` and its
 /// derivative with respect to a spatial spin of it (`R ← exp(η̂)R`), by
 /// three-lane forward AD; the value alone when `tangent` is false (the
-/// derivative is then zero).
+/// derivative is then zero). The oracle of the schemes' closed-form
+/// inertial tangents.
+#[cfg(test)]
 pub(crate) fn spin_derivative(
     r_end: &Matrix3<f64>,
     tangent: bool,
