@@ -37,7 +37,7 @@
 use crate::element::BeamElement;
 use crate::rotation::{log, tangent_inverse};
 use crate::rotation_derivatives::{
-    exp_transpose, tangent_inverse_transpose_derivative, tangent_transpose,
+    exp_transpose_first, tangent_inverse_transpose_derivative, tangent_transpose_first,
 };
 use crate::shape::{lagrange, reduced_gauss};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
@@ -93,10 +93,10 @@ impl BeamElement<3> {
         let ds = 2.0 / self.length;
         let p = psi[0] * v[0] + psi[1] * v[2];
         let dp = (psi[0] * d[0] + psi[1] * d[2]) * ds;
-        let ad = exp_transpose(&p);
-        let bd = tangent_transpose(&p);
-        let (am, da, dda) = (ad.value, ad.d1, ad.d2);
-        let (bm, db, ddb) = (bd.value, bd.d1, bd.d2);
+        let ad = exp_transpose_first(&p);
+        let bd = tangent_transpose_first(&p);
+        let (am, da) = (ad.value, ad.d1);
+        let (bm, db) = (bd.value, bd.d1);
         let (g0, k0) = self.initial_strains()[g];
         let (cn, cm) = (
             Matrix3::from_diagonal(&self.section.c_n),
@@ -107,6 +107,8 @@ impl BeamElement<3> {
         let m = cm * (bm * dp - k0);
         let aa: [Vector3<f64>; 3] = std::array::from_fn(|i| da[i] * a);
         let bp: [Vector3<f64>; 3] = std::array::from_fn(|i| db[i] * dp);
+        // N·∂ᵢⱼA a and M·∂ᵢⱼBᵀ p′, the only uses of second derivatives.
+        let (n_dda, m_ddb) = (ad.bilinear_hessian(&n, a), bd.bilinear_hessian(&m, &dp));
         // Gradient and Hessian in (p, p′, a).
         let mut grad = SVector::<f64, 9>::zeros();
         let mut hess = SMatrix::<f64, 9, 9>::zeros();
@@ -115,9 +117,9 @@ impl BeamElement<3> {
             for j in 0..3 {
                 hess[(i, j)] = c2
                     * (aa[j].dot(&(cn * aa[i]))
-                        + n.dot(&(dda[i][j] * a))
+                        + n_dda[(i, j)]
                         + bp[j].dot(&(cm * bp[i]))
-                        + m.dot(&(ddb[i][j] * dp)));
+                        + m_ddb[(i, j)]);
             }
             let p_dp = (db[i].transpose() * m + bm.transpose() * (cm * bp[i])) * c2;
             let p_a = (da[i].transpose() * n + am.transpose() * (cn * aa[i])) * c2;

@@ -195,6 +195,13 @@ pub fn exp_transpose_first(p: &Vector3<f64>) -> SkewQuadratic {
     quadratic_in_skew_first(p, negated(a), b)
 }
 
+/// `Hᵀ(p)` and its first derivatives; second derivatives through
+/// [`SkewQuadratic::bilinear_hessian`].
+pub fn tangent_transpose_first(p: &Vector3<f64>) -> SkewQuadratic {
+    let [_, b, c] = coefficients(p.norm_squared());
+    quadratic_in_skew_first(p, negated(b), c)
+}
+
 /// `Hᵀ(p) = I − b p̂ + c p̂²` ([`crate::rotation::tangent`]) and its first
 /// and second derivatives in `p`.
 pub fn tangent_transpose(p: &Vector3<f64>) -> MatrixDerivatives {
@@ -307,17 +314,22 @@ mod tests {
                 );
                 // The bilinear Hessian against the oracle's second derivatives.
                 let (u, w) = (Vector3::new(0.7, -1.3, 0.4), Vector3::new(-0.2, 0.9, 1.6));
-                let full = by_ad(exp(&seeded(&p)).transpose());
-                let first = exp_transpose_first(&p);
-                let hess = Matrix3::from_fn(|i, j| u.dot(&(full.d2[i][j] * w)));
-                let bh = (first.bilinear_hessian(&u, &w) - hess).norm();
-                let d1 = (0..3).fold(0.0f64, |m, i| m.max((first.d1[i] - full.d1[i]).norm()));
-                assert!(
-                    bh <= ORACLE_TOL
-                        && d1 <= ORACLE_TOL
-                        && (first.value - full.value).norm() <= ORACLE_TOL,
-                    "|p| = {scale}: {bh:e} {d1:e}"
-                );
+                for (first, full) in [
+                    (exp_transpose_first(&p), by_ad(exp(&seeded(&p)).transpose())),
+                    (
+                        tangent_transpose_first(&p),
+                        by_ad(tangent(&seeded(&p)).transpose()),
+                    ),
+                ] {
+                    let hess = Matrix3::from_fn(|i, j| u.dot(&(full.d2[i][j] * w)));
+                    let bh = (first.bilinear_hessian(&u, &w) - hess).norm();
+                    let d1 = (0..3).fold(0.0f64, |m, i| m.max((first.d1[i] - full.d1[i]).norm()));
+                    let d0 = (first.value - full.value).norm();
+                    assert!(
+                        bh <= ORACLE_TOL && d1 <= ORACLE_TOL && d0 <= ORACLE_TOL,
+                        "|p| = {scale}: {bh:e} {d1:e} {d0:e}"
+                    );
+                }
                 // ∂(H⁻ᵀv)/∂ψ up to |ψ| = 2·3.1 (H⁻¹ holds below 2π).
                 let (psi, v) = (p * 2.0, Vector3::new(1.0, 2.0, -0.5));
                 let oracle = tangent_inverse_transpose_derivative_ad(&psi, &v);
