@@ -6,38 +6,6 @@ use crate::assembly::Assembler;
 use crate::dofs::DofMap;
 use flexmech_core::Inertia;
 use nalgebra::{Matrix3, Vector3};
-#[cfg(test)]
-use {
-    nalgebra::{Const, U1},
-    num_dual::DualSVec64,
-};
-
-/// A nodal inertial moment `m(R)` at the end rotation `r_end` and its
-/// derivative with respect to a spatial spin of it (`R ← exp(η̂)R`), by
-/// three-lane forward AD; the value alone when `tangent` is false (the
-/// derivative is then zero). The oracle of the schemes' closed-form
-/// inertial tangents.
-#[cfg(test)]
-pub(crate) fn spin_derivative(
-    r_end: &Matrix3<f64>,
-    tangent: bool,
-    moment: impl Fn(&Matrix3<DualSVec64<3>>) -> Vector3<DualSVec64<3>>,
-    plain: impl Fn(&Matrix3<f64>) -> Vector3<f64>,
-) -> (Vector3<f64>, Matrix3<f64>) {
-    if !tangent {
-        return (plain(r_end), Matrix3::zeros());
-    }
-    type D = DualSVec64<3>;
-    let seed = |j: usize| D::from_re(0.0).derivative(j);
-    let eta = Vector3::new(seed(0), seed(1), seed(2));
-    let m = moment(&(flexmech_core::rotation::exp(&eta) * r_end.map(D::from_re)));
-    let mut k = Matrix3::zeros();
-    for c in 0..3 {
-        k.set_row(c, &m[c].eps.unwrap_generic(Const::<3>, U1).transpose());
-    }
-    (m.map(|v| v.re), k)
-}
-
 /// Where the mass and inertia blocks land in the tangent values. The
 /// translational mass `Σ m_ij I` is constant: the diagonal positions of the
 /// blocks whose nodes are independent, with their masses, are listed once,
@@ -147,5 +115,66 @@ impl MassSlots {
                 self.add_rotational(asm, dofs, i, &k);
             }
         }
+    }
+}
+
+/// Test support: forward AD of an inertial moment under a spatial spin of
+/// the end rotation, the oracle of the schemes' closed-form inertial
+/// tangents, with the fixtures both schemes' tests share.
+#[cfg(test)]
+pub(crate) mod inertia_oracle {
+    use flexmech_core::rotation::exp;
+    use nalgebra::{Const, Matrix3, Vector3, U1};
+    use num_dual::DualSVec64;
+
+    /// A number of the oracle's kind.
+    pub(crate) type D = DualSVec64<3>;
+
+    /// Both sides are exact: only round-off separates them.
+    const ORACLE_TOL: f64 = 1e-10;
+
+    /// A rotary inertia with products of inertia.
+    pub(crate) fn inertia() -> Matrix3<f64> {
+        Matrix3::new(2.0, 0.1, -0.2, 0.1, 1.5, 0.05, -0.2, 0.05, 0.8)
+    }
+
+    /// A start rotation and end rotations a small, a moderate and a large
+    /// spin from it (the last beyond 120°).
+    pub(crate) fn rotations() -> (Matrix3<f64>, [Matrix3<f64>; 3]) {
+        let r_n = exp(&Vector3::new(0.4, -1.1, 2.0));
+        let spins = [
+            Vector3::new(1e-4, 2e-4, -1e-4),
+            Vector3::new(0.3, -0.5, 0.2),
+            Vector3::new(-1.2, 0.9, 1.4),
+        ];
+        (r_n, spins.map(|s| exp(&s) * r_n))
+    }
+
+    /// Asserts that `closed` — a moment and its derivative under a spatial
+    /// spin of `r1` — equals three-lane forward AD of `moment` at `r1`.
+    pub(crate) fn assert_equals_ad(
+        r1: &Matrix3<f64>,
+        (m, k): (Vector3<f64>, Matrix3<f64>),
+        moment: impl Fn(&Matrix3<D>) -> Vector3<D>,
+        what: &str,
+    ) {
+        let seed = |j: usize| D::from_re(0.0).derivative(j);
+        let eta = Vector3::new(seed(0), seed(1), seed(2));
+        let m_ad = moment(&(exp(&eta) * r1.map(D::from_re)));
+        let mut k_ad = Matrix3::zeros();
+        for c in 0..3 {
+            k_ad.set_row(c, &m_ad[c].eps.unwrap_generic(Const::<3>, U1).transpose());
+        }
+        let m_ad = m_ad.map(|v| v.re);
+        let size = k_ad.norm().max(1.0);
+        assert!(
+            (m - m_ad).norm() <= ORACLE_TOL * m_ad.norm().max(1.0),
+            "{what}: moment"
+        );
+        assert!(
+            (k - k_ad).norm() <= ORACLE_TOL * size,
+            "{what}: {:e}",
+            (k - k_ad).norm() / size
+        );
     }
 }
