@@ -68,10 +68,8 @@ sTip = mbs.AddSensor(SensorNode(nodeNumber=nodes[-1], storeInternal=True, writeT
                                 outputVariableType=exu.OutputVariableType.Displacement))
 mbs.Assemble()
 
-s = dynamic_settings(exu, a.dt, a.t_end, a.fast)
+s = dynamic_settings(exu, a.dt, a.t_end, a.fast, newmark=True, rho=1.0)
 t = s.timeIntegration
-t.generalizedAlpha.useNewmark = True
-t.generalizedAlpha.spectralRadius = 1.0
 t.generalizedAlpha.newmarkBeta = 0.25
 t.generalizedAlpha.newmarkGamma = 0.5
 cpu1 = time.process_time()

@@ -14,9 +14,7 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 ne="${1:-512}"; tend="${2:-0.1}"; rounds="${3:-3}"
-bin="${FLEXMECH:-$here/../../target/release/flexmech}"
-export RAYON_NUM_THREADS=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
-out="$(mktemp -d)"; trap 'rm -rf "$out"' EXIT
+. "$here/paired.sh"
 
 # the flexmech model: the yardstick with ELEMENTS, T_END and every step stored
 sed -e "0,/^name = .*/s//name = \"cantilever\"/" -e "s/^elements = .*/elements = $ne/" \
@@ -24,7 +22,6 @@ sed -e "0,/^name = .*/s//name = \"cantilever\"/" -e "s/^elements = .*/elements =
     "$here/../cantilever512.toml" > "$out/cantilever.toml"
 sed -e 's/^\[solver\]/[solver]\nnewton = "modified"/' "$out/cantilever.toml" > "$out/modified.toml"
 
-. "$here/paired.sh"
 
 echo "cantilever: $ne elements, t_end $tend, dt 1e-3, $rounds rounds, one thread each"
 paired_rounds "$rounds" "$out/cantilever.toml" "$out/modified.toml" "$here/cantilever.py" --elements "$ne" --t-end "$tend"

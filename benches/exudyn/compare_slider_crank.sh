@@ -16,9 +16,7 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 scale="${1:-1}"; tend="${2:-1.0}"; rounds="${3:-3}"
-bin="${FLEXMECH:-$here/../../target/release/flexmech}"
-export RAYON_NUM_THREADS=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
-out="$(mktemp -d)"; trap 'rm -rf "$out"' EXIT
+. "$here/paired.sh"
 
 # the flexmech model: element counts times SCALE, T_END, every step stored
 awk -v k="$scale" -v te="$tend" '
@@ -30,7 +28,6 @@ awk -v k="$scale" -v te="$tend" '
     "$here/../../data/benchmarks/slider_crank.toml" > "$out/slider_crank.toml"
 sed -e 's/^\[solver\]/[solver]\nnewton = "modified"/' "$out/slider_crank.toml" > "$out/modified.toml"
 
-. "$here/paired.sh"
 
 echo "slider-crank: element scale $scale ($((2 * scale))/$((4 * scale))/$scale elements), t_end $tend, dt 1e-3, $rounds rounds, one thread each"
 paired_rounds "$rounds" "$out/slider_crank.toml" "$out/modified.toml" "$here/slider_crank.py" --elements-scale "$scale" --t-end "$tend"

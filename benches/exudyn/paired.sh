@@ -1,5 +1,10 @@
-# Shared by compare.sh and compare_slider_crank.sh (sourced): the CPU time of
-# one command and the median ratios of paired rounds.
+# Shared by compare.sh and compare_slider_crank.sh (sourced first): the binary,
+# one thread for every library, a scratch directory, the CPU time of one command
+# and the median ratios of paired rounds.
+
+bin="${FLEXMECH:-$here/../../target/release/flexmech}"
+export RAYON_NUM_THREADS=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
+out="$(mktemp -d)"; trap 'rm -rf "$out"' EXIT
 
 TIMEFORMAT='%U %S'
 

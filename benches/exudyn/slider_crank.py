@@ -122,10 +122,8 @@ sC = mbs.AddSensor(SensorNode(nodeNumber=block[0], storeInternal=True, writeToFi
                               outputVariableType=exu.OutputVariableType.Position))
 mbs.Assemble()
 
-s = dynamic_settings(exu, a.dt, a.t_end, a.fast)
+s = dynamic_settings(exu, a.dt, a.t_end, a.fast, newmark=False, rho=0.5)
 t = s.timeIntegration
-t.generalizedAlpha.useNewmark = False
-t.generalizedAlpha.spectralRadius = 0.5
 if a.newton_error == 'increment':   # robust at every element count, see README.md
     t.newton.residualMode = 1
     t.newton.relativeTolerance = t.newton.absoluteTolerance = a.tol

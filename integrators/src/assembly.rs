@@ -248,6 +248,11 @@ impl Assembler {
     /// Zeroes the tangent values and the nodal forces.
     fn clear(&mut self) {
         self.values.iter_mut().for_each(|v| *v = 0.0);
+        self.clear_forces();
+    }
+
+    /// Zeroes the nodal forces and their scale.
+    fn clear_forces(&mut self) {
         self.nodal.iter_mut().for_each(|v| *v = 0.0);
         self.nodal_abs.iter_mut().for_each(|v| *v = 0.0);
     }
@@ -268,8 +273,7 @@ impl Assembler {
         F: Fn(&Element, &mut [f64]) + Sync,
     {
         if sequential(mesh.elements.len()) {
-            self.nodal.iter_mut().for_each(|v| *v = 0.0);
-            self.nodal_abs.iter_mut().for_each(|v| *v = 0.0);
+            self.clear_forces();
             for el in &mesh.elements {
                 let w = scratch_for(&mut self.scratch, el.dofs());
                 kernel(el, w.r.as_mut_slice());
@@ -281,8 +285,7 @@ impl Assembler {
             .par_iter_mut()
             .zip(mesh.elements.par_iter())
             .for_each(|(w, el)| kernel(el, w.r.as_mut_slice()));
-        self.nodal.iter_mut().for_each(|v| *v = 0.0);
-        self.nodal_abs.iter_mut().for_each(|v| *v = 0.0);
+        self.clear_forces();
         for (w, el) in self.work.iter().zip(&mesh.elements) {
             add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
         }
