@@ -2,10 +2,12 @@
 //!
 //! Structure once, numbers every iteration: the sparsity pattern and every
 //! element's positions in the value array are computed when the assembler is
-//! built. Each call evaluates the element kernels in parallel (rayon) into
-//! per-element buffers, reduces them with the node maps (`Gᵀ K G`, `Gᵀ r`),
-//! and then sums them in element order on one thread — so the result is
-//! bitwise the same for any number of threads.
+//! built. Each call evaluates the element kernels, reduces them with the
+//! node maps (`Gᵀ K G`, `Gᵀ r`) and sums them in element order. With more
+//! than one thread the elements are cut into contiguous chunks evaluated in
+//! parallel, each summing straight into the values it owns (see
+//! [`crate::element_split`]) — every sum is still formed in element order,
+//! so the result is bitwise the same for any number of threads.
 
 use crate::dofs::DofMap;
 use faer::sparse::SymbolicSparseColMat;
@@ -13,6 +15,7 @@ use flexmech_core::{Configuration, Element, Mesh};
 use nalgebra::{DMatrix, DVector, Matrix3};
 use rayon::prelude::*;
 
+use crate::element_split::{Shared, Split};
 use crate::threads::sequential;
 
 struct Slots {
@@ -80,6 +83,10 @@ pub struct Assembler {
     /// One buffer per element kind (its number of unknowns) for the
     /// one-thread path, which sums each element as soon as it is evaluated.
     scratch: Vec<Work>,
+    /// The split of the element loop over threads, made when first needed.
+    split: Option<Split>,
+    /// One set of [`Self::scratch`] buffers per chunk of `split`.
+    chunk_scratch: Vec<Vec<Work>>,
     /// CSC values of the reduced tangent after [`Assembler::assemble`].
     pub values: Vec<f64>,
     /// Internal nodal forces, 6 per node (force, spatial moment).
@@ -185,6 +192,8 @@ impl Assembler {
             blocks: extra,
             work,
             scratch,
+            split: None,
+            chunk_scratch: Vec::new(),
             values: vec![0.0; nnz],
             nodal: vec![0.0; 6 * mesh.node_count()],
             nodal_abs: vec![0.0; 6 * mesh.node_count()],
@@ -233,16 +242,75 @@ impl Assembler {
             }
             return;
         }
-        self.work
-            .par_iter_mut()
-            .zip(mesh.elements.par_iter().enumerate())
-            .zip(self.slots.par_iter())
-            .for_each(|((w, (index, el)), s)| element(w, index, el, s));
+        self.split_for(mesh);
         self.clear();
-        for ((w, s), el) in self.work.iter().zip(&self.slots).zip(&mesh.elements) {
-            add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
-            add_tangent(&mut self.values, w, s);
+        let Self {
+            slots,
+            work,
+            split: Some(split),
+            chunk_scratch,
+            values,
+            nodal,
+            nodal_abs,
+            ..
+        } = self
+        else {
+            return;
+        };
+        let sinks = Sinks::new(values, nodal, nodal_abs);
+        chunk_parts(work, split)
+            .into_par_iter()
+            .zip(chunk_scratch.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, (part, scratch))| {
+                for (w_own, index) in part.iter_mut().zip(split.chunks[c].clone()) {
+                    let (el, s) = (&mesh.elements[index], &slots[index]);
+                    let late = split.is_late(index);
+                    let w = match &s.direct {
+                        Some(_) if !late => scratch_for(scratch, el.dofs()),
+                        _ => w_own,
+                    };
+                    element(w, index, el, s);
+                    // SAFETY: chunk `c` adds only what it owns (all of it
+                    // for an element that is not late).
+                    unsafe { sinks.add(el, w, Some(s), late.then_some((split, c, true))) };
+                }
+            });
+        for &index in &split.late {
+            let c = split.chunk_of(index);
+            let (el, s) = (&mesh.elements[index], &slots[index]);
+            // SAFETY: the parallel phase is over.
+            unsafe { sinks.add(el, &work[index], Some(s), Some((split, c, false))) };
         }
+    }
+
+    /// Makes [`Self::split`] for the current thread count if it is not.
+    fn split_for(&mut self, mesh: &Mesh) {
+        let threads = rayon::current_num_threads();
+        if self.split.as_ref().is_some_and(|s| s.is_for(threads)) {
+            return;
+        }
+        let split = Split::new(
+            threads,
+            self.values.len(),
+            mesh.node_count(),
+            self.slots
+                .iter()
+                .zip(&mesh.elements)
+                .map(|(s, el)| (&s.pos[..], el.nodes())),
+            mesh.elements.len(),
+        );
+        self.chunk_scratch = split
+            .chunks
+            .iter()
+            .map(|_| {
+                self.scratch
+                    .iter()
+                    .map(|w| Work::new(w.r.len(), 0))
+                    .collect()
+            })
+            .collect();
+        self.split = Some(split);
     }
 
     /// Zeroes the tangent values and the nodal forces.
@@ -281,13 +349,50 @@ impl Assembler {
             }
             return;
         }
-        self.work
-            .par_iter_mut()
-            .zip(mesh.elements.par_iter())
-            .for_each(|(w, el)| kernel(el, w.r.as_mut_slice()));
+        self.split_for(mesh);
         self.clear_forces();
-        for (w, el) in self.work.iter().zip(&mesh.elements) {
-            add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
+        let Self {
+            work,
+            split: Some(split),
+            chunk_scratch,
+            values,
+            nodal,
+            nodal_abs,
+            ..
+        } = self
+        else {
+            return;
+        };
+        let sinks = Sinks::new(values, nodal, nodal_abs);
+        chunk_parts(work, split)
+            .into_par_iter()
+            .zip(chunk_scratch.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, (part, scratch))| {
+                for (w_own, index) in part.iter_mut().zip(split.chunks[c].clone()) {
+                    let el = &mesh.elements[index];
+                    let late = split.is_late(index);
+                    let w = if late {
+                        w_own
+                    } else {
+                        scratch_for(scratch, el.dofs())
+                    };
+                    kernel(el, w.r.as_mut_slice());
+                    // SAFETY: as in `assemble_with`.
+                    unsafe { sinks.add(el, w, None, late.then_some((split, c, true))) };
+                }
+            });
+        for &index in &split.late {
+            let c = split.chunk_of(index);
+            // SAFETY: the parallel phase is over.
+            unsafe {
+                sinks.add(
+                    &mesh.elements[index],
+                    &work[index],
+                    None,
+                    Some((split, c, false)),
+                )
+            };
         }
     }
 
@@ -405,33 +510,141 @@ fn reduce_tangent(w: &mut Work, el: &Element, dofs: &DofMap, s: &Slots) {
     w.k_red.gemm_tr(1.0, rows, &w.tmp, 0.0);
 }
 
-/// Adds an element's forces `r` (6 per node, ordered as its nodes) to the
-/// nodal forces and their absolute values to the scale.
+/// An element's forces `r` (6 per node, ordered as its nodes) as
+/// `(node, its six forces)`.
+fn force_blocks<'a>(
+    el: &'a Element,
+    r: &'a DVector<f64>,
+) -> impl Iterator<Item = (usize, &'a [f64])> {
+    el.nodes()
+        .iter()
+        .enumerate()
+        .map(move |(a, &nd)| (nd, &r.as_slice()[6 * a..6 * a + 6]))
+}
+
+/// Adds a node's six forces to its nodal forces and their absolute values
+/// to the scale.
+fn add_force_block(nodal: &mut [f64], nodal_abs: &mut [f64], f: &[f64]) {
+    for ((n, a), v) in nodal.iter_mut().zip(nodal_abs.iter_mut()).zip(f) {
+        *n += v;
+        *a += v.abs();
+    }
+}
+
+/// Adds an element's forces `r` to the nodal forces and scale.
 fn add_forces(nodal: &mut [f64], nodal_abs: &mut [f64], el: &Element, r: &DVector<f64>) {
-    for (a, &nd) in el.nodes().iter().enumerate() {
-        for d in 0..6 {
-            let v = r[6 * a + d];
-            nodal[6 * nd + d] += v;
-            nodal_abs[6 * nd + d] += v.abs();
+    for (nd, f) in force_blocks(el, r) {
+        add_force_block(
+            &mut nodal[6 * nd..6 * nd + 6],
+            &mut nodal_abs[6 * nd..6 * nd + 6],
+            f,
+        );
+    }
+}
+
+/// An element's tangent as runs `(first position, values)`: straight from
+/// the kernel's buffer along the direct runs, or its reduced tangent
+/// through `pos`, one entry a run.
+fn tangent_runs<'a>(w: &'a Work, s: &'a Slots) -> impl Iterator<Item = (usize, &'a [f64])> {
+    let k = w.k.as_slice();
+    let k_red = w.k_red.as_slice();
+    let direct = s
+        .direct
+        .iter()
+        .flatten()
+        .map(move |&(e, p, len)| (p, &k[e..e + len]));
+    let reduced = if s.direct.is_some() {
+        &[][..]
+    } else {
+        &s.pos[..]
+    };
+    let reduced = reduced
+        .iter()
+        .enumerate()
+        .map(move |(i, &p)| (p, &k_red[i..i + 1]));
+    direct.chain(reduced)
+}
+
+/// Adds `src` to `target` entry by entry.
+fn add_run(target: &mut [f64], src: &[f64]) {
+    for (t, v) in target.iter_mut().zip(src) {
+        *t += v;
+    }
+}
+
+/// Adds an element's tangent to the values.
+fn add_tangent(values: &mut [f64], w: &Work, s: &Slots) {
+    for (p, run) in tangent_runs(w, s) {
+        add_run(&mut values[p..p + run.len()], run);
+    }
+}
+
+/// The arrays the chunks of a parallel loop add into.
+struct Sinks {
+    values: Shared,
+    nodal: Shared,
+    nodal_abs: Shared,
+}
+
+impl Sinks {
+    fn new(values: &mut [f64], nodal: &mut [f64], nodal_abs: &mut [f64]) -> Self {
+        Self {
+            values: Shared::new(values),
+            nodal: Shared::new(nodal),
+            nodal_abs: Shared::new(nodal_abs),
+        }
+    }
+
+    /// Adds element `el`'s forces (and, with its slots `s`, its tangent)
+    /// from `w`: everything, or with `Some((split, c, owned))` only the
+    /// values and nodes that chunk `c` owns (`owned`) or does not own.
+    ///
+    /// # Safety
+    /// No other thread touches what this adds to meanwhile: in a parallel
+    /// phase, chunk `c` adds only what it owns.
+    unsafe fn add(
+        &self,
+        el: &Element,
+        w: &Work,
+        s: Option<&Slots>,
+        only: Option<(&Split, usize, bool)>,
+    ) {
+        for (nd, f) in force_blocks(el, &w.r) {
+            if only.is_none_or(|(split, c, owned)| split.owns_node(c, nd) == owned) {
+                // SAFETY: by the caller's contract.
+                unsafe {
+                    self.nodal.add(6 * nd, f, |v| v);
+                    self.nodal_abs.add(6 * nd, f, f64::abs);
+                }
+            }
+        }
+        let Some(s) = s else { return };
+        for (p, run) in tangent_runs(w, s) {
+            match only {
+                // SAFETY: by the caller's contract.
+                None => unsafe { self.values.add(p, run, |v| v) },
+                Some((split, c, owned)) => {
+                    for (i, v) in run.iter().enumerate() {
+                        if split.owns_value(c, p + i) == owned {
+                            // SAFETY: by the caller's contract.
+                            unsafe { self.values.add(p + i, &[*v], |v| v) };
+                        }
+                    }
+                }
+            }
         }
     }
 }
 
-/// Adds an element's tangent to the values: straight from the kernel's
-/// buffer along the direct runs, or its reduced tangent through `pos`.
-fn add_tangent(values: &mut [f64], w: &Work, s: &Slots) {
-    if let Some(runs) = &s.direct {
-        let k = w.k.as_slice();
-        for &(e, p, len) in runs {
-            for (t, v) in values[p..p + len].iter_mut().zip(&k[e..e + len]) {
-                *t += v;
-            }
-        }
-    } else {
-        for (&p, &v) in s.pos.iter().zip(w.k_red.as_slice()) {
-            values[p] += v;
-        }
+/// `work` cut at the chunks of `split`.
+fn chunk_parts<'a>(mut work: &'a mut [Work], split: &Split) -> Vec<&'a mut [Work]> {
+    let mut parts = Vec::with_capacity(split.chunks.len());
+    for r in &split.chunks {
+        let (part, rest) = std::mem::take(&mut work).split_at_mut(r.len());
+        parts.push(part);
+        work = rest;
     }
+    parts
 }
 
 /// The scratch buffer for elements of `dofs` unknowns (one per element

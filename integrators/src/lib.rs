@@ -11,6 +11,7 @@ pub mod builder;
 pub mod constraints;
 pub mod dofs;
 pub mod dynamics;
+mod element_split;
 pub mod error;
 pub mod free_motion;
 pub mod linsolve;
