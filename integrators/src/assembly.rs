@@ -4,10 +4,12 @@
 //! element's positions in the value array are computed when the assembler is
 //! built. Each call evaluates the element kernels, reduces them with the
 //! node maps (`Gᵀ K G`, `Gᵀ r`) and sums them in element order. With more
-//! than one thread the elements are cut into contiguous chunks evaluated in
-//! parallel, each summing straight into the values it owns (see
-//! [`crate::element_split`]) — every sum is still formed in element order,
-//! so the result is bitwise the same for any number of threads.
+//! than one thread, and kernels costly enough to gain from it
+//! ([`crate::threads::LoopCost`]), the elements are cut into contiguous
+//! chunks evaluated in parallel, each summing straight into the values it
+//! owns (see [`crate::element_split`]) — every sum is still formed in
+//! element order, so the result is bitwise the same for any number of
+//! threads.
 
 use crate::dofs::DofMap;
 use faer::sparse::SymbolicSparseColMat;
@@ -16,7 +18,8 @@ use nalgebra::{DMatrix, DVector, Matrix3};
 use rayon::prelude::*;
 
 use crate::element_split::{Shared, Split};
-use crate::threads::sequential;
+use crate::threads::LoopCost;
+use std::time::Instant;
 
 struct Slots {
     /// Sorted, unique global equations the element touches.
@@ -87,6 +90,10 @@ pub struct Assembler {
     split: Option<Split>,
     /// One set of [`Self::scratch`] buffers per chunk of `split`.
     chunk_scratch: Vec<Vec<Work>>,
+    /// Whether the residual-and-tangent loop is worth splitting.
+    tangent_cost: LoopCost,
+    /// Whether the residual-only loop is worth splitting.
+    residual_cost: LoopCost,
     /// CSC values of the reduced tangent after [`Assembler::assemble`].
     pub values: Vec<f64>,
     /// Internal nodal forces, 6 per node (force, spatial moment).
@@ -194,6 +201,8 @@ impl Assembler {
             scratch,
             split: None,
             chunk_scratch: Vec::new(),
+            tangent_cost: LoopCost::default(),
+            residual_cost: LoopCost::default(),
             values: vec![0.0; nnz],
             nodal: vec![0.0; 6 * mesh.node_count()],
             nodal_abs: vec![0.0; 6 * mesh.node_count()],
@@ -226,10 +235,12 @@ impl Assembler {
                 reduce_tangent(w, el, dofs, s);
             }
         };
-        if sequential(mesh.elements.len()) {
+        let n = mesh.elements.len();
+        if !self.tangent_cost.split(n) {
             // One thread: each element is summed as soon as it is evaluated,
             // from a buffer that stays in cache (the same sums in the same
             // order as below).
+            let start = self.tangent_cost.probing(n).then(Instant::now);
             self.clear();
             for (index, (el, s)) in mesh.elements.iter().zip(&self.slots).enumerate() {
                 let w = match &s.direct {
@@ -239,6 +250,9 @@ impl Assembler {
                 element(w, index, el, s);
                 add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
                 add_tangent(&mut self.values, w, s);
+            }
+            if let Some(start) = start {
+                self.tangent_cost.record(start.elapsed(), n);
             }
             return;
         }
@@ -340,12 +354,17 @@ impl Assembler {
     where
         F: Fn(&Element, &mut [f64]) + Sync,
     {
-        if sequential(mesh.elements.len()) {
+        let n = mesh.elements.len();
+        if !self.residual_cost.split(n) {
+            let start = self.residual_cost.probing(n).then(Instant::now);
             self.clear_forces();
             for el in &mesh.elements {
                 let w = scratch_for(&mut self.scratch, el.dofs());
                 kernel(el, w.r.as_mut_slice());
                 add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
+            }
+            if let Some(start) = start {
+                self.residual_cost.record(start.elapsed(), n);
             }
             return;
         }

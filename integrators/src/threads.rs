@@ -7,15 +7,37 @@
 //! 0.14 s without. And where there is one thread, or the solve is itself one
 //! of many parallel tasks (a study's runs, [`one_thread_each`]), splitting
 //! its loops again only adds hand-offs between the same threads.
+//!
+//! Nor does a large mesh gain when its element kernels are cheap next to the
+//! rest of the step: a Newmark step of 2-node elements spends about a sixth
+//! of its time in the kernels (≈ 1 µs per element) and the rest in the band
+//! factorisation and the solves, which stay on one thread; splitting the
+//! kernels saved less than the hand-offs and the second busy core cost it
+//! (2 048 and 4 096 elements ran 1.00–1.07 × *slower* with two threads than
+//! with one). So an element loop is split only when its kernels, timed on
+//! one thread for the first few calls ([`LoopCost`]), cost at least
+//! [`PARALLEL_MIN_NS_PER_ELEMENT`] each: the energy–momentum scheme's exact
+//! tangent (≈ 24 µs, 1.5–1.6 × faster on two threads at 2 048 elements),
+//! 3-node elements (≈ 5 µs). Either way the sums are the same numbers.
 
 use std::cell::Cell;
+use std::time::Duration;
 
 /// Below this many elements a loop stays on the calling thread.
 pub const PARALLEL_MIN_ELEMENTS: usize = 64;
 
+/// Least time per element (ns) of an element loop's kernels, timed on one
+/// thread, for the loop to be split over threads.
+pub const PARALLEL_MIN_NS_PER_ELEMENT: f64 = 2000.0;
+
+/// One-thread calls timed before a loop's cost is known.
+const PROBE_CALLS: u32 = 3;
+
 thread_local! {
     /// Set while this thread runs one of many parallel tasks.
     static ONE_THREAD_EACH: Cell<bool> = const { Cell::new(false) };
+    /// Set while this thread's loops split whatever their cost.
+    static ALWAYS_SPLIT: Cell<bool> = const { Cell::new(false) };
 }
 
 /// Whether a loop over `elements` element kernels runs on the calling
@@ -42,6 +64,60 @@ pub fn one_thread_each<R>(task: impl FnOnce() -> R) -> R {
     task()
 }
 
+/// Runs `task` with every element loop that may be split ([`sequential`]
+/// false) split over the threads whatever its kernels cost: for tests of
+/// the parallel paths with cheap kernels.
+pub fn always_split<R>(task: impl FnOnce() -> R) -> R {
+    /// Restores the flag also if `task` panics.
+    struct Restore(bool);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            ALWAYS_SPLIT.with(|f| f.set(self.0));
+        }
+    }
+    let _restore = Restore(ALWAYS_SPLIT.with(|f| f.replace(true)));
+    task()
+}
+
+/// The measured cost of one element loop (one assembler's kernel), which
+/// decides whether the loop is split over threads.
+#[derive(Debug, Clone, Default)]
+pub struct LoopCost {
+    /// One-thread calls timed so far.
+    probes: u32,
+    /// The fastest of them, ns per element.
+    best: f64,
+}
+
+impl LoopCost {
+    /// Whether this call of a loop over `elements` elements is split: not
+    /// when [`sequential`], nor before its cost is known, nor when its
+    /// kernels cost less than [`PARALLEL_MIN_NS_PER_ELEMENT`] (unless
+    /// [`always_split`]).
+    pub fn split(&self, elements: usize) -> bool {
+        !sequential(elements)
+            && (ALWAYS_SPLIT.with(Cell::get)
+                || (self.probes >= PROBE_CALLS && self.best >= PARALLEL_MIN_NS_PER_ELEMENT))
+    }
+
+    /// Whether this one-thread call should be timed (the loop could be
+    /// split and its cost is not known yet).
+    pub fn probing(&self, elements: usize) -> bool {
+        !sequential(elements) && self.probes < PROBE_CALLS
+    }
+
+    /// Records a timed one-thread call over `elements` elements.
+    pub fn record(&mut self, elapsed: Duration, elements: usize) {
+        let ns = elapsed.as_secs_f64() * 1e9 / elements.max(1) as f64;
+        self.best = if self.probes == 0 {
+            ns
+        } else {
+            self.best.min(ns)
+        };
+        self.probes += 1;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -66,5 +142,38 @@ mod tests {
             assert!(!sequential(big));
         });
         pool(1).install(|| assert!(sequential(big)));
+    }
+
+    #[test]
+    fn a_loop_is_split_once_timed_as_costly_enough() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("a thread pool");
+        let big = PARALLEL_MIN_ELEMENTS;
+        let per = |ns: f64| Duration::from_secs_f64(ns * big as f64 * 1e-9);
+        pool.install(|| {
+            let (mut cheap, mut costly) = (LoopCost::default(), LoopCost::default());
+            for _ in 0..PROBE_CALLS {
+                assert!(!costly.split(big) && costly.probing(big));
+                cheap.record(per(0.5 * PARALLEL_MIN_NS_PER_ELEMENT), big);
+                // The fastest probe counts: one slow (cold) call does not.
+                costly.record(per(1.5 * PARALLEL_MIN_NS_PER_ELEMENT), big);
+            }
+            assert!(costly.split(big) && !costly.probing(big));
+            assert!(!cheap.split(big) && !cheap.probing(big));
+            assert!(always_split(|| cheap.split(big)));
+            assert!(!always_split(|| cheap.split(big - 1)));
+            // Inside a study's run, nothing is split or timed.
+            assert!(one_thread_each(
+                || !costly.split(big) && !costly.probing(big)
+            ));
+            let mut slow_first = LoopCost::default();
+            slow_first.record(per(10.0 * PARALLEL_MIN_NS_PER_ELEMENT), big);
+            for _ in 1..PROBE_CALLS {
+                slow_first.record(per(0.1 * PARALLEL_MIN_NS_PER_ELEMENT), big);
+            }
+            assert!(!slow_first.split(big));
+        });
     }
 }

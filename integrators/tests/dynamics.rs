@@ -279,7 +279,10 @@ fn energy_momentum_is_bitwise_deterministic_across_thread_counts() {
             .unwrap();
         let mut steps: Vec<StepRecord> = Vec::new();
         pool.install(|| {
-            energy_momentum::solve(&mech, &settings, &motion, |s| steps.push(s.clone())).unwrap()
+            flexmech_integrators::threads::always_split(|| {
+                energy_momentum::solve(&mech, &settings, &motion, |s| steps.push(s.clone()))
+                    .unwrap()
+            })
         });
         steps
     };

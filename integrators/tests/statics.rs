@@ -167,7 +167,9 @@ fn assembly_is_bitwise_deterministic_across_thread_counts() {
             .num_threads(threads)
             .build()
             .unwrap();
-        pool.install(|| run(&mech, &settings(3)).0)
+        // Split whatever the kernels cost (a cheap 2-node loop is otherwise
+        // kept on one thread).
+        pool.install(|| flexmech_integrators::threads::always_split(|| run(&mech, &settings(3)).0))
     };
     let one = solve_with(1);
     let two = solve_with(2);

@@ -152,7 +152,12 @@ fn the_jointed_chain_is_bitwise_the_same_on_one_two_and_three_threads() {
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            let file = pool.install(|| run_model(&model, dir.path()).unwrap().file);
+            // Every loop split, however cheap its kernels.
+            let file = pool.install(|| {
+                flexmech_integrators::threads::always_split(|| {
+                    run_model(&model, dir.path()).unwrap().file
+                })
+            });
             let bits = |name: &str| -> Vec<u64> {
                 read::<f64>(&file, name)
                     .iter()
