@@ -9,6 +9,15 @@
 //! the system's round-off floor ([`NewtonSystem::floor`]) and has stopped
 //! falling also counts as converged: no iteration can improve on it (this matters when the loads
 //! are tiny, e.g. the first steps of a ramp, and stiff internal forces round).
+//!
+//! An iterate at the floor that is still falling gets one more correction,
+//! with the factorisation of the exact tangent already made in this solve
+//! (at an iterate within [`FLOOR_REUSE_RESIDUAL`]) rather than a new
+//! tangent: a correction of round-off size gains nothing from the exact
+//! tangent there (the old one is off by terms of the size of the last
+//! increment), and a new tangent and factorisation were a third of a
+//! typical dynamic step (the 512-element cantilever under Newmark converges
+//! as `0.88, 4e-5, 2.8e-10 (floor), 3.1e-10 (stalled)`).
 
 use crate::error::NewtonFailure;
 use crate::free_motion::FreeMotion;
@@ -55,6 +64,16 @@ pub const MODIFIED_CONTRACTION: f64 = TOLERANCES.modified_contraction;
 /// tangent ([`NewtonSystem::tangent_is_exact`]) before it switches to the
 /// exact one for the rest of the solve.
 pub const INEXACT_CONTRACTION: f64 = TOLERANCES.inexact_contraction;
+
+/// Largest scaled residual of the iterate whose tangent was factorised for
+/// that factorisation to correct a later iterate at the round-off floor: it
+/// then differs from the exact tangent there by terms of that order (the
+/// size of the increment since), so the correction still gains about three
+/// orders, which is all the floor allows. (A tumbling free body whose floor
+/// sits at 1e-7 of its scaled residual reaches it straight from residuals
+/// of 0.5; corrected there with the tangent of that far iterate, its
+/// energy–momentum run lost energy at 7e-7 in 10 s instead of 2e-13.)
+pub const FLOOR_REUSE_RESIDUAL: f64 = 1e-3;
 
 /// A nonlinear system `r(q) = 0` in the reduced unknowns.
 pub trait NewtonSystem {
@@ -197,12 +216,23 @@ fn iterate<S: NewtonSystem>(
         if it == settings.max_iterations {
             break;
         }
-        let mut reuse = settings.modified
-            && if it == 0 {
+        let mut reuse = if settings.modified {
+            if it == 0 {
                 lu.key() == Some(sys.tangent_key())
             } else {
                 res < MODIFIED_CONTRACTION * history[it - 1]
-            };
+            }
+        } else {
+            // At the floor, still falling: a round-off correction with
+            // this solve's factorisation of the exact tangent, made close to
+            // the solution (see the module's notes and
+            // `FLOOR_REUSE_RESIDUAL`).
+            *factored
+                && it > 0
+                && norm <= sys.floor()
+                && history[it - 1] <= FLOOR_REUSE_RESIDUAL
+                && sys.tangent_is_exact()
+        };
         let slow = if settings.modified {
             !reuse
         } else {

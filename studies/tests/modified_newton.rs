@@ -67,7 +67,13 @@ fn the_free_chain_follows_full_newton_with_every_joint_kind() {
              {full_factorizations} / {full_iterations}"
         );
         assert!(worst <= SAME_SOLUTION, "{integrator}: {worst:e}");
-        assert_eq!(full_factorizations, full_iterations);
+        // Full Newton factorises at every iteration but the round-off
+        // corrections at the floor (rare here: at most one a step).
+        assert!(
+            full_factorizations <= full_iterations
+                && full_factorizations + steps as u64 >= full_iterations,
+            "{integrator}: full Newton {full_factorizations} factorisations / {full_iterations} iterations"
+        );
         assert!(
             (factorizations as usize) < steps,
             "{integrator}: {factorizations} factorisations for {steps} steps"
