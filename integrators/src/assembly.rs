@@ -599,14 +599,14 @@ fn add_tangent(values: &mut [f64], w: &Work, s: &Slots) {
 }
 
 /// The arrays the chunks of a parallel loop add into.
-struct Sinks {
-    values: Shared,
-    nodal: Shared,
-    nodal_abs: Shared,
+struct Sinks<'a> {
+    values: Shared<'a>,
+    nodal: Shared<'a>,
+    nodal_abs: Shared<'a>,
 }
 
-impl Sinks {
-    fn new(values: &mut [f64], nodal: &mut [f64], nodal_abs: &mut [f64]) -> Self {
+impl<'a> Sinks<'a> {
+    fn new(values: &'a mut [f64], nodal: &'a mut [f64], nodal_abs: &'a mut [f64]) -> Self {
         Self {
             values: Shared::new(values),
             nodal: Shared::new(nodal),

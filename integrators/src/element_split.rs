@@ -22,6 +22,7 @@
 //! older scheme made a 2 048-element cantilever *slower* with two threads
 //! than with one (1.32 s against 1.10 s).
 
+use std::marker::PhantomData;
 use std::ops::Range;
 
 /// No chunk owns this (no element adds to it).
@@ -134,26 +135,28 @@ impl Split {
 /// An array that several chunks add into at once, each only at what it
 /// owns (see [`Split`]).
 #[derive(Clone, Copy)]
-pub(crate) struct Shared {
+pub(crate) struct Shared<'a> {
     ptr: *mut f64,
     len: usize,
+    /// The array stays borrowed, mutably, as long as this lives.
+    array: PhantomData<&'a mut [f64]>,
 }
 
 // SAFETY: `Shared` is only a pointer and a length; the positions added to by
 // `Shared::add` are disjoint between threads by the ownership of `Split`
-// (the caller's obligation), and the array outlives the parallel phase (it
-// is borrowed mutably for the whole of it by `Shared::new`'s caller).
-unsafe impl Send for Shared {}
+// (the caller's obligation), and the array stays mutably borrowed as long
+// as the `Shared` lives (its lifetime), so nothing else touches it.
+unsafe impl Send for Shared<'_> {}
 // SAFETY: as for `Send`.
-unsafe impl Sync for Shared {}
+unsafe impl Sync for Shared<'_> {}
 
-impl Shared {
-    /// Shares `values` for the duration of a parallel phase; the caller
-    /// must not touch `values` otherwise until that phase ends.
-    pub fn new(values: &mut [f64]) -> Self {
+impl<'a> Shared<'a> {
+    /// Shares `values` (borrowed for as long as the result lives).
+    pub fn new(values: &'a mut [f64]) -> Self {
         Self {
             ptr: values.as_mut_ptr(),
             len: values.len(),
+            array: PhantomData,
         }
     }
 
