@@ -213,7 +213,9 @@ impl ReleasedDerivatives {
 /// The released block of the transfer in the master's frame: with
 /// `G_x = R_mᵀ g_x`, `G_φ = R_mᵀ g_φ` and
 /// `w(a, b) = G_x·(r_R(a, b) − r_R(0, b)) + G_φ·spin(Λ_R(a, b) Λ_R(0, b)ᵀ)`,
-/// `(∂w/∂a, ∂²w/∂a∂b)` at zero — hyper-dual AD over the released lanes only.
+/// `(∂w/∂a, ∂²w/∂a∂b)` at zero — hyper-dual AD over the released lanes only,
+/// as many as the joint releases (a revolute's hyper-duals carry 4 numbers,
+/// not the 25 of [`MAX_RELEASED`] lanes).
 fn released_transfer<J: JointKinematics>(
     joint: &J,
     state: &ReleasedState,
@@ -223,10 +225,37 @@ fn released_transfer<J: JointKinematics>(
     SVector<f64, MAX_RELEASED>,
     SMatrix<f64, MAX_RELEASED, MAX_RELEASED>,
 ) {
-    type H = HyperDualSVec64<MAX_RELEASED, MAX_RELEASED>;
-    let a: [H; MAX_RELEASED] = std::array::from_fn(|i| H::from_re(0.0).derivative1(i));
-    let b: [H; MAX_RELEASED] = std::array::from_fn(|i| H::from_re(0.0).derivative2(i));
-    let zero = [H::from_re(0.0); MAX_RELEASED];
+    match released_count::<J>() {
+        0 => (SVector::zeros(), SMatrix::zeros()),
+        1 => released_transfer_in::<J, 1>(joint, state, gx, gp),
+        2 => released_transfer_in::<J, 2>(joint, state, gx, gp),
+        3 => released_transfer_in::<J, 3>(joint, state, gx, gp),
+        _ => released_transfer_in::<J, MAX_RELEASED>(joint, state, gx, gp),
+    }
+}
+
+/// [`released_transfer`] over `N` released lanes (the rest of the result
+/// zero).
+fn released_transfer_in<J: JointKinematics, const N: usize>(
+    joint: &J,
+    state: &ReleasedState,
+    gx: &Vector3<f64>,
+    gp: &Vector3<f64>,
+) -> (
+    SVector<f64, MAX_RELEASED>,
+    SMatrix<f64, MAX_RELEASED, MAX_RELEASED>,
+) {
+    let lane = |i: usize, first: bool| {
+        let x = HyperDualSVec64::<N, N>::from_re(0.0);
+        match (i < N, first) {
+            (true, true) => x.derivative1(i),
+            (true, false) => x.derivative2(i),
+            (false, _) => x,
+        }
+    };
+    let a: [HyperDualSVec64<N, N>; MAX_RELEASED] = std::array::from_fn(|i| lane(i, true));
+    let b: [HyperDualSVec64<N, N>; MAX_RELEASED] = std::array::from_fn(|i| lane(i, false));
+    let zero = [HyperDualSVec64::<N, N>::from_re(0.0); MAX_RELEASED];
     let (r1, l1) = joint.released_at_state(
         state,
         Increments {
@@ -242,18 +271,21 @@ fn released_transfer<J: JointKinematics>(
         },
     );
     let m = l1 * l0.transpose();
-    let half = H::from_re(0.5);
+    let half = HyperDualSVec64::<N, N>::from_re(0.5);
     let spin = Vector3::new(
         (m[(2, 1)] - m[(1, 2)]) * half,
         (m[(0, 2)] - m[(2, 0)]) * half,
         (m[(1, 0)] - m[(0, 1)]) * half,
     );
-    let w = (r1 - r0).dot(&gx.map(H::from_re)) + spin.dot(&gp.map(H::from_re));
-    (
-        w.eps1.unwrap_generic(Const::<MAX_RELEASED>, U1),
-        w.eps1eps2
-            .unwrap_generic(Const::<MAX_RELEASED>, Const::<MAX_RELEASED>),
-    )
+    let w = (r1 - r0).dot(&gx.map(HyperDualSVec64::<N, N>::from_re))
+        + spin.dot(&gp.map(HyperDualSVec64::<N, N>::from_re));
+    let first = w.eps1.unwrap_generic(Const::<N>, U1);
+    let second = w.eps1eps2.unwrap_generic(Const::<N>, Const::<N>);
+    let mut d1 = SVector::<f64, MAX_RELEASED>::zeros();
+    let mut d2 = SMatrix::<f64, MAX_RELEASED, MAX_RELEASED>::zeros();
+    d1.fixed_rows_mut::<N>(0).copy_from(&first);
+    d2.fixed_view_mut::<N, N>(0, 0).copy_from(&second);
+    (d1, d2)
 }
 
 impl<J: JointKinematics> JointMap for J {

@@ -305,9 +305,18 @@ pub fn released_count<J: JointKinematics + ?Sized>() -> usize {
     <J::Coordinates as Coordinates>::COUNT
 }
 
-/// `exp(φ t̂)` for a unit axis `t` and an angle `φ` (one-axis released rotation).
+/// `exp(φ t̂)` for a unit axis `t` and an angle `φ` (one-axis released
+/// rotation), by Rodrigues' formula `I + sin φ t̂ + (1 − cos φ) t̂²`: one sine
+/// and one cosine of the (dual) angle times constant matrices, where the
+/// general `exp` of the vector `φt` would take its norm and series in duals.
 pub fn axis_rotation<T: Scalar>(axis: &Vector3<f64>, angle: T) -> Matrix3<T> {
-    exp(&(axis.map(cst::<T>) * angle))
+    let t = skew(axis);
+    let t2 = t * t;
+    let (s, c) = (angle.sin(), T::one() - angle.cos());
+    Matrix3::from_fn(|i, j| {
+        let id = if i == j { T::one() } else { T::zero() };
+        id + s * cst::<T>(t[(i, j)]) + c * cst::<T>(t2[(i, j)])
+    })
 }
 
 /// `â` for an `f64` vector (re-exported for the joint kinds' closed forms).
@@ -390,4 +399,40 @@ pub(crate) fn released_at<J: JointKinematics + ?Sized, T: Scalar>(
 
 fn stack<T: Scalar>(a: &Vector3<T>, b: &Vector3<T>) -> Vector6<T> {
     Vector6::new(a.x, a.y, a.z, b.x, b.y, b.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axis_rotation_is_the_exponential_with_its_derivatives() {
+        // Rodrigues' formula against the general exponential of `φt`, in
+        // value and in the first and second derivatives in the angle
+        // (hyper-dual), from zero through a small angle to beyond a turn.
+        type H = HyperDualSVec64<1, 1>;
+        let axes = [
+            Vector3::z(),
+            Vector3::new(1.0, -2.0, 0.5).normalize(),
+            Vector3::new(0.0, 0.6, 0.8),
+        ];
+        for axis in axes {
+            for phi in [0.0, 1e-9, 0.3, 2.0, 3.1, 7.0, -4.5] {
+                let angle = H::from_re(phi).derivative1(0).derivative2(0);
+                let ours = axis_rotation(&axis, angle);
+                let general = exp(&(axis.map(cst::<H>) * angle));
+                for (a, b) in ours.iter().zip(general.iter()) {
+                    let parts = |x: &H| {
+                        let e1 = x.eps1.unwrap_generic(Const::<1>, U1);
+                        let e2 = x.eps2.unwrap_generic(U1, Const::<1>);
+                        let e12 = x.eps1eps2.unwrap_generic(Const::<1>, Const::<1>);
+                        [x.re, e1[0], e2[0], e12[(0, 0)]]
+                    };
+                    for (p, q) in parts(a).iter().zip(parts(b)) {
+                        assert!((p - q).abs() <= 1e-14, "{axis:?} {phi}: {p} vs {q}");
+                    }
+                }
+            }
+        }
+    }
 }
