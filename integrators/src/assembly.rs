@@ -256,8 +256,24 @@ impl Assembler {
             }
             return;
         }
+        self.split_loop(mesh, true, element);
+    }
+
+    /// The element loop over the chunks of [`Self::split`]: `evaluate(w,
+    /// index, element, slots)` fills `w` (with `tangent`, the residual and
+    /// the reduced tangent; otherwise the residual `w.r`), which is added to
+    /// the nodal forces (and the tangent values) as [`crate::element_split`]
+    /// says.
+    fn split_loop<F>(&mut self, mesh: &Mesh, tangent: bool, evaluate: F)
+    where
+        F: Fn(&mut Work, usize, &Element, &Slots) + Sync,
+    {
         self.split_for(mesh);
-        self.clear();
+        if tangent {
+            self.clear();
+        } else {
+            self.clear_forces();
+        }
         let Self {
             slots,
             work,
@@ -280,21 +296,25 @@ impl Assembler {
                 for (w_own, index) in part.iter_mut().zip(split.chunks[c].clone()) {
                     let (el, s) = (&mesh.elements[index], &slots[index]);
                     let late = split.is_late(index);
-                    let w = match &s.direct {
-                        Some(_) if !late => scratch_for(scratch, el.dofs()),
-                        _ => w_own,
+                    // Late elements keep their output for the second phase;
+                    // reduced tangents need the element's own buffers.
+                    let w = if late || (tangent && s.direct.is_none()) {
+                        w_own
+                    } else {
+                        scratch_for(scratch, el.dofs())
                     };
-                    element(w, index, el, s);
+                    evaluate(w, index, el, s);
+                    let s = tangent.then_some(s);
                     // SAFETY: chunk `c` adds only what it owns (all of it
                     // for an element that is not late).
-                    unsafe { sinks.add(el, w, Some(s), late.then_some((split, c, true))) };
+                    unsafe { sinks.add(el, w, s, late.then_some((split, c, true))) };
                 }
             });
         for &index in &split.late {
             let c = split.chunk_of(index);
-            let (el, s) = (&mesh.elements[index], &slots[index]);
+            let (el, s) = (&mesh.elements[index], tangent.then_some(&slots[index]));
             // SAFETY: the parallel phase is over.
-            unsafe { sinks.add(el, &work[index], Some(s), Some((split, c, false))) };
+            unsafe { sinks.add(el, &work[index], s, Some((split, c, false))) };
         }
     }
 
@@ -368,51 +388,7 @@ impl Assembler {
             }
             return;
         }
-        self.split_for(mesh);
-        self.clear_forces();
-        let Self {
-            work,
-            split: Some(split),
-            chunk_scratch,
-            values,
-            nodal,
-            nodal_abs,
-            ..
-        } = self
-        else {
-            return;
-        };
-        let sinks = Sinks::new(values, nodal, nodal_abs);
-        chunk_parts(work, split)
-            .into_par_iter()
-            .zip(chunk_scratch.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, (part, scratch))| {
-                for (w_own, index) in part.iter_mut().zip(split.chunks[c].clone()) {
-                    let el = &mesh.elements[index];
-                    let late = split.is_late(index);
-                    let w = if late {
-                        w_own
-                    } else {
-                        scratch_for(scratch, el.dofs())
-                    };
-                    kernel(el, w.r.as_mut_slice());
-                    // SAFETY: as in `assemble_with`.
-                    unsafe { sinks.add(el, w, None, late.then_some((split, c, true))) };
-                }
-            });
-        for &index in &split.late {
-            let c = split.chunk_of(index);
-            // SAFETY: the parallel phase is over.
-            unsafe {
-                sinks.add(
-                    &mesh.elements[index],
-                    &work[index],
-                    None,
-                    Some((split, c, false)),
-                )
-            };
-        }
+        self.split_loop(mesh, false, |w, _, el, _| kernel(el, w.r.as_mut_slice()));
     }
 
     /// Adds the dense matrix `m` (column-major over block `b`'s equations) to

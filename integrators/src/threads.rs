@@ -21,6 +21,7 @@
 //! 3-node elements (≈ 5 µs). Either way the sums are the same numbers.
 
 use std::cell::Cell;
+use std::thread::LocalKey;
 use std::time::Duration;
 
 /// Below this many elements a loop stays on the calling thread.
@@ -53,14 +54,19 @@ pub fn sequential(elements: usize) -> bool {
 /// that is one of many tasks already spread over the threads (a study's
 /// runs), where the threads are busy with the other tasks.
 pub fn one_thread_each<R>(task: impl FnOnce() -> R) -> R {
-    /// Restores the flag also if `task` panics.
-    struct Restore(bool);
+    with_flag(&ONE_THREAD_EACH, task)
+}
+
+/// Runs `task` with this thread's `flag` set, and restores it afterwards
+/// (also if `task` panics).
+fn with_flag<R>(flag: &'static LocalKey<Cell<bool>>, task: impl FnOnce() -> R) -> R {
+    struct Restore(&'static LocalKey<Cell<bool>>, bool);
     impl Drop for Restore {
         fn drop(&mut self) {
-            ONE_THREAD_EACH.with(|f| f.set(self.0));
+            self.0.with(|f| f.set(self.1));
         }
     }
-    let _restore = Restore(ONE_THREAD_EACH.with(|f| f.replace(true)));
+    let _restore = Restore(flag, flag.with(|f| f.replace(true)));
     task()
 }
 
@@ -68,15 +74,7 @@ pub fn one_thread_each<R>(task: impl FnOnce() -> R) -> R {
 /// false) split over the threads whatever its kernels cost: for tests of
 /// the parallel paths with cheap kernels.
 pub fn always_split<R>(task: impl FnOnce() -> R) -> R {
-    /// Restores the flag also if `task` panics.
-    struct Restore(bool);
-    impl Drop for Restore {
-        fn drop(&mut self) {
-            ALWAYS_SPLIT.with(|f| f.set(self.0));
-        }
-    }
-    let _restore = Restore(ALWAYS_SPLIT.with(|f| f.replace(true)));
-    task()
+    with_flag(&ALWAYS_SPLIT, task)
 }
 
 /// The measured cost of one element loop (one assembler's kernel), which

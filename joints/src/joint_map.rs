@@ -210,6 +210,12 @@ impl ReleasedDerivatives {
     }
 }
 
+/// `(∂w/∂a, ∂²w/∂a∂b)` of [`released_transfer`].
+type ReleasedTransfer = (
+    SVector<f64, MAX_RELEASED>,
+    SMatrix<f64, MAX_RELEASED, MAX_RELEASED>,
+);
+
 /// The released block of the transfer in the master's frame: with
 /// `G_x = R_mᵀ g_x`, `G_φ = R_mᵀ g_φ` and
 /// `w(a, b) = G_x·(r_R(a, b) − r_R(0, b)) + G_φ·spin(Λ_R(a, b) Λ_R(0, b)ᵀ)`,
@@ -221,10 +227,7 @@ fn released_transfer<J: JointKinematics>(
     state: &ReleasedState,
     gx: &Vector3<f64>,
     gp: &Vector3<f64>,
-) -> (
-    SVector<f64, MAX_RELEASED>,
-    SMatrix<f64, MAX_RELEASED, MAX_RELEASED>,
-) {
+) -> ReleasedTransfer {
     match released_count::<J>() {
         0 => (SVector::zeros(), SMatrix::zeros()),
         1 => released_transfer_in::<J, 1>(joint, state, gx, gp),
@@ -241,10 +244,7 @@ fn released_transfer_in<J: JointKinematics, const N: usize>(
     state: &ReleasedState,
     gx: &Vector3<f64>,
     gp: &Vector3<f64>,
-) -> (
-    SVector<f64, MAX_RELEASED>,
-    SMatrix<f64, MAX_RELEASED, MAX_RELEASED>,
-) {
+) -> ReleasedTransfer {
     let lane = |i: usize, first: bool| {
         let x = HyperDualSVec64::<N, N>::from_re(0.0);
         match (i < N, first) {
