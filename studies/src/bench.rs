@@ -4,6 +4,9 @@
 //! variant and with 3-node elements, as microseconds per step and per
 //! element-step — and as ratios to Newmark with full Newton measured in the
 //! same run, which is what carries over between machines on a shared one.
+//! Then the mechanisms of `data/benchmarks/` (the four-bar with a misaligned
+//! joint and the slider-crank), each a whole run of the published benchmark
+//! with each integrator that applies.
 
 use crate::model::parse_model;
 use crate::run::{run_model, RunError};
@@ -73,6 +76,8 @@ pub const CASES: [Case; 7] = [
 /// One timed run.
 #[derive(Debug, Clone)]
 pub struct Timing {
+    /// The model: `cantilever` (the yardstick) or a [`Mechanism`]'s name.
+    pub model: &'static str,
     /// What ran.
     pub case: Case,
     /// Elements of 2 nodes (or the 3-node mesh with the same unknowns).
@@ -180,6 +185,105 @@ pub fn bench(
     Ok(timings)
 }
 
+/// The yardstick's name in the timings.
+pub const CANTILEVER: &str = "cantilever";
+
+/// A mechanism of `data/benchmarks/` timed by `flexmech bench` (the file's
+/// text is built into the binary, so the command runs anywhere).
+#[derive(Debug, Clone, Copy)]
+pub struct Mechanism {
+    /// The name `--mechanisms` takes and the tables show.
+    pub name: &'static str,
+    /// The model file's text (generalized-α as published).
+    pub text: &'static str,
+}
+
+/// The mechanisms `flexmech bench` times after the cantilever.
+pub const MECHANISMS: [Mechanism; 2] = [
+    Mechanism {
+        name: "four-bar",
+        text: include_str!("../../data/benchmarks/four_bar.toml"),
+    },
+    Mechanism {
+        name: "slider-crank",
+        text: include_str!("../../data/benchmarks/slider_crank.toml"),
+    },
+];
+
+/// The cases a mechanism runs with: the 2-node cases (its mesh is the
+/// file's).
+pub fn mechanism_cases() -> impl Iterator<Item = &'static Case> {
+    CASES.iter().filter(|c| c.nodes_per_element == 2)
+}
+
+/// A mechanism's model text run with `case`'s integrator and Newton: the
+/// file's `integrator` line replaced, its `rho_inf` kept for
+/// generalized-α only.
+pub fn mechanism_text(mechanism: &Mechanism, case: &Case) -> String {
+    let mut text = String::with_capacity(mechanism.text.len() + 64);
+    for line in mechanism.text.lines() {
+        let key = line.split('=').next().unwrap_or("").trim();
+        match key {
+            "integrator" => {
+                let _ = writeln!(
+                    text,
+                    "integrator = \"{}\"\nnewton = \"{}\"",
+                    case.integrator, case.newton
+                );
+            }
+            // Replaced with the integrator line.
+            "newton" => {}
+            "rho_inf" if case.integrator != "generalized-alpha" => {}
+            _ => {
+                text.push_str(line);
+                text.push('\n');
+            }
+        }
+    }
+    text
+}
+
+/// Times the named mechanisms with each of their cases, `rounds` times
+/// interleaved, keeping each case's fastest run (as [`bench`]).
+/// `progress` is called with each kept timing once its mechanism is done.
+pub fn bench_mechanisms(
+    mechanisms: &[Mechanism],
+    rounds: usize,
+    out: &Path,
+    mut progress: impl FnMut(&Timing),
+) -> Result<Vec<Timing>, RunError> {
+    let mut timings = Vec::new();
+    for mechanism in mechanisms {
+        let cases: Vec<&Case> = mechanism_cases().collect();
+        let mut fastest: Vec<Option<Timing>> = vec![None; cases.len()];
+        for _ in 0..rounds.max(1) {
+            for (case, kept) in cases.iter().zip(fastest.iter_mut()) {
+                let text = mechanism_text(mechanism, case);
+                let path = PathBuf::from(format!(
+                    "bench-{}-{}.toml",
+                    mechanism.name,
+                    case.label.replace('/', "-")
+                ));
+                let elements = parse_model(&text, &path)
+                    .map_err(RunError::from)?
+                    .beams
+                    .iter()
+                    .map(|b| b.elements)
+                    .sum();
+                let t = timed_run(mechanism.name, case, &text, &path, elements, out)?;
+                if kept.as_ref().is_none_or(|k| t.seconds < k.seconds) {
+                    *kept = Some(t);
+                }
+            }
+        }
+        for t in fastest.into_iter().flatten() {
+            progress(&t);
+            timings.push(t);
+        }
+    }
+    Ok(timings)
+}
+
 /// One run of `case` at `elements`, its result file under `out`.
 fn time_case(case: &Case, elements: usize, steps: usize, out: &Path) -> Result<Timing, RunError> {
     let text = model_text(case, elements, steps);
@@ -187,10 +291,23 @@ fn time_case(case: &Case, elements: usize, steps: usize, out: &Path) -> Result<T
         "bench-{}-{elements}.toml",
         case.label.replace('/', "-")
     ));
-    let model = parse_model(&text, &path).map_err(RunError::from)?;
+    timed_run(CANTILEVER, case, &text, &path, elements, out)
+}
+
+/// Parses and runs `text` (read as if from `path`), timing its steps.
+fn timed_run(
+    model: &'static str,
+    case: &Case,
+    text: &str,
+    path: &Path,
+    elements: usize,
+    out: &Path,
+) -> Result<Timing, RunError> {
+    let parsed = parse_model(text, path).map_err(RunError::from)?;
     let dir = out.join(path.with_extension(""));
-    let summary = run_model(&model, &dir)?;
+    let summary = run_model(&parsed, &dir)?;
     Ok(Timing {
+        model,
         case: *case,
         elements,
         // The summary counts the initial record too.
@@ -221,20 +338,23 @@ pub fn machine() -> String {
 }
 
 /// A Markdown table of the timings, with each run's ratio to the reference
-/// case (Newmark, full Newton) at the same size.
+/// case (Newmark, full Newton) of the same model and size.
 pub fn table(timings: &[Timing]) -> String {
     let mut s = String::from(
-        "| elements | case | steps | iterations | µs/step | µs/(element·step) | / newmark | set-up ms |\n\
-         |---|---|---|---|---|---|---|---|\n",
+        "| model | elements | case | steps | iterations | µs/step | µs/(element·step) | / newmark | set-up ms |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
     );
     for t in timings {
         let reference = timings
             .iter()
-            .find(|r| r.elements == t.elements && r.case.label == CASES[0].label)
+            .find(|r| {
+                r.model == t.model && r.elements == t.elements && r.case.label == CASES[0].label
+            })
             .map_or(f64::NAN, |r| t.seconds / r.seconds);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.0} | {:.2} | {:.2} | {:.1} |",
+            "| {} | {} | {} | {} | {} | {:.0} | {:.2} | {:.2} | {:.1} |",
+            t.model,
             t.elements,
             t.case.label,
             t.steps,

@@ -182,7 +182,8 @@ enum Command {
     },
     /// Time steps of the yardstick cantilever (2 m, tip force, dt = 1e-3)
     /// at several mesh sizes with each integrator, modified Newton and
-    /// 3-node elements.
+    /// 3-node elements; then the four-bar and slider-crank benchmarks with
+    /// each integrator.
     ///
     /// Prints the machine, then µs per step, µs per element-step and the
     /// ratio to Newmark with full Newton at the same size (ratios carry over
@@ -203,6 +204,11 @@ enum Command {
         /// only adds time).
         #[arg(long, default_value_t = 3)]
         rounds: usize,
+        /// Mechanisms of data/benchmarks timed after the cantilever, each a
+        /// whole run of the benchmark with each 2-node case (`none` for
+        /// none).
+        #[arg(long, value_delimiter = ',', default_values_t = ["four-bar".to_string(), "slider-crank".to_string()])]
+        mechanisms: Vec<String>,
         /// Output directory.
         #[arg(long, short, default_value = "bench")]
         out: PathBuf,
@@ -510,18 +516,38 @@ fn execute(cli: Cli) -> ExitCode {
             elements,
             steps,
             rounds,
+            mechanisms,
             out,
         } => {
             use crate::bench;
+            let mut chosen = Vec::new();
+            for name in mechanisms.iter().filter(|n| n.as_str() != "none") {
+                match bench::MECHANISMS.iter().find(|m| m.name == name.as_str()) {
+                    Some(m) => chosen.push(*m),
+                    None => {
+                        let known: Vec<&str> = bench::MECHANISMS.iter().map(|m| m.name).collect();
+                        eprintln!(
+                            "error: --mechanisms: no mechanism `{name}`; fix: one of {} or `none`",
+                            known.join(", ")
+                        );
+                        return ExitCode::FAILURE;
+                    }
+                }
+            }
             println!("{}", bench::machine());
-            let outcome = bench::bench(&elements, steps, rounds, &out, |t| {
+            let show = |t: &bench::Timing| {
                 println!(
-                    "{:>6} elements  {:<26} {:>9.0} µs/step  {:>7.2} µs/(element·step)",
+                    "{:<12} {:>6} elements  {:<26} {:>9.0} µs/step  {:>7.2} µs/(element·step)",
+                    t.model,
                     t.elements,
                     t.case.label,
                     t.per_step_us(),
                     t.per_element_step_us()
                 );
+            };
+            let outcome = bench::bench(&elements, steps, rounds, &out, show).and_then(|mut all| {
+                all.extend(bench::bench_mechanisms(&chosen, rounds, &out, show)?);
+                Ok(all)
             });
             match outcome {
                 Ok(timings) => {
