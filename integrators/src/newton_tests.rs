@@ -103,7 +103,14 @@ fn a_poor_cheap_tangent_is_replaced_by_the_exact_one() {
         .windows(2)
         .filter(|w| w[1] > INEXACT_CONTRACTION * w[0])
         .count();
-    assert!(slow <= 2, "history {:?}", report.history);
+    // The first correction is not judged (INEXACT_JUDGED_FROM), the second
+    // switches, and this system's tangent comes with its residual, so the
+    // switch shows one correction later: at most three slow ones.
+    assert!(
+        slow <= INEXACT_JUDGED_FROM + 1,
+        "history {:?}",
+        report.history
+    );
     // The same solve with the exact tangent throughout never uses the
     // cheap one.
     let mut exact = Cubic::new(2.0);
