@@ -67,10 +67,10 @@ pub const INEXACT_CONTRACTION: f64 = TOLERANCES.inexact_contraction;
 /// First iteration whose contraction judges an approximate tangent: the
 /// second. The first correction starts from the step's predictor, and how
 /// far it gets is set by the residual's curvature over that distance, not
-/// by the tangent (with the exact tangent too it cuts the residual only
-/// 10–50-fold on the four-bar of `data/benchmarks`, where the cheap tangent's
-/// later iterations contract 10⁴-fold); judging it there switched 38 % of
-/// that model's energy–momentum steps to the exact tangent for nothing.
+/// by the tangent: on the four-bar of `data/benchmarks` it cuts the residual
+/// less than 20-fold in 38 % of the energy–momentum steps with the exact
+/// tangent and with the cheap one alike (whose later iterations contract
+/// about 10⁴-fold), so judging it switched those steps for nothing.
 pub const INEXACT_JUDGED_FROM: usize = 2;
 
 /// Largest scaled residual of the iterate whose tangent was factorised for
