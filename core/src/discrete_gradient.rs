@@ -224,9 +224,19 @@ impl BeamElement<2> {
         start: &Pose<T>,
         end: &Pose<T>,
     ) -> SVector<T, 12> {
+        self.energy_momentum_force_parts(start, end).0
+    }
+
+    /// [`Self::energy_momentum_force`] and, separately, the part of it due
+    /// to the rank-one corrections (as [`Self::discrete_gradient_parts`]).
+    pub fn energy_momentum_force_parts<T: Scalar>(
+        &self,
+        start: &Pose<T>,
+        end: &Pose<T>,
+    ) -> (SVector<T, 12>, SVector<T, 12>) {
         let (s, e) = (self.frames(start), self.frames(end));
         let (nbar, mbar) = self.averaged_resultants(&s, &e);
-        step_force(&dg_step_of(&s, &e), &nbar, &mbar).0
+        step_force(&dg_step_of(&s, &e), &nbar, &mbar)
     }
 
     /// The step averages `(N̄, M̄)` of the resultants of two poses.

@@ -25,7 +25,7 @@
 use super::bordered::{self, Bordered};
 use super::checkpoint::{CheckpointMismatch, Tape};
 use super::mass_slots::MassSlots;
-use super::midpoint_kernels::{correction_size, element_force, element_kernel};
+use super::midpoint_kernels::{correction_size, element_force, element_kernel, CorrectionTally};
 use super::time_scheme::TimeScheme;
 pub use super::Scheme;
 use super::{increment_work, slave_velocities, Motion};
@@ -128,6 +128,9 @@ pub(crate) struct MidpointTerms {
     /// Whether the energy–momentum scheme's exact tangent is asked for
     /// (see [`NewtonSystem::set_exact_tangent`](crate::newton::NewtonSystem::set_exact_tangent)).
     exact_tangent: bool,
+    /// The energy–momentum scheme's correction sizes at the last residual
+    /// evaluation.
+    tally: CorrectionTally,
 }
 
 impl MidpointTerms {
@@ -166,6 +169,7 @@ impl MidpointTerms {
             w_n,
             rates,
             exact_tangent: true,
+            tally: CorrectionTally::default(),
         }
     }
 }
@@ -184,14 +188,16 @@ impl StepTerms for MidpointTerms {
         end: &Configuration,
         tangent: bool,
     ) {
-        let (scheme, beta, exact) = (self.scheme, self.beta, self.exact_tangent);
+        let (scheme, beta, exact, tally) =
+            (self.scheme, self.beta, self.exact_tangent, &self.tally);
+        tally.start(!tangent);
         if tangent {
             asm.assemble_with(&mech.mesh, dofs, |el, _, re, ke| {
                 element_kernel(el, start, end, scheme, beta, exact, re, ke)
             });
         } else {
             asm.assemble_residual_with(&mech.mesh, |el, re| {
-                element_force(el, start, end, scheme, beta, re)
+                element_force(el, start, end, scheme, beta, tally, re)
             });
         }
     }
@@ -304,7 +310,14 @@ impl TimeScheme for MidpointTerms {
         match sys.terms.scheme {
             Scheme::Momentum => newton::solve(sys, lu, settings, r, dq).map(|rep| (rep, f64::NAN)),
             Scheme::EnergyMomentum => newton::solve(sys, lu, settings, r, dq).map(|rep| {
-                let size = correction_size(sys.mech, &sys.start.config, &sys.end.config);
+                // Newton's last evaluation was at the accepted iterate.
+                let size = sys
+                    .terms
+                    .tally
+                    .correction_size(sys.mech)
+                    .unwrap_or_else(|| {
+                        correction_size(sys.mech, &sys.start.config, &sys.end.config)
+                    });
                 (rep, size)
             }),
             Scheme::EnergyMomentumPaper => bordered::solve_step(sys, lu, settings),

@@ -10,6 +10,7 @@ use flexmech_core::rotation::exp;
 use flexmech_core::{cst, BeamElement, Configuration, Element, Scalar};
 use nalgebra::{Const, SVector, Vector3, U1};
 use num_dual::DualSVec64;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Dual numbers for derivatives with respect to an element's 12 increments.
 pub(crate) type Dual12 = DualSVec64<12>;
@@ -138,13 +139,16 @@ pub(crate) fn element_kernel(
 }
 
 /// The element force of [`element_kernel`] alone (no derivative): for
-/// residual checks that no factorisation follows.
+/// residual checks that no factorisation follows. The energy–momentum
+/// scheme's 2-node elements add the sizes of their force and of its
+/// rank-one corrections to `tally`.
 pub(crate) fn element_force(
     el: &Element,
     start: &Configuration,
     end: &Configuration,
     scheme: Scheme,
     beta: f64,
+    tally: &CorrectionTally,
     r: &mut [f64],
 ) {
     let q = match (el, scheme) {
@@ -154,7 +158,9 @@ pub(crate) fn element_force(
                 let (nbar, mbar) = averaged_resultants(e, &s, &t);
                 e.midpoint_force(&s, &t, &nbar, &mbar, MidRotation::Geodesic)
             } else {
-                e.energy_momentum_force(&s, &t)
+                let (q, c) = e.energy_momentum_force_parts(&s, &t);
+                tally.add(c.norm(), q.norm());
+                q
             }
         }
         (Element::Quadratic(e), _) => {
@@ -237,12 +243,15 @@ pub fn correction_size(mech: &Mechanism, start: &Configuration, end: &Configurat
     let (mut corr, mut size) = (0.0f64, 0.0f64);
     for el in &mech.mesh.elements {
         let Element::Linear(e) = el else { continue };
-        let (s, t) = (pose_of(e, start), pose_of(e, end));
-        let (nbar, mbar) = averaged_resultants(e, &s, &t);
-        let (q, c) = e.discrete_gradient_parts(&s, &t, &nbar, &mbar);
+        let (q, c) = e.energy_momentum_force_parts(&pose_of(e, start), &pose_of(e, end));
         corr = corr.max(c.norm());
         size = size.max(q.norm());
     }
+    correction_ratio(mech, corr, size)
+}
+
+/// [`correction_size`] from the largest correction and force sizes.
+fn correction_ratio(mech: &Mechanism, corr: f64, size: f64) -> f64 {
     let linear = mech
         .mesh
         .elements
@@ -254,5 +263,45 @@ pub fn correction_size(mech: &Mechanism, start: &Configuration, end: &Configurat
         corr / size
     } else {
         0.0
+    }
+}
+
+/// The largest correction and force sizes of the energy–momentum scheme's
+/// 2-node elements over one residual evaluation ([`element_force`]), so
+/// that a converged step's [`correction_size`] comes from Newton's last
+/// evaluation — at the accepted iterate — instead of another pass over the
+/// elements. The maxima are of non-negative numbers (compared through their
+/// bits), so they do not depend on the order the element loop's threads
+/// add them in.
+#[derive(Debug, Default)]
+pub(crate) struct CorrectionTally {
+    corr: AtomicU64,
+    size: AtomicU64,
+    /// Whether the last evaluation was a residual alone (which tallies);
+    /// a tangent evaluation does not.
+    complete: AtomicBool,
+}
+
+impl CorrectionTally {
+    /// Starts an evaluation: one that tallies (`complete`) or not.
+    pub(crate) fn start(&self, complete: bool) {
+        self.corr.store(0, Ordering::Relaxed);
+        self.size.store(0, Ordering::Relaxed);
+        self.complete.store(complete, Ordering::Relaxed);
+    }
+
+    /// Adds one element's correction and force sizes (both `≥ 0`).
+    fn add(&self, corr: f64, size: f64) {
+        self.corr.fetch_max(corr.to_bits(), Ordering::Relaxed);
+        self.size.fetch_max(size.to_bits(), Ordering::Relaxed);
+    }
+
+    /// [`correction_size`] at the configuration the last evaluation was
+    /// at, if that evaluation tallied.
+    pub(crate) fn correction_size(&self, mech: &Mechanism) -> Option<f64> {
+        self.complete.load(Ordering::Relaxed).then(|| {
+            let get = |a: &AtomicU64| f64::from_bits(a.load(Ordering::Relaxed));
+            correction_ratio(mech, get(&self.corr), get(&self.size))
+        })
     }
 }
