@@ -334,3 +334,47 @@ fn the_energy_momentum_schemes_cheap_tangent_reaches_the_exact_tangents_solution
         assert!(slow < cheap.len(), "{name}: {slow} slow iterations");
     }
 }
+
+#[test]
+fn the_recorded_correction_size_is_that_of_the_converged_step() {
+    // The energy–momentum record's `beta` (the discrete gradient's
+    // corrections relative to its force) is tallied during Newton's last
+    // residual evaluation; recomputed from the stored end configurations of
+    // each step it is the same number, to the round-off of the stored
+    // rotations (quaternions) in a size measured relative to the force:
+    // 1e3 ε, where an evaluation at another iterate would differ by the
+    // order of `beta` itself (~4e-9 here).
+    use flexmech_integrators::dynamics::midpoint_kernels::correction_size;
+    use nalgebra::{Matrix3, Quaternion, UnitQuaternion};
+    let (mech, motion) = free_pair(Arc::new(Revolute { axis: Vector3::z() }));
+    let mut steps: Vec<StepRecord> = Vec::new();
+    energy_momentum::solve(&mech, &settings(0.02, 0.4), &motion, |r| {
+        steps.push(r.clone())
+    })
+    .unwrap();
+    let config = |r: &StepRecord| flexmech_core::Configuration {
+        x: r.positions.iter().map(|p| Vector3::from(*p)).collect(),
+        rot: r
+            .quaternions
+            .iter()
+            .map(|q| -> Matrix3<f64> {
+                UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]))
+                    .to_rotation_matrix()
+                    .into_inner()
+            })
+            .collect(),
+    };
+    let mut checked = 0;
+    for w in steps.windows(2) {
+        let recomputed = correction_size(&mech, &config(&w[0]), &config(&w[1]));
+        assert!(w[1].beta > 0.0, "a turning pair has corrections");
+        assert!(
+            (w[1].beta - recomputed).abs() <= 1e3 * f64::EPSILON,
+            "t = {}: recorded {:e}, recomputed {recomputed:e}",
+            w[1].time,
+            w[1].beta
+        );
+        checked += 1;
+    }
+    assert_eq!(checked, 20);
+}
