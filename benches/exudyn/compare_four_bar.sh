@@ -17,12 +17,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 scale="${1:-1}"; tend="${2:-12}"; rounds="${3:-3}"
 . "$here/paired.sh"
 
-awk -v k="$scale" -v te="$tend" '
-    /^elements = / { $3 = $3 * k }
-    /^t_end = /    { $3 = te }
-    { print }' \
-    "$here/../../data/benchmarks/four_bar.toml" > "$out/four_bar.toml"
-sed -e 's/^\[solver\]/[solver]\nnewton = "modified"/' "$out/four_bar.toml" > "$out/modified.toml"
+scaled_models "$here/../../data/benchmarks/four_bar.toml" "$scale" "$tend" four_bar
 
 echo "four-bar: element scale $scale ($((8 * scale))/$((16 * scale))/$((8 * scale)) elements), t_end $tend, dt 1e-2, $rounds rounds, one thread each"
 paired_rounds "$rounds" "$out/four_bar.toml" "$out/modified.toml" "$here/four_bar.py" --elements-scale "$scale" --t-end "$tend"

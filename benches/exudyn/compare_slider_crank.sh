@@ -18,16 +18,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 scale="${1:-1}"; tend="${2:-1.0}"; rounds="${3:-3}"
 . "$here/paired.sh"
 
-# the flexmech model: element counts times SCALE, T_END, every step stored
-awk -v k="$scale" -v te="$tend" '
-    /^elements = / { $3 = $3 * k }
-    /^t_end = /    { $3 = te }
-    /^every = /    { next }
-    { print }
-    /^\[output\]/  { print "every = 1" }' \
-    "$here/../../data/benchmarks/slider_crank.toml" > "$out/slider_crank.toml"
-sed -e 's/^\[solver\]/[solver]\nnewton = "modified"/' "$out/slider_crank.toml" > "$out/modified.toml"
-
+scaled_models "$here/../../data/benchmarks/slider_crank.toml" "$scale" "$tend" slider_crank
 
 echo "slider-crank: element scale $scale ($((2 * scale))/$((4 * scale))/$scale elements), t_end $tend, dt 1e-3, $rounds rounds, one thread each"
 paired_rounds "$rounds" "$out/slider_crank.toml" "$out/modified.toml" "$here/slider_crank.py" --elements-scale "$scale" --t-end "$tend"

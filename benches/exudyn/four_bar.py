@@ -20,27 +20,16 @@ C (x, y, z), the axial force of bar 1's element at index n1/2 (its mid-span) and
 bending moments (local y, z) of bar 3's element at index n3/2.
 Prints the CPU time of the solve alone (time.process_time) and of the model build.
 """
-import argparse, sys, time
+import time
 
-ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-ap.add_argument('--t-end', type=float, default=12.0)
-ap.add_argument('--dt', type=float, default=1e-2)
-ap.add_argument('--elements-scale', type=int, default=1,
-                help='multiplies the element counts 8/16/8 of bars 1/2/3')
-ap.add_argument('--fast', action='store_true', help='modified Newton + exudynCPPfast')
+from twin import dynamic_settings, mechanism_args, start
+
+ap = mechanism_args(__doc__, t_end=12.0, dt=1e-2, counts='8/16/8 of bars 1/2/3')
 ap.add_argument('--tol', type=float, default=1e-7,
                 help='Newton tolerance on the increment (at 1e-8 it stalls at ~4e-8 in the first step)')
 ap.add_argument('--csv', default='', help='write the histories (see above) here')
-a = ap.parse_args()
-if a.elements_scale < 1:
-    ap.error('--elements-scale must be at least 1')
-
-cpu0 = time.process_time()
-if a.fast:
-    sys.exudynFast = True          # must precede the import: no range checks, AVX2
+a, exu, cpu0 = start(ap)
 import numpy as np
-import exudyn as exu
-from twin import dynamic_settings
 from exudyn.itemInterface import (NodeRigidBodyRotVecLG, ObjectGround,
     ObjectBeamGeometricallyExact, MarkerNodeRigid, MarkerBodyRigid, GenericJoint,
     SensorNode, SensorBody)

@@ -18,6 +18,19 @@ cpu() {
 # solve LOGFILE : the solve-only CPU seconds an Exudyn twin printed
 solve() { awk '/^cpu_solve_s/ {print $2}' "$1"; }
 
+# scaled_models SOURCE SCALE T_END NAME : writes $out/NAME.toml, SOURCE with its
+# element counts times SCALE, t_end = T_END and every step stored, and
+# $out/modified.toml, the same with newton = "modified"
+scaled_models() {
+    awk -v k="$2" -v te="$3" '
+        /^elements = / { $3 = $3 * k }
+        /^t_end = /    { $3 = te }
+        /^every = /    { next }
+        { print }
+        /^\[output\]/  { print "every = 1" }' "$1" > "$out/$4.toml"
+    sed -e 's/^\[solver\]/[solver]\nnewton = "modified"/' "$out/$4.toml" > "$out/modified.toml"
+}
+
 # medians < ROWS : rows "A B_solve B_process C_solve C_process M" of the rounds
 # (A, M flexmech full and modified Newton; B, C Exudyn full and fastest);
 # prints the median of each per-round ratio

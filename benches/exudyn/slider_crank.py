@@ -19,14 +19,11 @@ generalized-alpha), Newton converged on the increment (1e-8). --fast: Exudyn's f
 exudynCPPfast module, reused sparse pattern). One thread in both cases.
 Prints the CPU time of the solve alone (time.process_time) and of the model build.
 """
-import argparse, sys, time
+import time
 
-ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-ap.add_argument('--t-end', type=float, default=1.0)
-ap.add_argument('--dt', type=float, default=1e-3)
-ap.add_argument('--elements-scale', type=int, default=1,
-                help='multiplies the element counts 2/4/1 of crank/rod/block')
-ap.add_argument('--fast', action='store_true', help='modified Newton + exudynCPPfast')
+from twin import dynamic_settings, mechanism_args, start
+
+ap = mechanism_args(__doc__, t_end=1.0, dt=1e-3, counts='2/4/1 of crank/rod/block')
 ap.add_argument('--node', choices=['RotVecLG', 'Rxyz', 'EP'], default='RotVecLG')
 ap.add_argument('--newton-error', choices=['increment', 'residual'], default='increment',
                 help="Newton's error measure: the increment (newton.residualMode = 1, relative = "
@@ -34,16 +31,8 @@ ap.add_argument('--newton-error', choices=['increment', 'residual'], default='in
                      "= --tol); see README.md")
 ap.add_argument('--tol', type=float, default=1e-8, help='Newton tolerance (default 1e-8)')
 ap.add_argument('--csv', default='', help='write t,x_C (the slider position) here')
-a = ap.parse_args()
-if a.elements_scale < 1:
-    ap.error('--elements-scale must be at least 1')
-
-cpu0 = time.process_time()
-if a.fast:
-    sys.exudynFast = True          # must precede the import: no range checks, AVX2
+a, exu, cpu0 = start(ap)
 import numpy as np
-import exudyn as exu
-from twin import dynamic_settings
 from exudyn.itemInterface import (NodeRigidBodyRotVecLG, NodeRigidBodyRxyz, NodeRigidBodyEP,
     ObjectGround, ObjectBeamGeometricallyExact, ObjectMassPoint, MarkerNodeRigid,
     MarkerBodyRigid, GenericJoint, SensorNode)
