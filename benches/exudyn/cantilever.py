@@ -13,7 +13,11 @@ Default: full Newton. --fast: Exudyn's fastest setting (modified Newton, the
 exudynCPPfast module, reused sparse pattern). One thread in both cases.
 Prints the CPU time of the solve alone (time.process_time) and of the model build.
 """
-import argparse, sys, time
+import argparse
+import sys
+import time
+
+from twin import dynamic_settings, start
 
 ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
 ap.add_argument('--elements', type=int, default=512)
@@ -23,14 +27,8 @@ ap.add_argument('--fast', action='store_true', help='modified Newton + exudynCPP
 ap.add_argument('--node', choices=['Rxyz', 'EP', 'RotVecLG'], default='Rxyz')
 ap.add_argument('--static', action='store_true', help='static solution only (check)')
 ap.add_argument('--csv', default='', help='write t,ux,uy,uz of the tip here')
-a = ap.parse_args()
-
-cpu0 = time.process_time()
-if a.fast:
-    sys.exudynFast = True          # must precede the import: no range checks, AVX2
+a, exu, cpu0 = start(ap)
 import numpy as np
-import exudyn as exu
-from twin import dynamic_settings
 from exudyn.itemInterface import (NodeRigidBodyRxyz, NodeRigidBodyEP, NodeRigidBodyRotVecLG,
     NodePointGround, ObjectGround, ObjectBeamGeometricallyExact, MarkerNodeCoordinate,
     MarkerNodeRigid, MarkerBodyRigid, CoordinateConstraint, GenericJoint, Force, SensorNode)
