@@ -166,23 +166,33 @@ pub fn bench(
     out: &Path,
     mut progress: impl FnMut(&Timing),
 ) -> Result<Vec<Timing>, RunError> {
+    let cases: Vec<&Case> = CASES.iter().collect();
     let mut timings = Vec::new();
     for &elements in sizes {
-        let mut fastest: Vec<Option<Timing>> = vec![None; CASES.len()];
-        for _ in 0..rounds.max(1) {
-            for (case, kept) in CASES.iter().zip(fastest.iter_mut()) {
-                let t = time_case(case, elements, steps, out)?;
-                if kept.as_ref().is_none_or(|k| t.seconds < k.seconds) {
-                    *kept = Some(t);
-                }
-            }
-        }
-        for t in fastest.into_iter().flatten() {
-            progress(&t);
-            timings.push(t);
-        }
+        let kept = fastest_of(&cases, rounds, |case| time_case(case, elements, steps, out))?;
+        kept.iter().for_each(&mut progress);
+        timings.extend(kept);
     }
     Ok(timings)
+}
+
+/// Runs `cases` `rounds` times, interleaved (all cases, then all again),
+/// and keeps each case's fastest run, in the cases' order.
+fn fastest_of(
+    cases: &[&Case],
+    rounds: usize,
+    mut run: impl FnMut(&Case) -> Result<Timing, RunError>,
+) -> Result<Vec<Timing>, RunError> {
+    let mut fastest: Vec<Option<Timing>> = vec![None; cases.len()];
+    for _ in 0..rounds.max(1) {
+        for (case, kept) in cases.iter().zip(fastest.iter_mut()) {
+            let t = run(case)?;
+            if kept.as_ref().is_none_or(|k| t.seconds < k.seconds) {
+                *kept = Some(t);
+            }
+        }
+    }
+    Ok(fastest.into_iter().flatten().collect())
 }
 
 /// The yardstick's name in the timings.
@@ -252,34 +262,20 @@ pub fn bench_mechanisms(
     out: &Path,
     mut progress: impl FnMut(&Timing),
 ) -> Result<Vec<Timing>, RunError> {
+    let cases: Vec<&Case> = mechanism_cases().collect();
     let mut timings = Vec::new();
     for mechanism in mechanisms {
-        let cases: Vec<&Case> = mechanism_cases().collect();
-        let mut fastest: Vec<Option<Timing>> = vec![None; cases.len()];
-        for _ in 0..rounds.max(1) {
-            for (case, kept) in cases.iter().zip(fastest.iter_mut()) {
-                let text = mechanism_text(mechanism, case);
-                let path = PathBuf::from(format!(
-                    "bench-{}-{}.toml",
-                    mechanism.name,
-                    case.label.replace('/', "-")
-                ));
-                let elements = parse_model(&text, &path)
-                    .map_err(RunError::from)?
-                    .beams
-                    .iter()
-                    .map(|b| b.elements)
-                    .sum();
-                let t = timed_run(mechanism.name, case, &text, &path, elements, out)?;
-                if kept.as_ref().is_none_or(|k| t.seconds < k.seconds) {
-                    *kept = Some(t);
-                }
-            }
-        }
-        for t in fastest.into_iter().flatten() {
-            progress(&t);
-            timings.push(t);
-        }
+        let kept = fastest_of(&cases, rounds, |case| {
+            let path = PathBuf::from(format!(
+                "bench-{}-{}.toml",
+                mechanism.name,
+                case.label.replace('/', "-")
+            ));
+            let text = mechanism_text(mechanism, case);
+            timed_run(mechanism.name, case, &text, &path, None, out)
+        })?;
+        kept.iter().for_each(&mut progress);
+        timings.extend(kept);
     }
     Ok(timings)
 }
@@ -291,19 +287,21 @@ fn time_case(case: &Case, elements: usize, steps: usize, out: &Path) -> Result<T
         "bench-{}-{elements}.toml",
         case.label.replace('/', "-")
     ));
-    timed_run(CANTILEVER, case, &text, &path, elements, out)
+    timed_run(CANTILEVER, case, &text, &path, Some(elements), out)
 }
 
-/// Parses and runs `text` (read as if from `path`), timing its steps.
+/// Parses and runs `text` (read as if from `path`), timing its steps;
+/// `elements` is the count the timing reports (default: the model's).
 fn timed_run(
     model: &'static str,
     case: &Case,
     text: &str,
     path: &Path,
-    elements: usize,
+    elements: Option<usize>,
     out: &Path,
 ) -> Result<Timing, RunError> {
     let parsed = parse_model(text, path).map_err(RunError::from)?;
+    let elements = elements.unwrap_or_else(|| parsed.beams.iter().map(|b| b.elements).sum());
     let dir = out.join(path.with_extension(""));
     let summary = run_model(&parsed, &dir)?;
     Ok(Timing {
