@@ -3,7 +3,7 @@
 # (data/paper, every integrator) with their charts, solve every other model in
 # data/benchmarks/, data/statics/ and data/dynamics/, and check the published
 # dynamic benchmarks in full with every integrator (the long, #[ignore]d runs
-# of studies/tests/published_dynamics.rs).
+# of flexmech/tests/published_dynamics.rs).
 #   results/<model>/<integrator>.h5   the paper's examples
 #   results/charts/*.png, .svg, .csv, .tex   their figures (and editable copies)
 #   results/summary.csv, summary.md   outcome, energy drift, step halvings
@@ -18,5 +18,5 @@ cargo build --release --bin flexmech
 FLEXMECH="${CARGO_TARGET_DIR:-target}/release/flexmech"
 "$FLEXMECH" reproduce --out "$OUT"
 "$FLEXMECH" run data/benchmarks/*.toml data/statics/*.toml data/dynamics/*.toml --out "$OUT/models"
-cargo test --release -p flexmech-studies --test published_dynamics -- --ignored
+cargo test --release -p flexmech --test main published_dynamics -- --ignored
 echo "results written to $OUT/ (figures in $OUT/charts/, summary in $OUT/summary.md, ParaView series $OUT/<model>/<integrator>.pvd, animations in $OUT/animations/)"

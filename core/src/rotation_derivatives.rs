@@ -4,7 +4,7 @@
 //! `α, β` and their first two derivatives in `t` (one scalar second-order
 //! dual number through the Rodrigues coefficients). The three-lane
 //! hyper-dual evaluation of the whole matrix stays as the oracle in the
-//! tests. `∂(H⁻ᵀv)/∂ψ` likewise, from `D(t)` of [`tangent_inverse`] and
+//! tests. `∂(H⁻ᵀv)/∂ψ` likewise, from `D(t)` of [`tangent_inverse`](crate::rotation::tangent_inverse) and
 //! its derivative (one scalar dual number); its three-lane forward AD is the
 //! oracle.
 

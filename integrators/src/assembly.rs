@@ -7,7 +7,7 @@
 //! than one thread, and kernels costly enough to gain from it
 //! ([`crate::threads::LoopCost`]), the elements are cut into contiguous
 //! chunks evaluated in parallel, each summing straight into the values it
-//! owns (see [`crate::element_split`]) — every sum is still formed in
+//! owns (see the `element_split` module) — every sum is still formed in
 //! element order, so the result is bitwise the same for any number of
 //! threads.
 

@@ -1,0 +1,19 @@
+//! What the three jobs need, in one `use flexmech::prelude::*;`.
+
+pub use crate::{data, App};
+
+pub use flexmech_core::{cst, Scalar};
+pub use flexmech_integrators::dynamics::{Integrator, Simulation};
+pub use flexmech_joints::model_joint::{direction, perpendicular_slide, positive};
+pub use flexmech_joints::{DependentJoint, ModelJoint, ParamError};
+pub use flexmech_model::{load_model, parse_model, JointRegistry, Model, ModelError};
+pub use nalgebra::Vector3;
+pub use serde::Deserialize;
+pub use std::path::Path;
+
+#[cfg(feature = "plot")]
+pub use flexmech_plot::charts::{LineChart, Series};
+#[cfg(feature = "hdf5")]
+pub use flexmech_results::{restart_model, run_model, ResultReader, RunError, RunSummary};
+#[cfg(feature = "studies")]
+pub use flexmech_studies::{Component, DatasetFigure, Figure, Reduce, Study, StudyReport};

@@ -1,0 +1,324 @@
+//! From a validated [`Model`] to the [`Mechanism`] the solvers work on: mesh
+//! the beams, number the nodes, apply supports, loads and gravity.
+
+use crate::{Analysis, IntegratorKind, Model, ModelError, NodeRef, PrescribedSpec, TimeFunction};
+use flexmech_integrators::builder::{BeamDef, BuildError, Dof, JointDef, MechanismBuilder, NodeId};
+use flexmech_integrators::dynamics::Motion;
+use flexmech_integrators::{Mechanism, Schedule};
+use nalgebra::{Matrix3, Vector3};
+
+/// A mechanism with the numbering that relates it back to the model file.
+#[derive(Debug, Clone)]
+pub struct Built {
+    /// What the solvers work on.
+    pub mechanism: Mechanism,
+    /// Global node numbers of every beam's nodes (`beam_nodes[b][k]`).
+    pub beam_nodes: Vec<Vec<usize>>,
+    /// Every beam's elements' range in the mesh.
+    pub beam_elements: Vec<std::ops::Range<usize>>,
+    /// Initial velocities (dynamic analyses).
+    pub motion: Motion,
+    /// The ground node of every joint to the ground: `(joint index, node)`
+    /// (nodes of no element, after the beams' nodes; labelled
+    /// `ground.<joint name>`).
+    pub ground_nodes: Vec<(usize, usize)>,
+    /// The centre-of-mass node of every rigid body with an offset:
+    /// `(body index, node)` (labelled `body.<body name>`; its rigid joint to
+    /// the carrying node is the joint `body.<body name>`, after the model's).
+    pub body_nodes: Vec<(usize, usize)>,
+}
+
+impl Built {
+    /// Global node number of a model node.
+    pub fn node(&self, r: NodeRef) -> usize {
+        self.beam_nodes[r.beam][r.node]
+    }
+}
+
+fn v(a: [f64; 3]) -> Vector3<f64> {
+    Vector3::from(a)
+}
+
+/// The schedule of a load: its time table if the file gives one; otherwise
+/// the load factor itself in statics (proportional loading) and 1 in dynamics.
+fn schedule(time: &Option<TimeFunction>, analysis: &Analysis) -> Schedule {
+    match (time, analysis) {
+        (Some(f), _) => schedule_of(f),
+        (None, Analysis::Static { .. } | Analysis::ArcLength { .. }) => Schedule::ramp(),
+        (None, Analysis::Dynamic { .. }) => Schedule::constant(1.0),
+    }
+}
+
+/// Initial nodal velocities from the `[[initial_velocity]]` fields
+/// (`v = v₀ + ω × (x − origin)`, body angular velocity `W = ω` since every
+/// node starts at the identity); a later field overrides an earlier one on
+/// the nodes they share; nodes in no field start at rest. Joints' `rate`s set
+/// the released rates (slave velocities follow from them).
+fn initial_motion(model: &Model, built: &Built) -> Motion {
+    let x0 = &built.mechanism.mesh.positions;
+    let mut motion = Motion::rest(x0.len());
+    for field in &model.initial_velocities {
+        let (v0, om, o) = (v(field.linear), v(field.angular), v(field.origin));
+        for r in &field.nodes {
+            let n = built.node(*r);
+            motion.v[n] = v0 + om.cross(&(x0[n] - o));
+            motion.w[n] = om;
+        }
+    }
+    motion.joint_rates = model.joints.iter().map(|j| j.rate).collect();
+    // Drivers written as expressions start at their exact rate f′(0): a
+    // driven joint's released rate (unless `rate` is given) and a
+    // prescribed DOF's velocity (a rotation DOF: the spin about its global
+    // axis, = W at t = 0 where R = I).
+    for p in &model.prescribed {
+        match p {
+            PrescribedSpec::JointAngle {
+                joint,
+                angle: f @ TimeFunction::Expression(_),
+            } if model.joints[*joint].rate == 0.0 => {
+                motion.joint_rates[*joint] = f.derivatives(0.0).1;
+            }
+            PrescribedSpec::NodeDof {
+                node,
+                dof,
+                value: f @ TimeFunction::Expression(_),
+            } => {
+                let n = built.node(*node);
+                let rate = f.derivatives(0.0).1;
+                match *dof {
+                    d @ 0..=2 => motion.v[n][d] = rate,
+                    d => motion.w[n][d - 3] = rate,
+                }
+            }
+            _ => {}
+        }
+    }
+    motion
+}
+
+/// A time function as a schedule.
+fn schedule_of(f: &TimeFunction) -> Schedule {
+    let f = f.clone();
+    Schedule::new(move |t| f.eval(t))
+}
+
+/// The builder's refusal as a model error: the key of the model entry it is
+/// about (`key`), in the model's words.
+fn refused(model: &Model, key: String, e: BuildError) -> ModelError {
+    let message = match &e {
+        BuildError::Mesh { beam, source } => {
+            format!("beam `{}`: {source}", model.beams[*beam].name)
+        }
+        BuildError::NonFiniteRelease { joint, expected } => format!(
+            "joint `{joint}`: its released translation at the initial angle is not a finite \
+             number ({expected:?}); check the joint's parameters (pitch, radius, profile \
+             coefficients or table, period) and its `angle`"
+        ),
+        BuildError::SlaveOff {
+            joint,
+            at,
+            expected,
+            gap,
+        } => {
+            let spec = model.joints.iter().find(|j| &j.name == joint);
+            let label = |r: Option<NodeRef>| r.map(|r| model.node_label(r)).unwrap_or_default();
+            let p = |x: &[f64; 3]| format!("({:.6}, {:.6}, {:.6})", x[0], x[1], x[2]);
+            format!(
+                "joint `{joint}`: the slave `{}` starts at {} but the master `{}` plus the \
+                 released translation at the initial angle puts it at {} (off by {gap:.3e}); \
+                 move the beam, or set the joint's `angle`",
+                label(spec.map(|s| s.slave)),
+                p(at),
+                spec.map_or_else(String::new, |s| match s.master {
+                    Some(m) => model.node_label(m),
+                    None => "ground".into(),
+                }),
+                p(expected)
+            )
+        }
+        other => other.to_string(),
+    };
+    ModelError::new(&model.path, key, None, message)
+}
+
+/// Builds the mechanism of `model` through the [`MechanismBuilder`], whose
+/// checks (sections, geometry, joints placed by relation (1)) apply.
+///
+/// The model's invariants are checked first ([`Model::check`]), so a model
+/// built or changed in Rust is refused with a message naming the key rather
+/// than meshed with an index out of range.
+pub fn build(model: &Model) -> Result<Built, ModelError> {
+    model.check()?;
+    let mut b = MechanismBuilder::new();
+    let mut beam_nodes: Vec<Vec<NodeId>> = Vec::with_capacity(model.beams.len());
+    let mut beams = Vec::with_capacity(model.beams.len());
+    for (i, beam) in model.beams.iter().enumerate() {
+        if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
+            if integrator == IntegratorKind::EnergyMomentumPaper && beam.nodes_per_element != 2 {
+                return Err(ModelError::new(
+                    &model.path,
+                    format!("beam[{i}].nodes_per_element"),
+                    None,
+                    format!(
+                        "integrator = \"{}\" runs on 2-node elements (the paper's internal force is the midpoint form of the linear element); use nodes_per_element = 2 with more elements, or integrator = \"energy-momentum\"",
+                        integrator.name()
+                    ),
+                ));
+            }
+        }
+        let s = &model.sections[beam.section];
+        let nodes = b
+            .beam(BeamDef {
+                shape: beam.geometry,
+                elements: beam.elements,
+                nodes_per_element: beam.nodes_per_element,
+                section: s.values,
+            })
+            .map_err(|e| refused(model, format!("beam[{i}]"), e))?;
+        if s.damping > 0.0 {
+            if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
+                if !matches!(
+                    integrator,
+                    IntegratorKind::Newmark | IntegratorKind::GeneralizedAlpha { .. }
+                ) {
+                    return Err(ModelError::new(
+                        &model.path,
+                        format!("section[{}].damping", beam.section),
+                        None,
+                        format!(
+                            "structural damping runs with integrator = \"newmark\" or \
+                             \"generalized-alpha\", not \"{}\" (the midpoint schemes' \
+                             conservation statements have no place for it); change the \
+                             integrator or remove `damping`",
+                            integrator.name()
+                        ),
+                    ));
+                }
+            }
+            b.damping(&nodes, s.damping)
+                .map_err(|e| refused(model, format!("section[{}].damping", beam.section), e))?;
+        }
+        beam_nodes.push(nodes.nodes().to_vec());
+        beams.push(nodes);
+    }
+    let node = |r: NodeRef| beam_nodes[r.beam][r.node];
+    for (i, s) in model.supports.iter().enumerate() {
+        let dofs: Vec<Dof> = (0..6)
+            .filter(|&d| s.fixed[d])
+            .filter_map(Dof::from_index)
+            .collect();
+        b.fix(node(s.node), &dofs)
+            .map_err(|e| refused(model, format!("support[{i}]"), e))?;
+    }
+    for (i, l) in model.loads.iter().enumerate() {
+        let scale = schedule(&l.time, &model.solver.analysis);
+        if l.follower {
+            b.follower_load(node(l.node), v(l.force), v(l.moment), scale)
+        } else {
+            b.load(node(l.node), v(l.force), v(l.moment), scale)
+        }
+        .map_err(|e| refused(model, format!("load[{i}]"), e))?;
+    }
+    for (i, l) in model.distributed_loads.iter().enumerate() {
+        let scale = schedule(&l.time, &model.solver.analysis);
+        let beam = &beams[l.beam];
+        if l.follower {
+            b.follower_distributed_load(beam, v(l.force), v(l.moment), scale)
+        } else {
+            b.distributed_load(beam, v(l.force), v(l.moment), scale)
+        }
+        .map_err(|e| refused(model, format!("distributed_load[{i}]"), e))?;
+    }
+    b.gravity(v(model.gravity), schedule(&None, &model.solver.analysis))
+        .map_err(|e| refused(model, "gravity".into(), e))?;
+    let mut joints = Vec::with_capacity(model.joints.len());
+    let mut ground_nodes = Vec::new();
+    for (j, spec) in model.joints.iter().enumerate() {
+        let angle = if spec.kind.has_angle() {
+            spec.angle
+        } else {
+            0.0
+        };
+        let placed = match spec.master {
+            Some(master) => b.joint(JointDef {
+                name: spec.name.clone(),
+                map: spec.kind.map().clone(),
+                master: node(master),
+                slave: node(spec.slave),
+                angle,
+            }),
+            None => b
+                .ground_joint(
+                    spec.name.clone(),
+                    spec.kind.map().clone(),
+                    node(spec.slave),
+                    angle,
+                )
+                .map(|(id, ground)| {
+                    ground_nodes.push((j, ground.index()));
+                    id
+                }),
+        };
+        let id = placed.map_err(|e| {
+            let key = match e {
+                BuildError::SlaveOff { .. } => format!("joint[{j}].slave"),
+                _ => format!("joint[{j}]"),
+            };
+            refused(model, key, e)
+        })?;
+        joints.push(id);
+    }
+    let mut body_nodes = Vec::new();
+    for (i, body) in model.rigid_bodies.iter().enumerate() {
+        let carrier = node(body.node);
+        let inertia = Matrix3::from_fn(|r, c| body.inertia[r][c]);
+        let centre = b
+            .rigid_body(
+                body.name.clone(),
+                carrier,
+                body.mass,
+                inertia,
+                v(body.offset),
+            )
+            .map_err(|e| refused(model, format!("rigid_body[{i}]"), e))?;
+        if centre != carrier {
+            body_nodes.push((i, centre.index()));
+        }
+    }
+    for (i, p) in model.prescribed.iter().enumerate() {
+        match p {
+            PrescribedSpec::JointAngle { joint, angle } => {
+                b.drive(joints[*joint], schedule_of(angle))
+            }
+            PrescribedSpec::NodeDof {
+                node: r,
+                dof,
+                value,
+            } => match Dof::from_index(*dof) {
+                Some(d) => b.prescribe(node(*r), d, schedule_of(value)),
+                None => Err(BuildError::NotFinite {
+                    what: format!("dof index {dof} (0..6)"),
+                    value: *dof as f64,
+                }),
+            },
+        }
+        .map_err(|e| refused(model, format!("prescribed[{i}]"), e))?;
+    }
+    let mechanism = b.build();
+    let beam_nodes = beam_nodes
+        .into_iter()
+        .map(|nodes| nodes.into_iter().map(NodeId::index).collect())
+        .collect();
+    let beam_elements = beams.iter().map(|b| b.elements()).collect();
+    let mut built = Built {
+        mechanism,
+        beam_nodes,
+        beam_elements,
+        motion: Motion::rest(0),
+        ground_nodes,
+        body_nodes,
+    };
+    built.motion = initial_motion(model, &built);
+    crate::initial_check::check(model, &built.mechanism, &built.beam_nodes, &built.motion)?;
+    Ok(built)
+}

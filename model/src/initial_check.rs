@@ -1,0 +1,177 @@
+//! The derived quantities of a built model at t = 0 must be finite numbers.
+//!
+//! Every value in a model file is checked to be finite where it is read, but
+//! products of finite values can overflow: a density of 1e308 times a
+//! length, a velocity of 1e308 squared in the kinetic energy, a screw pitch
+//! of 1e308 in the joint's map `N`, a stiffness of 1e308 squared in the
+//! round-off floor. Such a model would fail at its first step with "residual
+//! is not finite", or write `inf` in its first record; it is refused here
+//! instead, naming the key whose value overflows and the quantity.
+
+use crate::{Analysis, Model, ModelError, NodeRef};
+use flexmech_integrators::dynamics::Motion;
+use flexmech_integrators::Mechanism;
+use nalgebra::{Matrix3, Vector3};
+
+/// Checks the derived quantities of `mech` (built from `model`, node numbers
+/// `beam_nodes`, initial motion `motion`) at t = 0.
+pub(crate) fn check(
+    model: &Model,
+    mech: &Mechanism,
+    beam_nodes: &[Vec<usize>],
+    motion: &Motion,
+) -> Result<(), ModelError> {
+    let fail = |key: String, what: String| {
+        Err(ModelError::new(
+            &model.path,
+            key,
+            None,
+            format!(
+                "{what} is not a finite number in double precision; use smaller values (or \
+                 other units)"
+            ),
+        ))
+    };
+    let radius = mech
+        .mesh
+        .positions
+        .iter()
+        .map(|x| x.norm())
+        .fold(1.0, f64::max);
+    let dt = match model.solver.analysis {
+        Analysis::Dynamic { dt, .. } => Some(dt),
+        Analysis::Static { .. } | Analysis::ArcLength { .. } => None,
+    };
+    // Elements, beam by beam (elements are numbered in the beams' order).
+    let mut first = 0;
+    for beam in &model.beams {
+        let key = format!("section[{}]", beam.section);
+        for e in &mech.mesh.elements[first..first + beam.elements] {
+            let s = e.section();
+            let (l, scale) = (e.length(), e.force_scale(radius));
+            if !(scale * scale * beam.elements as f64).is_finite() {
+                return fail(
+                    key,
+                    format!(
+                        "beam `{}`: the squared force scale of its elements (stiffness × size \
+                         / element length)",
+                        beam.name
+                    ),
+                );
+            }
+            let mass = s.rho_a * l * (1.0 + radius * radius);
+            let spin = s.rho_j.iter().fold(0.0f64, |m, j| m.max(j.abs())) * l;
+            let stepped = dt.map_or(1.0, |dt| 1.0 / (dt * dt));
+            if !(mass * stepped).is_finite() || !(spin * stepped).is_finite() {
+                return fail(
+                    key,
+                    format!(
+                        "beam `{}`: the mass or rotary inertia of its elements (times size² and \
+                         1/dt²)",
+                        beam.name
+                    ),
+                );
+            }
+            let weight =
+                model.gravity.iter().fold(0.0f64, |m, g| m.max(g.abs())) * s.rho_a * l * radius;
+            if !weight.is_finite() {
+                return fail(
+                    "gravity".into(),
+                    format!("beam `{}`: gravity's work", beam.name),
+                );
+            }
+        }
+        first += beam.elements;
+    }
+    for (k, body) in model.rigid_bodies.iter().enumerate() {
+        let stepped = dt.map_or(1.0, |dt| 1.0 / (dt * dt));
+        let spin = body
+            .inertia
+            .as_flattened()
+            .iter()
+            .fold(0.0f64, |m, j| m.max(j.abs()));
+        let g = model.gravity.iter().fold(0.0f64, |m, g| m.max(g.abs()));
+        let products = [
+            body.mass * (1.0 + radius * radius) * stepped,
+            spin * stepped,
+            g * body.mass * radius,
+        ];
+        if products.iter().any(|p| !p.is_finite()) {
+            return fail(
+                format!("rigid_body[{k}]"),
+                format!(
+                    "rigid body `{}`: its mass or inertia (times size², 1/dt² and gravity)",
+                    body.name
+                ),
+            );
+        }
+    }
+    for (k, load) in model.loads.iter().enumerate() {
+        let f = Vector3::from(load.force).norm() * radius;
+        let m = Vector3::from(load.moment).norm();
+        let scale = load
+            .time
+            .as_ref()
+            .map_or(1.0, |f| f.eval(0.0))
+            .abs()
+            .max(1.0);
+        if !(f * scale).is_finite() || !(m * scale).is_finite() {
+            return fail(format!("load[{k}]"), "the load's work".into());
+        }
+    }
+    for (k, field) in model.initial_velocities.iter().enumerate() {
+        for r in &field.nodes {
+            let n = node(beam_nodes, *r);
+            let (v, w) = (motion.v[n], motion.w[n]);
+            let squares = v.norm_squared() * (1.0 + radius * radius) + w.norm_squared();
+            if !squares.is_finite() {
+                return fail(
+                    format!("initial_velocity[{k}]"),
+                    format!("the initial velocity of `{}` squared", model.node_label(*r)),
+                );
+            }
+        }
+    }
+    let kinetic: f64 = mech
+        .mesh
+        .elements
+        .iter()
+        .map(|e| {
+            let s = e.section();
+            let j = s.rho_j.iter().fold(0.0f64, |m, j| m.max(j.abs()));
+            e.nodes()
+                .iter()
+                .map(|&n| {
+                    e.length()
+                        * (s.rho_a * motion.v[n].norm_squared() + j * motion.w[n].norm_squared())
+                })
+                .sum::<f64>()
+        })
+        .sum();
+    if !kinetic.is_finite() {
+        return fail(
+            "initial_velocity".into(),
+            "the initial kinetic energy (mass × velocity²)".into(),
+        );
+    }
+    for (j, joint) in mech.joints.iter().enumerate() {
+        let x = &mech.mesh.positions[joint.master];
+        let n = joint.map.variation(x, &Matrix3::identity(), &joint.initial);
+        let rate = model.joints.get(j).map_or(0.0, |s| s.rate).abs().max(1.0);
+        if n.iter().any(|v| !(v * rate).is_finite()) {
+            return fail(
+                format!("joint[{j}]"),
+                format!(
+                    "joint `{}`: its map N at the initial angle (the derivative of the released \
+                     translation, times the joint's rate)",
+                    joint.name
+                ),
+            );
+        }
+    }
+    Ok(())
+}
+
+fn node(beam_nodes: &[Vec<usize>], r: NodeRef) -> usize {
+    beam_nodes[r.beam][r.node]
+}

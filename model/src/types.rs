@@ -1,0 +1,301 @@
+//! The validated model: what a model file means once every key has been checked
+//! and every node label resolved. Built by [`crate::load_model`]; consumed
+//! by the mechanism builder. Plain data, no behaviour beyond small helpers.
+
+use std::path::PathBuf;
+
+/// A node of the mesh: node `node` (0-based, along the beam) of beam `beam`
+/// (index into [`Model::beams`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct NodeRef {
+    /// Index of the beam in [`Model::beams`].
+    pub beam: usize,
+    /// Node index within the beam, `0..=elements*(nodes_per_element-1)`.
+    pub node: usize,
+}
+
+/// A scale factor as a function of time (statics: of the load factor).
+#[derive(Debug, Clone, PartialEq)]
+pub enum TimeFunction {
+    /// The same value at every time.
+    Constant(f64),
+    /// Piecewise-linear interpolation of `(t, value)` pairs sorted by `t`;
+    /// constant extrapolation outside the table.
+    Table(Vec<(f64, f64)>),
+    /// An expression of `t` (statics: of the load factor), `{ expr = "…" }`,
+    /// with exact derivatives.
+    Expression(crate::expr::Expression),
+}
+
+/// The section values of the builder, one vocabulary for model files and
+/// Rust: `EA`, `GA₂,₃`, `GJ`, `EI₂,₃`, `ρA`, `ρJ` per unit length.
+pub use flexmech_integrators::builder::SectionValues;
+
+/// A named `[[section]]`: cross-section and material, per unit length.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SectionSpec {
+    /// Its name (`section` of a beam refers to it).
+    pub name: String,
+    /// Its values (`rho_a` 0 allowed in statics).
+    pub values: SectionValues,
+    /// Kelvin–Voigt damping time `η` (`damping`, seconds; 0: undamped).
+    pub damping: f64,
+}
+
+/// Initial geometry of a beam: the builder's [`BeamShape`](flexmech_integrators::builder::BeamShape),
+/// one vocabulary for model files and Rust. `Straight { start, end, e2 }`:
+/// `e2` is the section's second axis (not parallel to the beam; it is
+/// orthogonalised against the beam axis). `Arc { start, center, normal,
+/// sweep, e2 }`: starts at `start`, turns about the unit `normal` through
+/// `sweep` radians around `center`; the tangent at start is
+/// `normal × (start − center)/radius`; `e2` defaults to the direction from
+/// the point towards the center.
+pub use flexmech_integrators::builder::BeamShape as BeamGeometry;
+
+/// A beam meshed into equal elements.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BeamSpec {
+    /// Its name (node labels start with it).
+    pub name: String,
+    /// Index into [`Model::sections`].
+    pub section: usize,
+    /// Its initial geometry.
+    pub geometry: BeamGeometry,
+    /// Number of elements.
+    pub elements: usize,
+    /// 2 (linear) or 3 (quadratic).
+    pub nodes_per_element: usize,
+}
+
+impl BeamSpec {
+    /// Number of nodes of the beam: `elements·(nodes_per_element − 1) + 1`.
+    pub fn node_count(&self) -> usize {
+        self.elements * (self.nodes_per_element - 1) + 1
+    }
+}
+
+/// A support: the listed DOFs of a node are held at their initial values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SupportSpec {
+    /// The supported node.
+    pub node: NodeRef,
+    /// `[ux, uy, uz, rx, ry, rz]`: true where fixed.
+    pub fixed: [bool; 6],
+}
+
+/// A `[[joint]]`: a master–slave relation between two nodes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointSpec {
+    /// Its name (`/joints/<name>` in results).
+    pub name: String,
+    /// The registered kind and its parameters ([`super::JointRegistry`]).
+    pub kind: super::JointKind,
+    /// The master node (carries the joint frame); `None` for
+    /// `master = "ground"`: the joint frame is fixed in space, at the
+    /// slave's initial pose.
+    pub master: Option<NodeRef>,
+    /// The slave node (its DOFs are eliminated).
+    pub slave: NodeRef,
+    /// Initial released angle ψ₀ (default 0).
+    pub angle: f64,
+    /// Initial released angular rate (default 0).
+    pub rate: f64,
+}
+
+/// A `[[load]]`: a dead force and a fixed-axis moment on a node, or with
+/// `follower` a force and moment that turn with the node's triad.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadSpec {
+    /// The loaded node.
+    pub node: NodeRef,
+    /// Force, global components (a follower load's at t = 0).
+    pub force: [f64; 3],
+    /// Moment about fixed global axes (a follower load's at t = 0).
+    pub moment: [f64; 3],
+    /// `None` when the file gives no `time` table.
+    pub time: Option<TimeFunction>,
+    /// `follower = true`: the load turns with the node.
+    pub follower: bool,
+}
+
+/// A `[[distributed_load]]`: a dead force and a fixed-axis moment per unit
+/// length on a whole beam, applied as consistent nodal loads (`∫ q Nᵢ ds`
+/// over each element).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DistributedLoadSpec {
+    /// Index of the loaded beam in [`Model::beams`].
+    pub beam: usize,
+    /// Force per unit length, global components.
+    pub force: [f64; 3],
+    /// Moment per unit length about fixed global axes.
+    pub moment: [f64; 3],
+    /// `None` when the file gives no `time` table (as for `[[load]]`).
+    pub time: Option<TimeFunction>,
+    /// `follower = true`: the load turns with the beam's triads.
+    pub follower: bool,
+}
+
+/// A `[[prescribed]]` motion.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PrescribedSpec {
+    /// The released angle of joint `joint` (index into [`Model::joints`]) follows `angle`.
+    JointAngle {
+        /// Index into [`Model::joints`].
+        joint: usize,
+        /// The angle over time.
+        angle: TimeFunction,
+    },
+    /// DOF `dof` (0..6 = ux,uy,uz,rx,ry,rz) of `node` follows `value`
+    /// (displacement from the initial position / rotation-vector component).
+    NodeDof {
+        /// The node.
+        node: NodeRef,
+        /// 0..6 = ux, uy, uz, rx, ry, rz.
+        dof: usize,
+        /// Its value over time.
+        value: TimeFunction,
+    },
+}
+
+/// An `[[initial_velocity]]`: a rigid-body velocity field on a set of nodes,
+/// `v = linear + angular × (x − origin)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitialVelocitySpec {
+    /// The nodes it applies to.
+    pub nodes: Vec<NodeRef>,
+    /// Velocity at `origin`.
+    pub linear: [f64; 3],
+    /// Angular velocity.
+    pub angular: [f64; 3],
+    /// Reference point of `linear`.
+    pub origin: [f64; 3],
+}
+
+/// A `[[rigid_body]]`: a rigid body (a point mass when its inertia and
+/// offset are zero) carried by a node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigidBodySpec {
+    /// Its name (its index `i` when the file gives none); the centre of
+    /// mass of an offset body is the node `body.<name>` in results.
+    pub name: String,
+    /// The carrying node.
+    pub node: NodeRef,
+    /// Mass.
+    pub mass: f64,
+    /// Inertia tensor about the centre of mass in the node's initial frame
+    /// (the global axes: every node starts at the identity).
+    pub inertia: [[f64; 3]; 3],
+    /// Centre of mass from the node, in the same frame.
+    pub offset: [f64; 3],
+}
+
+/// The time integrators: the solvers' own enum, one vocabulary for model
+/// files and Rust (`IntegratorKind::name` gives the model-file name).
+pub use flexmech_integrators::dynamics::Integrator as IntegratorKind;
+
+/// How translational mass is distributed: the solvers' own enum.
+pub use flexmech_core::MassKind;
+
+/// What is solved.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Analysis {
+    /// Load factor from 0 to 1 in `load_steps` equal steps.
+    Static {
+        /// Number of equal load steps.
+        load_steps: usize,
+    },
+    /// The static path by Crisfield's arc-length method
+    /// (`[solver] control = "arc-length"`): past limit points, the load
+    /// factor an unknown, until it reaches 1.
+    ArcLength {
+        /// The first step's load increment is `1/load_steps`; its arc
+        /// length is the path's step.
+        load_steps: usize,
+        /// Most steps before the path must reach λ = 1.
+        max_steps: usize,
+        /// `branch_switch = true`: at the first bifurcation, leave the
+        /// fundamental path along the critical mode.
+        branch_switch: bool,
+    },
+    /// Time integration from 0 to `t_end`.
+    Dynamic {
+        /// The scheme.
+        integrator: IntegratorKind,
+        /// Nominal time step.
+        dt: f64,
+        /// End time.
+        t_end: f64,
+    },
+}
+
+/// `[solver]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolverSpec {
+    /// Static or dynamic, with its steps.
+    pub analysis: Analysis,
+    /// Newton's tolerance on the scaled residual norm.
+    pub tolerance: f64,
+    /// Newton iterations per step before the step is halved.
+    pub max_iterations: usize,
+    /// Halvings of a step before the run stops.
+    pub max_halvings: usize,
+    /// Translational mass distribution.
+    pub mass: MassKind,
+    /// `newton = "modified"`: keep a factorised tangent while it converges
+    /// fast enough (dynamic analyses; default `"full"`).
+    pub modified_newton: bool,
+    /// `newton = "exact"`: full Newton with the exact tangent at every
+    /// iterate, also in the energy–momentum scheme, whose `"full"` Newton
+    /// starts with a cheaper tangent (dynamic analyses).
+    pub exact_tangent: bool,
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputSpec {
+    /// Keep every k-th converged step (and the last).
+    pub every: usize,
+    /// Tracked nodes: the label as written in the file and the node it names.
+    pub track: Vec<(String, NodeRef)>,
+    /// `resultants = true`: write the stress resultants at every Gauss
+    /// point (`/resultants`).
+    pub resultants: bool,
+    /// `vtk = true`: after the run, write its ParaView time series next to
+    /// the result file (`<name>.pvd`, as `flexmech export --vtk` does).
+    pub vtk: bool,
+}
+
+/// A validated model file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// The model's name (result file `<name>.h5`).
+    pub name: String,
+    /// The file the model came from (for error messages).
+    pub path: PathBuf,
+    /// The TOML text, stored verbatim in result files.
+    pub source_text: String,
+    /// Gravity acceleration (acts on ρA).
+    pub gravity: [f64; 3],
+    /// `[[section]]` entries.
+    pub sections: Vec<SectionSpec>,
+    /// `[[beam]]` entries.
+    pub beams: Vec<BeamSpec>,
+    /// `[[support]]` entries.
+    pub supports: Vec<SupportSpec>,
+    /// `[[joint]]` entries.
+    pub joints: Vec<JointSpec>,
+    /// `[[load]]` entries.
+    pub loads: Vec<LoadSpec>,
+    /// `[[distributed_load]]` entries.
+    pub distributed_loads: Vec<DistributedLoadSpec>,
+    /// `[[prescribed]]` entries.
+    pub prescribed: Vec<PrescribedSpec>,
+    /// `[[initial_velocity]]` entries, in file order.
+    pub initial_velocities: Vec<InitialVelocitySpec>,
+    /// `[[rigid_body]]` entries (point masses included).
+    pub rigid_bodies: Vec<RigidBodySpec>,
+    /// `[solver]`.
+    pub solver: SolverSpec,
+    /// `[output]`.
+    pub output: OutputSpec,
+}

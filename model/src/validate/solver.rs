@@ -1,0 +1,337 @@
+//! The `[solver]` and `[output]` tables.
+
+use super::{limits, quoted_list, Ctx, Res};
+use crate::raw::{RawOutput, RawSolver, S};
+use crate::types::*;
+use flexmech_integrators::dynamics::generalized_alpha::DEFAULT_RHO_INF;
+
+/// `max_arc_steps` when the file gives none: this many per `load_steps`.
+const DEFAULT_ARC_STEPS_PER_LOAD_STEP: usize = 100;
+
+impl Ctx<'_> {
+    pub(super) fn solver(&self, raw: Option<&S<RawSolver>>) -> Res<SolverSpec> {
+        let Some(entry) = raw else {
+            return Ok(SolverSpec {
+                analysis: Analysis::Static { load_steps: 10 },
+                tolerance: 1e-10,
+                max_iterations: 25,
+                max_halvings: 10,
+                mass: MassKind::Consistent,
+                modified_newton: false,
+                exact_tangent: false,
+            });
+        };
+        let hs = entry.span();
+        let s = entry.get_ref();
+        let dynamic = match &s.analysis {
+            None => false,
+            Some(a) => match a.get_ref().as_str() {
+                "static" => false,
+                "dynamic" => true,
+                other => {
+                    return Err(self.at(
+                        "solver.analysis",
+                        a,
+                        format!("expected \"static\" or \"dynamic\", found \"{other}\""),
+                    ))
+                }
+            },
+        };
+        let analysis = if dynamic {
+            if let Some(l) = &s.load_steps {
+                return Err(self.at(
+                    "solver.load_steps",
+                    l,
+                    "`load_steps` belongs to a static analysis, but analysis = \"dynamic\"; a \
+                     dynamic analysis steps with `dt` up to `t_end`: remove `load_steps`",
+                ));
+            }
+            for (key, v) in [
+                ("control", s.control.as_ref().map(S::span)),
+                ("max_arc_steps", s.max_arc_steps.as_ref().map(S::span)),
+                ("branch_switch", s.branch_switch.as_ref().map(S::span)),
+            ] {
+                if let Some(span) = v {
+                    return Err(self.err(
+                        format!("solver.{key}"),
+                        Some(span),
+                        format!(
+                            "`{key}` belongs to a static analysis (load or arc-length control), \
+                             but analysis = \"dynamic\"; remove `{key}`"
+                        ),
+                    ));
+                }
+            }
+            let integrators = [
+                IntegratorKind::Newmark,
+                IntegratorKind::GeneralizedAlpha {
+                    rho_inf: DEFAULT_RHO_INF,
+                },
+                IntegratorKind::Momentum,
+                IntegratorKind::EnergyMomentum,
+                IntegratorKind::EnergyMomentumPaper,
+            ];
+            let names = quoted_list(integrators.iter().map(|i| i.name()));
+            let int_s = self.need(
+                &s.integrator,
+                "solver.integrator",
+                &hs,
+                &format!("a dynamic analysis needs an integrator, one of {names}"),
+            )?;
+            let Some(&integrator) = integrators.iter().find(|i| i.name() == int_s.get_ref()) else {
+                return Err(self.at(
+                    "solver.integrator",
+                    int_s,
+                    format!(
+                        "unknown integrator \"{}\"; expected one of {names}",
+                        int_s.get_ref()
+                    ),
+                ));
+            };
+            let integrator = match (integrator, &s.rho_inf) {
+                (IntegratorKind::GeneralizedAlpha { .. }, Some(r)) => {
+                    let rho_inf = r.get_ref().0;
+                    if !(0.0..=1.0).contains(&rho_inf) {
+                        return Err(self.at(
+                            "solver.rho_inf",
+                            r,
+                            format!(
+                                "the spectral radius at infinite frequency must lie in [0, 1] \
+                                 (1: no numerical damping, 0: the most), found {rho_inf:?}"
+                            ),
+                        ));
+                    }
+                    IntegratorKind::GeneralizedAlpha { rho_inf }
+                }
+                (_, Some(r)) => {
+                    return Err(self.at(
+                        "solver.rho_inf",
+                        r,
+                        format!(
+                            "`rho_inf` belongs to integrator = \"generalized-alpha\", but this \
+                             run uses \"{}\"; remove `rho_inf` or change the integrator",
+                            integrator.name()
+                        ),
+                    ))
+                }
+                (integrator, None) => integrator,
+            };
+            let dt_s = self.need(
+                &s.dt,
+                "solver.dt",
+                &hs,
+                "a dynamic analysis needs the time step, e.g. dt = 0.01",
+            )?;
+            let dt = self.positive(dt_s, "solver.dt")?;
+            let t_end_s = self.need(
+                &s.t_end,
+                "solver.t_end",
+                &hs,
+                "a dynamic analysis needs the end time, e.g. t_end = 1.0",
+            )?;
+            let t_end = self.positive(t_end_s, "solver.t_end")?;
+            if dt > t_end {
+                return Err(self.at(
+                    "solver.dt",
+                    dt_s,
+                    format!("must be <= t_end = {t_end:?}, found {dt:?}"),
+                ));
+            }
+            if t_end / dt > limits::MAX_TIME_STEPS {
+                return Err(self.at(
+                    "solver.dt",
+                    dt_s,
+                    format!(
+                        "gives t_end/dt = {:.3e} steps, more than the {:.0e} a run may take \
+                         (one stored record each); use a larger dt or a shorter t_end",
+                        t_end / dt,
+                        limits::MAX_TIME_STEPS
+                    ),
+                ));
+            }
+            Analysis::Dynamic {
+                integrator,
+                dt,
+                t_end,
+            }
+        } else {
+            let dynamic_only = [
+                ("dt", s.dt.as_ref().map(S::span)),
+                ("t_end", s.t_end.as_ref().map(S::span)),
+                ("integrator", s.integrator.as_ref().map(S::span)),
+                ("rho_inf", s.rho_inf.as_ref().map(S::span)),
+            ];
+            if let Some((key, span)) = dynamic_only.iter().find(|(_, sp)| sp.is_some()) {
+                let default = if s.analysis.is_none() {
+                    " (the default)"
+                } else {
+                    ""
+                };
+                return Err(self.err(
+                    format!("solver.{key}"),
+                    span.clone(),
+                    format!(
+                        "`{key}` belongs to a dynamic analysis, but this analysis is static{default}; \
+                         set analysis = \"dynamic\", or remove `{key}` (a static analysis takes `load_steps`)"
+                    ),
+                ));
+            }
+            let load_steps = match &s.load_steps {
+                Some(l) => self.int_in(l, "solver.load_steps", 1, limits::MAX_LOAD_STEPS)?,
+                None => 10,
+            };
+            let arc_length = match &s.control {
+                None => false,
+                Some(c) => match c.get_ref().as_str() {
+                    "load" => false,
+                    "arc-length" => true,
+                    other => {
+                        return Err(self.at(
+                            "solver.control",
+                            c,
+                            format!("expected \"load\" or \"arc-length\", found \"{other}\""),
+                        ))
+                    }
+                },
+            };
+            let branch_switch = match (&s.branch_switch, arc_length) {
+                (Some(b), false) => {
+                    return Err(self.at(
+                        "solver.branch_switch",
+                        b,
+                        "`branch_switch` belongs to control = \"arc-length\"; set it, or \
+                         remove `branch_switch`",
+                    ))
+                }
+                (b, _) => b.as_ref().is_some_and(|b| *b.get_ref()),
+            };
+            match (&s.max_arc_steps, arc_length) {
+                (Some(m), true) => Analysis::ArcLength {
+                    load_steps,
+                    max_steps: self.int_in(m, "solver.max_arc_steps", 1, limits::MAX_LOAD_STEPS)?,
+                    branch_switch,
+                },
+                (None, true) => Analysis::ArcLength {
+                    load_steps,
+                    max_steps: DEFAULT_ARC_STEPS_PER_LOAD_STEP * load_steps,
+                    branch_switch,
+                },
+                (Some(m), false) => {
+                    return Err(self.at(
+                        "solver.max_arc_steps",
+                        m,
+                        "`max_arc_steps` belongs to control = \"arc-length\"; set it, or \
+                         remove `max_arc_steps`",
+                    ))
+                }
+                (None, false) => Analysis::Static { load_steps },
+            }
+        };
+        let tolerance = match &s.tolerance {
+            Some(t) => self.positive(t, "solver.tolerance")?,
+            None => 1e-10,
+        };
+        let max_iterations = match &s.max_iterations {
+            Some(m) => self.int_in(m, "solver.max_iterations", 1, limits::MAX_ITERATIONS)?,
+            None => 25,
+        };
+        let max_halvings = match &s.max_halvings {
+            Some(m) => self.int_in(m, "solver.max_halvings", 0, limits::MAX_HALVINGS)?,
+            None => 10,
+        };
+        let mass = match &s.mass {
+            None => MassKind::Consistent,
+            Some(m) => match m.get_ref().as_str() {
+                "consistent" => MassKind::Consistent,
+                "lumped" => MassKind::Lumped,
+                other => {
+                    return Err(self.at(
+                        "solver.mass",
+                        m,
+                        format!("expected \"consistent\" or \"lumped\", found \"{other}\""),
+                    ))
+                }
+            },
+        };
+        let (modified_newton, exact_tangent) = match &s.newton {
+            None => (false, false),
+            Some(m) => match m.get_ref().as_str() {
+                "full" => (false, false),
+                "exact" => (false, true),
+                "modified" => match &analysis {
+                    Analysis::Static { .. } | Analysis::ArcLength { .. } => {
+                        return Err(self.at(
+                            "solver.newton",
+                            m,
+                            "modified Newton is for dynamic analyses (a static path checks \
+                             the stability of every converged state with its exact tangent); \
+                             remove `newton` or set it to \"full\"",
+                        ))
+                    }
+                    Analysis::Dynamic {
+                        integrator: IntegratorKind::EnergyMomentumPaper,
+                        ..
+                    } => {
+                        return Err(self.at(
+                            "solver.newton",
+                            m,
+                            "the paper's energy-momentum scheme solves a bordered system with \
+                             the exact tangent at every iterate; use newton = \"full\", or \
+                             integrator = \"energy-momentum\"",
+                        ))
+                    }
+                    Analysis::Dynamic { .. } => (true, false),
+                },
+                other => {
+                    return Err(self.at(
+                        "solver.newton",
+                        m,
+                        format!("expected \"full\", \"exact\" or \"modified\", found \"{other}\""),
+                    ))
+                }
+            },
+        };
+        Ok(SolverSpec {
+            analysis,
+            tolerance,
+            max_iterations,
+            max_halvings,
+            mass,
+            modified_newton,
+            exact_tangent,
+        })
+    }
+
+    pub(super) fn output(&self, raw: Option<&S<RawOutput>>, beams: &[BeamSpec]) -> Res<OutputSpec> {
+        let Some(entry) = raw else {
+            return Ok(OutputSpec {
+                every: 1,
+                track: Vec::new(),
+                resultants: false,
+                vtk: false,
+            });
+        };
+        let o = entry.get_ref();
+        let every = match &o.every {
+            Some(e) => self.int_in(e, "output.every", 1, limits::MAX_EVERY)?,
+            None => 1,
+        };
+        let mut track: Vec<(String, NodeRef)> = Vec::new();
+        if let Some(list) = &o.track {
+            for (n, item) in list.get_ref().iter().enumerate() {
+                let key = format!("output.track[{n}]");
+                let label = item.get_ref();
+                if track.iter().any(|(l, _)| l == label) {
+                    return Err(self.at(key, item, format!("node \"{label}\" is listed twice")));
+                }
+                track.push((label.clone(), self.node(item, &key, beams)?));
+            }
+        }
+        Ok(OutputSpec {
+            every,
+            track,
+            resultants: o.resultants.as_ref().is_some_and(|r| *r.get_ref()),
+            vtk: o.vtk.as_ref().is_some_and(|r| *r.get_ref()),
+        })
+    }
+}

@@ -1,0 +1,637 @@
+//! Running one model: build it, solve it, stream every kept step into its
+//! HDF5 result file. A run that fails part-way still leaves a valid file with
+//! `status = "failed: …"` and every step computed before the failure.
+
+use crate::checks::{Balance, Stability};
+use crate::{
+    layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultWriter,
+    ResultantsMeta, RunMeta,
+};
+use flexmech_integrators::arc_length::{solve_arc_length, ArcLengthSettings};
+use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
+use flexmech_integrators::{
+    solve_static, Mechanism, NewtonSettings, SolveError, StaticSettings, StepRecord,
+};
+use flexmech_model::build::{build, Built};
+use flexmech_model::{Analysis, IntegratorKind, Model, ModelError};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use thiserror::Error;
+
+/// Why a run did not complete.
+#[derive(Debug, Error)]
+pub enum RunError {
+    /// The model could not be loaded or built.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The output directory could not be created.
+    #[error("cannot create the output directory {dir}: {source}")]
+    OutputDir {
+        /// The directory.
+        dir: PathBuf,
+        /// The system's error.
+        source: std::io::Error,
+    },
+    /// Writing the result file failed.
+    #[error(transparent)]
+    Result(#[from] ResultError),
+    /// Two models of one `flexmech run` have the same `name`: the second
+    /// would overwrite the first's result file, so it is refused.
+    #[error(
+        "{}: key `name`: \"{name}\" is also the name of {} in this run; their results would \
+         overwrite each other ({name}.h5): give one of them another name",
+        file.display(),
+        first.display()
+    )]
+    DuplicateName {
+        /// The shared name.
+        name: String,
+        /// The second model file.
+        file: PathBuf,
+        /// The first model file with that name.
+        first: PathBuf,
+    },
+    /// The result file to continue cannot be read.
+    #[error(transparent)]
+    Restart(#[from] RestartError),
+    /// The ParaView series of `[output] vtk = true` could not be written
+    /// (the result file is complete).
+    #[error(transparent)]
+    Export(#[from] crate::export::ExportError),
+    /// The result file to continue is not a run of this model.
+    #[error(
+        "{}: cannot continue {} with this model: {why}",
+        model.display(),
+        result.display()
+    )]
+    RestartMismatch {
+        /// The model file.
+        model: PathBuf,
+        /// The result file.
+        result: PathBuf,
+        /// What differs, and what to do.
+        why: String,
+    },
+    /// The solver stopped; `file` holds the steps computed before.
+    #[error(
+        "{}: model \"{model}\": {error} (steps computed so far are in {})",
+        path.display(),
+        file.display()
+    )]
+    Solve {
+        /// The model's name.
+        model: String,
+        /// The model file.
+        path: PathBuf,
+        /// The solver's error.
+        error: Box<SolveError>,
+        /// The result file holding the steps computed before.
+        file: PathBuf,
+    },
+}
+
+/// What a completed run reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSummary {
+    /// The result file.
+    pub file: PathBuf,
+    /// The ParaView series (`.pvd`) written with `[output] vtk = true`.
+    pub vtk: Option<PathBuf>,
+    /// Converged steps.
+    pub steps: usize,
+    /// Steps written (every `output.every`-th and the last).
+    pub written: usize,
+    /// Total Newton iterations.
+    pub iterations: usize,
+    /// Wall time of the solve, seconds.
+    pub wall_time_s: f64,
+    /// The part of [`Self::wall_time_s`] before the first time step of a
+    /// dynamic run: building the simulation (patterns, orderings), the
+    /// initial accelerations and the first record; 0 for static and
+    /// arc-length runs. `wall_time_s − setup_time_s` is the time steps'.
+    pub setup_time_s: f64,
+    /// What the run's checks found doubtful in the completed result (also in
+    /// the file's root attribute `warnings`).
+    pub warnings: Vec<String>,
+}
+
+impl std::fmt::Display for RunSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} steps ({} written, {} Newton iterations) in {:.2} s -> {}",
+            self.steps,
+            self.written,
+            self.iterations,
+            self.wall_time_s,
+            self.file.display()
+        )?;
+        for w in &self.warnings {
+            write!(f, "\nwarning: {w}")?;
+        }
+        Ok(())
+    }
+}
+
+pub use crate::checks::ENERGY_BALANCE_WARNING;
+
+/// Keeps every `every`-th step and always the last one.
+struct Sink<'a> {
+    writer: ResultWriter,
+    mech: &'a Mechanism,
+    /// The energy balance, for dynamic runs.
+    balance: Option<Balance>,
+    /// The stability of the load path, for static runs.
+    stability: Option<Stability>,
+    /// The run's figures of merit over every converged step.
+    merit: Merit,
+    every: usize,
+    count: usize,
+    iterations: usize,
+    pending: Option<StepRecord>,
+    error: Option<ResultError>,
+}
+
+impl Sink<'_> {
+    /// Takes a step's record; returns whether it was written now.
+    fn push(&mut self, step: &StepRecord) -> bool {
+        if let Some(b) = &mut self.balance {
+            b.push(self.mech, step);
+        }
+        if let Some(s) = &mut self.stability {
+            s.push(step);
+        }
+        self.merit.push(step);
+        self.count += 1;
+        self.iterations += step.iterations;
+        if self.error.is_some() {
+            return false;
+        }
+        if self.count.is_multiple_of(self.every) {
+            self.pending = None;
+            if let Err(e) = self.writer.append(step) {
+                self.error = Some(e);
+            }
+            self.error.is_none()
+        } else {
+            self.pending = Some(step.clone());
+            false
+        }
+    }
+
+    /// Writes the last record if it is still pending; returns whether it did.
+    fn flush_last(&mut self) -> bool {
+        if let (Some(step), None) = (self.pending.take(), &self.error) {
+            if let Err(e) = self.writer.append(&step) {
+                self.error = Some(e);
+            }
+            return self.error.is_none();
+        }
+        false
+    }
+
+    /// Rewrites the file's restart state with the simulation's.
+    fn checkpoint(&mut self, sim: &Simulation<'_>) {
+        if self.error.is_none() {
+            if let Err(e) = self.writer.checkpoint(&sim.checkpoint()) {
+                self.error = Some(e);
+            }
+        }
+    }
+}
+
+/// Whether the stability count of a static `model` is a stability
+/// statement (see [`Stability`]): no applied nodal moment, no prescribed
+/// nodal rotation.
+fn conservative(model: &Model) -> bool {
+    model
+        .loads
+        .iter()
+        .all(|l| l.moment == [0.0; 3] && !l.follower)
+        && model
+            .distributed_loads
+            .iter()
+            .all(|l| l.moment == [0.0; 3] && !l.follower)
+        && model.prescribed.iter().all(|p| match p {
+            flexmech_model::PrescribedSpec::NodeDof { dof, .. } => *dof < 3,
+            flexmech_model::PrescribedSpec::JointAngle { .. } => true,
+        })
+}
+
+/// Full Newton with the model's tolerance and iteration limit (statics
+/// checks the stability of every converged state with its exact tangent).
+fn static_newton(model: &Model) -> NewtonSettings {
+    NewtonSettings {
+        tolerance: model.solver.tolerance,
+        max_iterations: model.solver.max_iterations,
+        modified: false,
+        exact_tangent: false,
+    }
+}
+
+/// Runs `model` and writes `out_dir/<name>.h5`.
+pub fn run_model(model: &Model, out_dir: &Path) -> Result<RunSummary, RunError> {
+    run_model_to(model, &out_dir.join(format!("{}.h5", model.name)))
+}
+
+/// Runs `model` and writes its results to `file` (parent directories are
+/// created).
+pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> {
+    run(model, file, None)
+}
+
+/// Relative distance between a node's initial position in the model and in
+/// the run to continue below which they are the same node (round-off of the
+/// mesh generator on coordinates of the model's size).
+const SAME_NODE: f64 = 1e-12;
+
+/// Continues the dynamic run stored in the result file `result` (its
+/// `/restart` state, the last stored step) to `model`'s `t_end`, writing
+/// `out_dir/<name>.h5` from the restart time on. `model` must describe the
+/// same mechanism (nodes, joints, prescribed DOFs) with the same integrator
+/// and `dt`; with full Newton the continuation equals the uninterrupted run
+/// bit for bit.
+pub fn restart_model(model: &Model, result: &Path, out_dir: &Path) -> Result<RunSummary, RunError> {
+    let file = out_dir.join(format!("{}.h5", model.name));
+    let mismatch = |why: String| RunError::RestartMismatch {
+        model: model.path.clone(),
+        result: result.to_path_buf(),
+        why,
+    };
+    let same_file = match (file.canonicalize(), result.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    if same_file {
+        return Err(mismatch(format!(
+            "the continuation would overwrite the file it continues ({}); give another --out",
+            file.display()
+        )));
+    }
+    let (checkpoint, initial) = read_checkpoint(result)?;
+    let Analysis::Dynamic { t_end, .. } = model.solver.analysis else {
+        return Err(mismatch(
+            "key `solver.analysis`: a static analysis cannot be continued; restarts continue \
+             dynamic runs"
+                .into(),
+        ));
+    };
+    if checkpoint.time >= t_end {
+        return Err(mismatch(format!(
+            "key `solver.t_end`: the stored run already reaches t = {} >= t_end = {t_end}; set a \
+             later t_end",
+            checkpoint.time
+        )));
+    }
+    let built = build(model)?;
+    let here = &built.mechanism.mesh.positions;
+    if here.len() != initial.len() {
+        return Err(mismatch(format!(
+            "the stored run has {} nodes, the model {}",
+            initial.len(),
+            here.len()
+        )));
+    }
+    let scale = here.iter().map(|x| x.norm()).fold(1.0, f64::max);
+    if let Some(i) = here
+        .iter()
+        .zip(&initial)
+        .position(|(a, b)| (a - nalgebra::Vector3::from(*b)).norm() > SAME_NODE * scale)
+    {
+        return Err(mismatch(format!(
+            "node {i} starts at {:?} in the stored run and at {:?} in the model: not the same \
+             mechanism",
+            initial[i],
+            [here[i].x, here[i].y, here[i].z]
+        )));
+    }
+    run(model, &file, Some((&checkpoint, result)))
+}
+
+fn run(
+    model: &Model,
+    file: &Path,
+    restart_from: Option<(&Checkpoint, &Path)>,
+) -> Result<RunSummary, RunError> {
+    let restart = restart_from.map(|(c, _)| c);
+    let built: Built = build(model)?;
+    let out_dir = file
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(out_dir).map_err(|source| RunError::OutputDir {
+        dir: out_dir.to_path_buf(),
+        source,
+    })?;
+    let file = file.to_path_buf();
+    let mech = &built.mechanism;
+    let mesh = mesh_meta(model, &built);
+    let supports = mech
+        .supported_nodes()
+        .into_iter()
+        .map(|n| mesh.node_labels[n].clone())
+        .collect();
+    let meta = RunMeta {
+        model_text: model.source_text.clone(),
+        integrator: match model.solver.analysis {
+            Analysis::Static { .. } | Analysis::ArcLength { .. } => "static".to_string(),
+            Analysis::Dynamic { integrator, .. } => integrator.name().to_string(),
+        },
+        initial_positions: mech
+            .mesh
+            .positions
+            .iter()
+            .map(|x| [x.x, x.y, x.z])
+            .collect(),
+        tracked: model
+            .output
+            .track
+            .iter()
+            .map(|(label, r)| (label.clone(), built.node(*r)))
+            .collect(),
+        // The model's joints, then the rigid bodies' joints (`body.<name>`).
+        joint_names: mech.joints.iter().map(|j| j.name.clone()).collect(),
+        joint_angles: mech
+            .joints
+            .iter()
+            .map(|j| j.map.reported_angle(&j.initial).is_some())
+            .collect(),
+        joint_nodes: mech.joints.iter().map(|j| [j.master, j.slave]).collect(),
+        command_line: command_line(),
+        supports,
+        mesh: Some(mesh),
+        resultants: model.output.resultants.then(|| ResultantsMeta {
+            mesh: mech.mesh.clone(),
+            beams: model
+                .beams
+                .iter()
+                .zip(&built.beam_elements)
+                .map(|(b, e)| (b.name.clone(), e.clone()))
+                .collect(),
+        }),
+    };
+    let mut writer = ResultWriter::create(&file, &meta)?;
+    if let Some((c, from)) = restart_from {
+        writer.restarted_from(from, c.time)?;
+    }
+    let dynamic = matches!(model.solver.analysis, Analysis::Dynamic { .. });
+    let dissipative = matches!(
+        model.solver.analysis,
+        Analysis::Dynamic {
+            integrator: IntegratorKind::GeneralizedAlpha { .. },
+            ..
+        }
+    );
+    let mut sink = Sink {
+        writer,
+        mech,
+        balance: dynamic.then(|| Balance::new(dissipative)),
+        stability: (!dynamic).then(|| Stability::new(conservative(model))),
+        merit: Merit::new(
+            meta.tracked
+                .iter()
+                .map(|&(_, n)| (n, meta.initial_positions[n]))
+                .collect(),
+        ),
+        every: model.output.every.max(1),
+        count: 0,
+        iterations: 0,
+        pending: None,
+        error: None,
+    };
+    let start = Instant::now();
+    let mut setup = 0.0;
+    let outcome = match model.solver.analysis {
+        Analysis::Static { load_steps } => {
+            let settings = StaticSettings {
+                load_steps,
+                newton: static_newton(model),
+                max_halvings: model.solver.max_halvings,
+            };
+            solve_static(mech, &settings, |s| {
+                sink.push(s);
+            })
+            .map(|_| ())
+        }
+        Analysis::ArcLength {
+            load_steps,
+            max_steps,
+            branch_switch,
+        } => {
+            let settings = ArcLengthSettings {
+                load_steps,
+                newton: static_newton(model),
+                max_halvings: model.solver.max_halvings,
+                max_steps,
+                branch_switch,
+            };
+            solve_arc_length(mech, &settings, |s| {
+                sink.push(s);
+            })
+            .map(|_| ())
+        }
+        Analysis::Dynamic {
+            integrator,
+            dt,
+            t_end,
+        } => {
+            let settings = DynamicSettings {
+                dt,
+                t_end,
+                newton: NewtonSettings {
+                    tolerance: model.solver.tolerance,
+                    max_iterations: model.solver.max_iterations,
+                    modified: model.solver.modified_newton,
+                    exact_tangent: model.solver.exact_tangent,
+                },
+                max_halvings: model.solver.max_halvings,
+                mass: model.solver.mass,
+            };
+            let sim = match restart {
+                Some(c) => Simulation::resume(mech, integrator, &settings, c),
+                None => Simulation::new(mech, integrator, &settings, &built.motion),
+            };
+            sim.and_then(|mut sim| {
+                if sink.push(&sim.record()) {
+                    sink.checkpoint(&sim);
+                }
+                setup = start.elapsed().as_secs_f64();
+                let outcome = loop {
+                    match sim.step() {
+                        Ok(Some(record)) => {
+                            if sink.push(&record) {
+                                sink.checkpoint(&sim);
+                            }
+                        }
+                        Ok(None) => break Ok(()),
+                        Err(e) => break Err(e),
+                    }
+                };
+                // The last converged state, also after a failure.
+                if sink.flush_last() {
+                    sink.checkpoint(&sim);
+                }
+                outcome
+            })
+        }
+    };
+    let wall = start.elapsed().as_secs_f64();
+    sink.flush_last();
+    if sink.error.is_none() {
+        if let Err(e) = sink.writer.figures(&sink.merit) {
+            sink.error = Some(e);
+        }
+    }
+    if let Some(e) = sink.error.take() {
+        // The file is as valid as HDF5 left it; report the write failure.
+        let _ = sink
+            .writer
+            .finish(&layout::failed_status(&e.to_string()), wall);
+        return Err(e.into());
+    }
+    let written = sink.writer.steps_written();
+    match outcome {
+        Ok(()) => {
+            let warnings: Vec<String> = sink
+                .balance
+                .as_ref()
+                .and_then(Balance::warning)
+                .into_iter()
+                .chain(sink.stability.as_ref().and_then(Stability::warning))
+                .collect();
+            if !warnings.is_empty() {
+                sink.writer.warn(&warnings.join("; "))?;
+            }
+            let file = sink.writer.finish(layout::STATUS_COMPLETED, wall)?;
+            let vtk = if model.output.vtk {
+                Some(crate::export::export_vtk(&file, out_dir, None)?)
+            } else {
+                None
+            };
+            Ok(RunSummary {
+                file,
+                vtk,
+                steps: sink.count,
+                written,
+                iterations: sink.iterations,
+                wall_time_s: wall,
+                setup_time_s: setup,
+                warnings,
+            })
+        }
+        Err(mut error) => {
+            name_the_beam(model, &built, &mut error);
+            let file = sink
+                .writer
+                .finish(&layout::failed_status(&error.to_string()), wall)?;
+            Err(RunError::Solve {
+                model: model.name.clone(),
+                path: model.path.clone(),
+                error: Box::new(error),
+                file,
+            })
+        }
+    }
+}
+
+/// This process's command line, arguments with spaces quoted.
+fn command_line() -> String {
+    std::env::args()
+        .map(|a| {
+            if a.contains(char::is_whitespace) {
+                format!("{a:?}")
+            } else {
+                a
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Labels, elements and beams of the built mechanism, for `/mesh`.
+fn mesh_meta(model: &Model, built: &Built) -> MeshMeta {
+    let mesh = &built.mechanism.mesh;
+    let mut node_labels = vec![String::new(); mesh.node_count()];
+    for (b, nodes) in built.beam_nodes.iter().enumerate() {
+        for (k, &n) in nodes.iter().enumerate() {
+            node_labels[n] = model.node_label(flexmech_model::NodeRef { beam: b, node: k });
+        }
+    }
+    for &(j, n) in &built.ground_nodes {
+        node_labels[n] = format!("ground.{}", model.joints[j].name);
+    }
+    for &(b, n) in &built.body_nodes {
+        node_labels[n] = format!("body.{}", model.rigid_bodies[b].name);
+    }
+    let mut node_directors = vec![[[0.0; 3]; 3]; mesh.node_count()];
+    for e in &mesh.elements {
+        for (&n, l0) in e.nodes().iter().zip(e.initial_triads()) {
+            node_directors[n] = std::array::from_fn(|k| [l0[(0, k)], l0[(1, k)], l0[(2, k)]]);
+        }
+    }
+    MeshMeta {
+        node_labels,
+        node_directors,
+        elements: mesh.elements.iter().map(|e| e.nodes().to_vec()).collect(),
+        beams: model
+            .beams
+            .iter()
+            .zip(&built.beam_nodes)
+            .map(|(b, nodes)| (b.name.clone(), nodes.clone()))
+            .collect(),
+    }
+}
+
+/// Names the model's own entries in an error: the beam (and the element
+/// within it) of an element — elements are numbered beam after beam, in the
+/// model's order — and the `[[prescribed]]` entry of a prescribed nodal DOF
+/// (the mechanism numbers only the nodal ones), and the nodes of a free
+/// motion.
+fn name_the_beam(model: &Model, built: &Built, error: &mut SolveError) {
+    if let SolveError::Unrestrained { motion, .. } = error {
+        motion.labels = motion
+            .nodes
+            .iter()
+            .map(|&n| {
+                built
+                    .beam_nodes
+                    .iter()
+                    .enumerate()
+                    .find_map(|(b, nodes)| {
+                        nodes
+                            .iter()
+                            .position(|&m| m == n)
+                            .map(|k| model.node_label(flexmech_model::NodeRef { beam: b, node: k }))
+                    })
+                    .unwrap_or_else(|| format!("node {n}"))
+            })
+            .collect();
+    }
+    if let SolveError::PrescribedRotationStep { index, .. } = error {
+        if let Some(i) = model
+            .prescribed
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| matches!(p, flexmech_model::PrescribedSpec::NodeDof { .. }))
+            .nth(*index)
+            .map(|(i, _)| i)
+        {
+            *index = i;
+        }
+    }
+    if let SolveError::ElementRotation { element, beam, .. } = error {
+        let mut first = 0;
+        for b in &model.beams {
+            if *element < first + b.elements {
+                *beam = format!(
+                    " (element {} of beam \"{}\", which has {})",
+                    *element - first,
+                    b.name,
+                    b.elements
+                );
+                return;
+            }
+            first += b.elements;
+        }
+    }
+}

@@ -1,0 +1,1255 @@
+//! The incremental HDF5 writer. The layout it produces is documented on the
+//! parent module ([`crate::results`]); the names live in [`super::layout`].
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+use flexmech_integrators::record::StepRecord;
+
+use hdf5::{Dataset, Extent, File, H5Type, Location};
+
+use super::layout as names;
+
+/// Appended steps are held in memory and written together (one resize and
+/// one write per dataset, then one flush of the file) when the oldest held
+/// step is this old...
+const WRITE_INTERVAL: std::time::Duration = std::time::Duration::from_secs(1);
+/// ... or the held steps reach this many values (32 MiB), whichever first;
+/// [`ResultWriter::flush`] and [`ResultWriter::finish`] write them at once.
+const HELD_VALUES: usize = 1 << 22;
+
+/// Rows per chunk of the time series (`T`, `T×3`, `T×4`).
+const SERIES_CHUNK_ROWS: usize = 256;
+/// Elements per chunk of the flat Newton residual history and its offsets.
+const NEWTON_CHUNK: usize = 1024;
+/// Upper bound on the rows (steps) per chunk of `/configuration/*`.
+const CONFIG_CHUNK_ROWS: usize = 16;
+/// Upper bound on the nodes per chunk of `/configuration/*`.
+const CONFIG_CHUNK_NODES: usize = 16_384;
+/// Target size of one `/configuration/*` chunk; it must fit HDF5's default
+/// 1 MiB per-dataset chunk cache, or every one-step write becomes a
+/// read-modify-write of the whole chunk.
+const CONFIG_CHUNK_BYTES: usize = 512 * 1024;
+
+/// What a run is: written once, when the file is created.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RunMeta {
+    /// The model file text; root attribute `model`.
+    pub model_text: String,
+    /// Integrator name; root attribute `integrator` (`"static"` for statics).
+    pub integrator: String,
+    /// Initial position of every node. Its length is the node count every
+    /// [`StepRecord`] must match; displacements are measured from it.
+    pub initial_positions: Vec<[f64; 3]>,
+    /// Tracked nodes as `(label, node index)`: the label, verbatim, names the
+    /// group `/nodes/<label>` holding `position`, `displacement` and `rotation`.
+    pub tracked: Vec<(String, usize)>,
+    /// Joint names in model order: `/joints/<name>` holds `angle`,
+    /// `released_translation` and `constraint_error`. Every [`StepRecord`]
+    /// must carry exactly this many joint records.
+    pub joint_names: Vec<String>,
+    /// Per joint, whether it has a released angle (`/joints/<name>/angle`
+    /// is written only then); joints past the end of the list have one.
+    pub joint_angles: Vec<bool>,
+    /// Per joint, its master and slave node (indices into
+    /// `/configuration`): attributes `master_node`, `slave_node` of
+    /// `/joints/<name>` (omitted for joints past the end of the list).
+    pub joint_nodes: Vec<[usize; 2]>,
+    /// The command line that made the run; root attribute `command_line`
+    /// (omitted when empty).
+    pub command_line: String,
+    /// Labels of the supported nodes (`Mechanism::supported_nodes` order):
+    /// `/supports/<label>/reaction_force` and `reaction_moment`; every
+    /// [`StepRecord`] must then carry as many support reactions.
+    pub supports: Vec<String>,
+    /// The mesh: `/mesh` (omitted when `None`).
+    pub mesh: Option<super::mesh::MeshMeta>,
+    /// The stress resultants to write under `/resultants` (omitted when
+    /// `None`; see [`super::resultants`]).
+    pub resultants: Option<super::resultants::ResultantsMeta>,
+}
+
+/// Everything that can go wrong while writing a result file.
+#[derive(Debug, thiserror::Error)]
+pub enum ResultError {
+    /// Another process holds the result file's lock: creating the file
+    /// would truncate a result being written (or just finished) there.
+    #[error(
+        "{}: another process is writing this result file (its lock {} is held); wait for it \
+         to finish, or write to another --out directory",
+        .path.display(),
+        .lock.display()
+    )]
+    Busy {
+        /// The result file.
+        path: PathBuf,
+        /// The lock file beside it.
+        lock: PathBuf,
+    },
+    /// The lock file beside the result could not be locked.
+    #[error("{}: cannot lock the result file: {source}", .lock.display())]
+    Lock {
+        /// The lock file.
+        lock: PathBuf,
+        /// The system's error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The HDF5 library reported an error.
+    #[error("{}: HDF5 error while {what}: {source}", .path.display())]
+    Hdf5 {
+        /// The result file.
+        path: PathBuf,
+        /// What was being done, naming the dataset or attribute.
+        what: String,
+        /// The library's error.
+        #[source]
+        source: hdf5::Error,
+    },
+    /// A step record does not match the run's meta data; nothing of the step
+    /// was written and the writer stays usable.
+    #[error(
+        "{}: step {step} (0-based) has {found} {field}, but the run has {expected}",
+        .path.display()
+    )]
+    RecordLength {
+        /// The result file.
+        path: PathBuf,
+        /// Index of the rejected step (= steps written before it).
+        step: usize,
+        /// `"positions"`, `"quaternions"`, `"joints"`, `"support_reactions"`,
+        /// `"velocities"` or `"angular_velocities"` (dynamics).
+        field: &'static str,
+        /// Length given by [`RunMeta`].
+        expected: usize,
+        /// Length found in the record.
+        found: usize,
+    },
+    /// A tracked node refers to a node the run does not have.
+    #[error(
+        "{}: tracked node {label:?} refers to node {index}, but the run has {nodes} nodes",
+        .path.display()
+    )]
+    NodeIndex {
+        /// The result file.
+        path: PathBuf,
+        /// The tracked node's label.
+        label: String,
+        /// The out-of-range index.
+        index: usize,
+        /// Number of nodes (`initial_positions.len()`).
+        nodes: usize,
+    },
+    /// A label or joint name cannot be used verbatim as a group name, or is
+    /// used twice.
+    #[error("{}: {kind} name {name:?} cannot name an HDF5 group: {reason}", .path.display())]
+    InvalidName {
+        /// The result file.
+        path: PathBuf,
+        /// `"node label"` or `"joint"`.
+        kind: &'static str,
+        /// The offending name.
+        name: String,
+        /// Why it is rejected.
+        reason: &'static str,
+    },
+}
+
+/// Attaches the file path and a description of the operation to HDF5 errors.
+trait Context<T> {
+    fn ctx(self, path: &Path, what: impl FnOnce() -> String) -> Result<T, ResultError>;
+}
+
+impl<T> Context<T> for hdf5::Result<T> {
+    fn ctx(self, path: &Path, what: impl FnOnce() -> String) -> Result<T, ResultError> {
+        self.map_err(|source| ResultError::Hdf5 {
+            path: path.to_path_buf(),
+            what: what(),
+            source,
+        })
+    }
+}
+
+/// Rotation vector ψ (axis × angle, |ψ| ≤ π) of the unit quaternion
+/// `q = (w, x, y, z)`.
+///
+/// The quaternion is normalised, its sign chosen so that `w ≥ 0` (q and −q
+/// are the same rotation), and `ψ = 2·atan2(|v|, w)·v/|v|` with `v = (x, y, z)`;
+/// for `|v| < 1e-4` the factor `2·atan2(|v|, w)/|v|` is replaced by its series
+/// `(2/w)(1 − |v|²/(3w²))`, exact to rounding there. A zero or non-finite
+/// quaternion gives NaNs.
+pub fn rotation_vector(q: [f64; 4]) -> [f64; 3] {
+    let norm = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if !(norm.is_finite() && norm > 0.0) {
+        return [f64::NAN; 3];
+    }
+    let sign = if q[0] < 0.0 { -1.0 } else { 1.0 };
+    let s = sign / norm;
+    let (w, v) = (q[0] * s, [q[1] * s, q[2] * s, q[3] * s]);
+    let sin_half = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let factor = if sin_half < 1e-4 {
+        // Here w = sqrt(1 − |v|²) > 0.99999999.
+        2.0 / w * (1.0 - sin_half * sin_half / (3.0 * w * w))
+    } else {
+        2.0 * sin_half.atan2(w) / sin_half
+    };
+    [factor * v[0], factor * v[1], factor * v[2]]
+}
+
+use crate::table::{str_attr as create_str_attr, varlen};
+
+fn set_str_attr(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
+    if loc.attr_names()?.iter().any(|n| n == name) {
+        loc.attr(name)?.as_writer().write_scalar(&varlen(value))
+    } else {
+        create_str_attr(loc, name, value)
+    }
+}
+
+fn create_group(
+    file: &File,
+    path: &Path,
+    name: &str,
+    description: &str,
+) -> Result<(), ResultError> {
+    let group = file
+        .create_group(name)
+        .ctx(path, || format!("creating group {name}"))?;
+    create_str_attr(&group, names::ATTR_DESCRIPTION, description)
+        .ctx(path, || format!("writing the description of {name}"))
+}
+
+/// One extendable dataset: rows along the first (unlimited) dimension, fixed
+/// trailing dimensions.
+struct Series {
+    ds: Dataset,
+    name: String,
+    tail: Vec<usize>,
+}
+
+impl Series {
+    /// Creates `name` with `rows` rows of shape `tail`, chunked as `chunk`.
+    fn create<T: H5Type>(
+        file: &File,
+        path: &Path,
+        name: &str,
+        rows: usize,
+        tail: &[usize],
+        chunk: &[usize],
+        description: &str,
+    ) -> Result<Self, ResultError> {
+        let mut extents = Vec::with_capacity(1 + tail.len());
+        extents.push(Extent::new(rows, None));
+        // A zero-length fixed dimension cannot be chunked; leave it unlimited.
+        extents.extend(tail.iter().map(|&d| Extent::new(d, (d > 0).then_some(d))));
+        let ds = file
+            .new_dataset::<T>()
+            .shape(extents)
+            .chunk(chunk.to_vec())
+            .create(name)
+            .ctx(path, || format!("creating dataset {name}"))?;
+        create_str_attr(&ds, names::ATTR_DESCRIPTION, description)
+            .ctx(path, || format!("writing the description of {name}"))?;
+        Ok(Self {
+            ds,
+            name: name.to_owned(),
+            tail: tail.to_vec(),
+        })
+    }
+
+    /// A `T` or `T×n` series, chunked by [`SERIES_CHUNK_ROWS`].
+    fn time_series<T: H5Type>(
+        file: &File,
+        path: &Path,
+        name: &str,
+        tail: &[usize],
+        description: &str,
+    ) -> Result<Self, ResultError> {
+        let mut chunk = vec![SERIES_CHUNK_ROWS];
+        chunk.extend(tail.iter().map(|&d| d.max(1)));
+        Self::create::<T>(file, path, name, 0, tail, &chunk, description)
+    }
+
+    /// Sets the number of rows (grows or shrinks).
+    fn set_rows(&self, rows: usize, path: &Path) -> Result<(), ResultError> {
+        let mut shape = Vec::with_capacity(1 + self.tail.len());
+        shape.push(rows);
+        shape.extend_from_slice(&self.tail);
+        self.ds
+            .resize(shape)
+            .ctx(path, || format!("resizing {} to {rows} rows", self.name))
+    }
+
+    /// Writes `values` into rows `start..start + values.len()` of a 1-D dataset.
+    fn write_values<T: H5Type>(
+        &self,
+        start: usize,
+        values: &[T],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        self.ds
+            .write_slice(values, start..start + values.len())
+            .ctx(path, || format!("writing row {start} of {}", self.name))
+    }
+
+    /// Extends a 1-D series to `t + values.len()` rows and writes `values`
+    /// from row `t`.
+    fn push_scalars<T: H5Type>(
+        &self,
+        t: usize,
+        values: &[T],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        self.set_rows(t + values.len(), path)?;
+        self.write_values(t, values, path)
+    }
+
+    /// Extends a `T×N` series to `t + rows.len()` rows and writes `rows` from
+    /// row `t`.
+    fn push_rows<const N: usize>(
+        &self,
+        t: usize,
+        rows: &[[f64; N]],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        self.set_rows(t + rows.len(), path)?;
+        self.ds
+            .write_slice::<_, f64, _, _>(rows, (t..t + rows.len(), ..))
+            .ctx(path, || format!("writing rows {t}.. of {}", self.name))
+    }
+
+    /// Extends a `T×n×N` series by `blocks.len()` rows from row `t`, each
+    /// block `n` rows of `N`.
+    fn push_blocks<const N: usize>(
+        &self,
+        t: usize,
+        blocks: &[&[[f64; N]]],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        self.set_rows(t + blocks.len(), path)?;
+        for (k, block) in blocks.iter().enumerate() {
+            self.ds
+                .write_slice::<_, f64, _, _>(*block, (t + k, .., ..))
+                .ctx(path, || format!("writing row {} of {}", t + k, self.name))?;
+        }
+        Ok(())
+    }
+}
+
+struct NodeSets {
+    index: usize,
+    position: Series,
+    displacement: Series,
+    rotation: Series,
+}
+
+struct JointSets {
+    /// Absent for a joint without a released angle.
+    angle: Option<Series>,
+    reaction_force: Series,
+    reaction_moment: Series,
+    released_translation: Series,
+    constraint_error: Series,
+}
+
+/// Every dataset handle of the file, kept open for the whole run.
+struct Datasets {
+    time: Series,
+    kinetic: Series,
+    strain: Series,
+    potential: Series,
+    total: Series,
+    driver_work: Series,
+    dissipated: Series,
+    momentum_linear: Series,
+    momentum_angular: Series,
+    iterations: Series,
+    factorizations: Series,
+    dt: Series,
+    residual: Series,
+    beta: Series,
+    /// Statics only.
+    negative_pivots: Option<Series>,
+    newton_residuals: Series,
+    newton_offsets: Series,
+    nodes: Vec<NodeSets>,
+    /// Per supported node: reaction force and moment.
+    supports: Vec<[Series; 2]>,
+    joints: Vec<JointSets>,
+    config_position: Series,
+    config_quaternion: Series,
+    /// Dynamics only: translational and angular velocities of every node.
+    config_velocity: Option<[Series; 2]>,
+    /// `[output] resultants = true`: force and moment at every Gauss point.
+    resultants: Option<[Series; 2]>,
+}
+
+impl Datasets {
+    /// Every dataset with one row per step.
+    fn per_step(&self) -> impl Iterator<Item = &Series> {
+        [
+            &self.time,
+            &self.kinetic,
+            &self.strain,
+            &self.potential,
+            &self.total,
+            &self.momentum_linear,
+            &self.momentum_angular,
+            &self.iterations,
+            &self.factorizations,
+            &self.dt,
+            &self.residual,
+            &self.beta,
+            &self.config_position,
+            &self.config_quaternion,
+        ]
+        .into_iter()
+        .chain(self.config_velocity.iter().flatten())
+        .chain(self.resultants.iter().flatten())
+        .chain(self.negative_pivots.iter())
+        .chain(
+            self.nodes
+                .iter()
+                .flat_map(|n| [&n.position, &n.displacement, &n.rotation]),
+        )
+        .chain(self.joints.iter().flat_map(|j| {
+            j.angle.iter().chain([
+                &j.released_translation,
+                &j.constraint_error,
+                &j.reaction_force,
+                &j.reaction_moment,
+            ])
+        }))
+        .chain(self.supports.iter().flatten())
+    }
+}
+
+/// Writes a result file step by step (layout: see the [crate docs](crate)
+/// documentation).
+///
+/// [`create`](Self::create) writes the root attributes with `status =
+/// "running"` and empty datasets; every [`append`](Self::append) extends each
+/// dataset by one row and flushes the file, so a run that dies leaves a valid
+/// file holding every step appended so far; [`finish`](Self::finish) records
+/// the final status and wall time and closes the file. Dropping the writer
+/// without `finish` closes the file with `status = "running"`.
+pub struct ResultWriter {
+    path: PathBuf,
+    file: File,
+    /// The lock file beside the result, held (exclusively) while writing
+    /// (`None` where no file can be made there: creating the result fails
+    /// then anyway, with HDF5's reason).
+    lock: Option<(std::fs::File, PathBuf)>,
+    sets: Datasets,
+    initial_positions: Vec<[f64; 3]>,
+    resultants: Option<super::resultants::ResultantsMeta>,
+    /// Steps in the file.
+    steps: usize,
+    newton_len: usize,
+    /// An append failed part-way: some datasets may hold an extra row.
+    inconsistent: bool,
+    /// Appended steps not yet in the file, and their size in values.
+    held: Vec<StepRecord>,
+    held_values: usize,
+    /// The restart state at the last appended step, written after the
+    /// steps it belongs to.
+    held_checkpoint: Option<flexmech_integrators::dynamics::Checkpoint>,
+    /// When the file was last written.
+    last_write: std::time::Instant,
+}
+
+impl std::fmt::Debug for ResultWriter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ResultWriter")
+            .field("path", &self.path)
+            .field("nodes", &self.initial_positions.len())
+            .field("tracked", &self.sets.nodes.len())
+            .field("joints", &self.sets.joints.len())
+            .field("steps", &self.steps)
+            .finish_non_exhaustive()
+    }
+}
+
+fn check_names<'a>(
+    path: &Path,
+    kind: &'static str,
+    list: impl Iterator<Item = &'a str>,
+) -> Result<(), ResultError> {
+    let mut seen = HashSet::new();
+    for name in list {
+        let reason = names::invalid_name_reason(name)
+            .or_else(|| (!seen.insert(name)).then_some("used twice"));
+        if let Some(reason) = reason {
+            return Err(ResultError::InvalidName {
+                path: path.to_path_buf(),
+                kind,
+                name: name.to_owned(),
+                reason,
+            });
+        }
+    }
+    Ok(())
+}
+
+impl ResultWriter {
+    /// Creates (or truncates) the file at `path`, writes the root attributes
+    /// `model`, `integrator`, `version` (this crate's version) and `status =
+    /// "running"`, creates every dataset with zero rows, and flushes.
+    ///
+    /// Fails before touching the file if a label or joint name is empty,
+    /// contains `/`, is `.` or is used twice, or if a tracked node index is
+    /// out of range.
+    pub fn create(path: &Path, meta: &RunMeta) -> Result<Self, ResultError> {
+        let n_nodes = meta.initial_positions.len();
+        check_names(
+            path,
+            "node label",
+            meta.tracked.iter().map(|(l, _)| l.as_str()),
+        )?;
+        check_names(path, "joint", meta.joint_names.iter().map(String::as_str))?;
+        if let Some((label, index)) = meta.tracked.iter().find(|(_, i)| *i >= n_nodes) {
+            return Err(ResultError::NodeIndex {
+                path: path.to_path_buf(),
+                label: label.clone(),
+                index: *index,
+                nodes: n_nodes,
+            });
+        }
+
+        // Lock before truncating: a second writer of the same file fails here
+        // and leaves the first one's result intact.
+        let lock = lock_result(path)?;
+        let file = File::create(path).ctx(path, || "creating the file".to_owned())?;
+        let created = super::mesh::utc_now();
+        let mut attrs = vec![
+            (names::ATTR_MODEL, meta.model_text.as_str()),
+            (names::ATTR_INTEGRATOR, meta.integrator.as_str()),
+            (names::ATTR_VERSION, env!("CARGO_PKG_VERSION")),
+            (names::ATTR_GIT_REVISION, env!("FLEXMECH_GIT_REVISION")),
+            (names::ATTR_CREATED, created.as_str()),
+            (names::ATTR_UNITS, names::UNITS_NOTE),
+            (names::ATTR_STATUS, names::STATUS_RUNNING),
+        ];
+        if !meta.command_line.is_empty() {
+            attrs.push((names::ATTR_COMMAND_LINE, meta.command_line.as_str()));
+        }
+        for (name, value) in attrs {
+            create_str_attr(&file, name, value)
+                .ctx(path, || format!("writing root attribute {name}"))?;
+        }
+        if let Some(mesh) = &meta.mesh {
+            super::mesh::write(&file, mesh, &meta.initial_positions)
+                .ctx(path, || "writing /mesh".to_owned())?;
+        }
+
+        let groups = [
+            (
+                names::ENERGY,
+                "energies of the whole mechanism at the end of each step",
+            ),
+            (names::MOMENTUM, "total momenta at the end of each step"),
+            (names::SOLVER, "solver statistics of each step"),
+            (names::NODES, "tracked nodes, one group per label"),
+            (names::JOINTS, "joints, one group per name, in model order"),
+            (names::CONFIGURATION, "every node at every stored step"),
+        ];
+        for (name, description) in groups {
+            create_group(&file, path, name, description)?;
+        }
+        if !meta.supports.is_empty() {
+            create_group(
+                &file,
+                path,
+                names::SUPPORTS,
+                "supported nodes (a fixed or prescribed DOF), one group per label",
+            )?;
+        }
+
+        let f64s = |name: &str, tail: &[usize], description: &str| {
+            Series::time_series::<f64>(&file, path, name, tail, description)
+        };
+        let time = f64s(
+            names::TIME,
+            &[],
+            "time of each stored step (statics: load factor)",
+        )?;
+        let kinetic = f64s(names::ENERGY_KINETIC, &[], "kinetic energy")?;
+        let strain = f64s(names::ENERGY_STRAIN, &[], "strain energy")?;
+        let potential = f64s(
+            names::ENERGY_POTENTIAL,
+            &[],
+            "potential of gravity and dead external loads",
+        )?;
+        let total = f64s(names::ENERGY_TOTAL, &[], "kinetic + strain + potential")?;
+        let driver_work = f64s(
+            names::ENERGY_DRIVER_WORK,
+            &[],
+            "work done by driven joint coordinates and prescribed DOFs since t = 0",
+        )?;
+        let dissipated = f64s(
+            names::ENERGY_DISSIPATED,
+            &[],
+            "energy dissipated by structural damping since t = 0 (in potential and total)",
+        )?;
+        let momentum_linear = f64s(names::MOMENTUM_LINEAR, &[3], "total linear momentum")?;
+        let momentum_angular = f64s(
+            names::MOMENTUM_ANGULAR,
+            &[3],
+            "total angular momentum about the origin",
+        )?;
+        let iterations = Series::time_series::<u64>(
+            &file,
+            path,
+            names::SOLVER_ITERATIONS,
+            &[],
+            "Newton iterations of the step",
+        )?;
+        let factorizations = Series::time_series::<u64>(
+            &file,
+            path,
+            names::SOLVER_FACTORIZATIONS,
+            &[],
+            "tangent factorisations of the step",
+        )?;
+        let dt = f64s(
+            names::SOLVER_DT,
+            &[],
+            "step size actually used (after halvings)",
+        )?;
+        let residual = f64s(names::SOLVER_RESIDUAL, &[], "final scaled residual norm")?;
+        let beta = f64s(
+            names::SOLVER_BETA,
+            &[],
+            "energy-momentum beta of the step (NaN for other integrators)",
+        )?;
+        let negative_pivots = (meta.integrator == "static")
+            .then(|| {
+                Series::time_series::<i64>(
+                    &file,
+                    path,
+                    names::SOLVER_NEGATIVE_PIVOTS,
+                    &[],
+                    "number of negative eigenvalues of the converged reduced tangent (negative \
+                     pivots of its LDLT factorisation); > 0: the equilibrium is unstable; -1: \
+                     undefined (a zero pivot)",
+                )
+            })
+            .transpose()?;
+        let newton_residuals = Series::create::<f64>(
+            &file,
+            path,
+            names::SOLVER_NEWTON_RESIDUALS,
+            0,
+            &[],
+            &[NEWTON_CHUNK],
+            "scaled residual after each Newton iteration (first: before the first solve), \
+             all steps concatenated; see newton_offsets",
+        )?;
+        let newton_offsets = Series::create::<u64>(
+            &file,
+            path,
+            names::SOLVER_NEWTON_OFFSETS,
+            1,
+            &[],
+            &[NEWTON_CHUNK],
+            "T+1 offsets: step k's residuals are newton_residuals[offsets[k]..offsets[k+1]]",
+        )?;
+        newton_offsets.write_values(0, &[0_u64], path)?;
+
+        let mut nodes = Vec::with_capacity(meta.tracked.len());
+        for (label, node) in &meta.tracked {
+            let group = names::node_group(label);
+            create_group(&file, path, &group, "tracked node")?;
+            let g = file
+                .group(&group)
+                .ctx(path, || format!("opening group {group}"))?;
+            let node_attr = g.new_attr::<u64>().shape(()).create(names::ATTR_NODE_INDEX);
+            node_attr
+                .and_then(|a| a.as_writer().write_scalar(&(*node as u64)))
+                .ctx(path, || {
+                    format!("writing {group} attribute {}", names::ATTR_NODE_INDEX)
+                })?;
+            nodes.push(NodeSets {
+                index: *node,
+                position: f64s(
+                    &names::node_path(label, names::NODE_POSITION),
+                    &[3],
+                    "position of the node",
+                )?,
+                displacement: f64s(
+                    &names::node_path(label, names::NODE_DISPLACEMENT),
+                    &[3],
+                    "position minus initial position",
+                )?,
+                rotation: f64s(
+                    &names::node_path(label, names::NODE_ROTATION),
+                    &[3],
+                    "rotation vector (axis times angle, |psi| <= pi) of the node's triad",
+                )?,
+            });
+        }
+
+        let mut joints = Vec::with_capacity(meta.joint_names.len());
+        for (index, name) in meta.joint_names.iter().enumerate() {
+            let group = names::joint_group(name);
+            create_group(&file, path, &group, "joint")?;
+            let g = file
+                .group(&group)
+                .ctx(path, || format!("opening group {group}"))?;
+            let joint_attr = g
+                .new_attr::<u64>()
+                .shape(())
+                .create(names::ATTR_JOINT_INDEX);
+            joint_attr
+                .and_then(|a| a.as_writer().write_scalar(&(index as u64)))
+                .ctx(path, || {
+                    format!("writing {group} attribute {}", names::ATTR_JOINT_INDEX)
+                })?;
+            if let Some(nodes) = meta.joint_nodes.get(index) {
+                for (attr, node) in [
+                    (names::ATTR_JOINT_MASTER_NODE, nodes[0]),
+                    (names::ATTR_JOINT_SLAVE_NODE, nodes[1]),
+                ] {
+                    g.new_attr::<u64>()
+                        .shape(())
+                        .create(attr)
+                        .and_then(|a| a.as_writer().write_scalar(&(node as u64)))
+                        .ctx(path, || format!("writing {group} attribute {attr}"))?;
+                }
+            }
+            let has_angle = meta.joint_angles.get(index).copied().unwrap_or(true);
+            joints.push(JointSets {
+                angle: if has_angle {
+                    Some(f64s(
+                        &names::joint_path(name, names::JOINT_ANGLE),
+                        &[],
+                        "released angle psi",
+                    )?)
+                } else {
+                    None
+                },
+                released_translation: f64s(
+                    &names::joint_path(name, names::JOINT_RELEASED_TRANSLATION),
+                    &[3],
+                    "released translation r_R in the master frame",
+                )?,
+                reaction_force: f64s(
+                    &names::joint_path(name, names::JOINT_REACTION_FORCE),
+                    &[3],
+                    "force the joint exerts on its slave node in the step's equations (NaN at t = 0)",
+                )?,
+                reaction_moment: f64s(
+                    &names::joint_path(name, names::JOINT_REACTION_MOMENT),
+                    &[3],
+                    "moment the joint exerts on its slave node in the step's equations (NaN at t = 0)",
+                )?,
+                constraint_error: f64s(
+                    &names::joint_path(name, names::JOINT_CONSTRAINT_ERROR),
+                    &[],
+                    "|r_s - r_m - L_m f(psi)| + |L_m^T L_s - exp(psi t^)|_F",
+                )?,
+            });
+        }
+
+        let mut supports = Vec::with_capacity(meta.supports.len());
+        for label in &meta.supports {
+            create_group(
+                &file,
+                path,
+                &format!("{}/{label}", names::SUPPORTS),
+                "supported node",
+            )?;
+            supports.push([
+                f64s(
+                    &names::support_path(label, names::JOINT_REACTION_FORCE),
+                    &[3],
+                    "force the supports exert on the node at its held DOFs (zero at free ones; \
+                     NaN at t = 0)",
+                )?,
+                f64s(
+                    &names::support_path(label, names::JOINT_REACTION_MOMENT),
+                    &[3],
+                    "moment the supports exert on the node at its held DOFs (zero at free ones; \
+                     NaN at t = 0)",
+                )?,
+            ]);
+        }
+
+        // T x count x width, chunked by rows of at most CONFIG_CHUNK_BYTES.
+        let block = |name: &str, count: usize, width: usize, description: &str| {
+            let count_chunk = count.clamp(1, CONFIG_CHUNK_NODES);
+            let rows = (CONFIG_CHUNK_BYTES / (count_chunk * width * 8)).clamp(1, CONFIG_CHUNK_ROWS);
+            let chunk = [rows, count_chunk, width];
+            Series::create::<f64>(&file, path, name, 0, &[count, width], &chunk, description)
+        };
+        let config =
+            |name: &str, width: usize, description: &str| block(name, n_nodes, width, description);
+        let config_position = config(
+            names::CONFIGURATION_POSITION,
+            3,
+            "position of every node at every stored step (T x nodes x 3)",
+        )?;
+        let config_quaternion = config(
+            names::CONFIGURATION_QUATERNION,
+            4,
+            "rotation of every node's triad from its initial configuration as a unit \
+             quaternion (w, x, y, z) (T x nodes x 4)",
+        )?;
+
+        let config_velocity = if meta.integrator == "static" {
+            None
+        } else {
+            Some([
+                config(
+                    names::CONFIGURATION_VELOCITY,
+                    3,
+                    "translational velocity of every node at every stored step (T x nodes x 3)",
+                )?,
+                config(
+                    names::CONFIGURATION_ANGULAR_VELOCITY,
+                    3,
+                    "angular velocity w = R W of every node's triad in spatial components \
+                     (T x nodes x 3)",
+                )?,
+            ])
+        };
+
+        let resultants = match &meta.resultants {
+            None => None,
+            Some(r) => {
+                let (arc, offsets) = r.points();
+                let group = names::RESULTANTS;
+                file.create_group(group)
+                    .ctx(path, || format!("creating group {group}"))?;
+                let points = arc.len();
+                let force = block(
+                    names::RESULTANTS_FORCE,
+                    points,
+                    3,
+                    "material stress resultant N = C_N Gamma (axial, shear 2, shear 3) at every \
+                     Gauss point, element order (T x G x 3)",
+                )?;
+                let moment = block(
+                    names::RESULTANTS_MOMENT,
+                    points,
+                    3,
+                    "material stress resultant M = C_M K (torsion, bending 2, bending 3) at every \
+                     Gauss point, element order (T x G x 3)",
+                )?;
+                super::resultants::write_ranges(&force.ds, r, &offsets).ctx(path, || {
+                    "writing the beams' ranges of /resultants".to_owned()
+                })?;
+                file.new_dataset::<f64>()
+                    .shape([points])
+                    .create(names::RESULTANTS_ARC_LENGTH)
+                    .and_then(|ds| ds.write_raw(&arc))
+                    .ctx(path, || format!("writing {}", names::RESULTANTS_ARC_LENGTH))?;
+                Some([force, moment])
+            }
+        };
+
+        let sets = Datasets {
+            time,
+            kinetic,
+            strain,
+            potential,
+            total,
+            driver_work,
+            dissipated,
+            momentum_linear,
+            momentum_angular,
+            iterations,
+            factorizations,
+            dt,
+            residual,
+            beta,
+            negative_pivots,
+            newton_residuals,
+            newton_offsets,
+            nodes,
+            joints,
+            supports,
+            config_position,
+            config_quaternion,
+            config_velocity,
+            resultants,
+        };
+        file.flush().ctx(path, || "flushing the file".to_owned())?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            file,
+            lock,
+            sets,
+            initial_positions: meta.initial_positions.clone(),
+            resultants: meta.resultants.clone(),
+            steps: 0,
+            newton_len: 0,
+            inconsistent: false,
+            held: Vec::new(),
+            held_values: 0,
+            held_checkpoint: None,
+            last_write: std::time::Instant::now(),
+        })
+    }
+
+    /// Appends one step. Steps are written in batches: held in memory and
+    /// written together (each dataset extended once, then the file flushed)
+    /// once the oldest held step is `WRITE_INTERVAL` (1 s) old or the held steps
+    /// reach `HELD_VALUES` values, and by [`Self::flush`] and
+    /// [`Self::finish`]. A process that dies therefore leaves a valid file
+    /// holding every step up to the last write — at most about a second of
+    /// the run is lost — and its restart state at the last of them.
+    ///
+    /// A record whose `positions`, `quaternions`, `joints` or (dynamics)
+    /// velocities length differs
+    /// from the [`RunMeta`] is rejected with [`ResultError::RecordLength`]
+    /// before anything is held or written. If HDF5 fails part-way through a
+    /// write, the steps stay held (the next write rewrites the same rows) and
+    /// `finish` trims the file back to the steps written successfully.
+    pub fn append(&mut self, step: &StepRecord) -> Result<(), ResultError> {
+        let t = self.steps + self.held.len();
+        let n_nodes = self.initial_positions.len();
+        let lengths = [
+            ("positions", n_nodes, step.positions.len()),
+            ("quaternions", n_nodes, step.quaternions.len()),
+            ("joints", self.sets.joints.len(), step.joints.len()),
+        ];
+        let supports = self.sets.supports.len();
+        let found_supports = if supports == 0 {
+            0
+        } else {
+            step.support_reactions.len()
+        };
+        let velocities = self.sets.config_velocity.as_ref().map_or(0, |_| n_nodes);
+        let lengths = lengths.into_iter().chain([
+            ("support_reactions", supports, found_supports),
+            ("velocities", velocities, step.velocities.len()),
+            (
+                "angular_velocities",
+                velocities,
+                step.angular_velocities.len(),
+            ),
+        ]);
+        for (field, expected, found) in lengths {
+            if expected != found {
+                return Err(ResultError::RecordLength {
+                    path: self.path.clone(),
+                    step: t,
+                    field,
+                    expected,
+                    found,
+                });
+            }
+        }
+        if !self.held.is_empty()
+            && (self.held_values >= HELD_VALUES || self.last_write.elapsed() >= WRITE_INTERVAL)
+        {
+            self.flush()?;
+        }
+        self.held_values += record_values(step);
+        self.held.push(step.clone());
+        Ok(())
+    }
+
+    /// Writes the held steps and the restart state, and flushes the file:
+    /// after it, the file holds every step appended so far.
+    pub fn flush(&mut self) -> Result<(), ResultError> {
+        if !self.held.is_empty() {
+            match self.write_steps(self.steps, &self.held) {
+                Ok(()) => {
+                    self.steps += self.held.len();
+                    self.newton_len += self
+                        .held
+                        .iter()
+                        .map(|r| r.residual_history.len())
+                        .sum::<usize>();
+                    self.inconsistent = false;
+                    self.held.clear();
+                    self.held_values = 0;
+                }
+                Err(e) => {
+                    self.inconsistent = true;
+                    return Err(e);
+                }
+            }
+        }
+        if let Some(checkpoint) = self.held_checkpoint.take() {
+            super::restart::write(&self.file, &checkpoint, &self.initial_positions)
+                .ctx(&self.path, || {
+                    "writing the restart state /restart".to_owned()
+                })?;
+        }
+        self.last_write = std::time::Instant::now();
+        self.file.flush().ctx(&self.path, || {
+            format!("flushing after step {}", self.steps.saturating_sub(1))
+        })
+    }
+
+    /// Writes `recs` as rows `t0..t0 + recs.len()` of every dataset.
+    fn write_steps(&self, t0: usize, recs: &[StepRecord]) -> Result<(), ResultError> {
+        let path = self.path.as_path();
+        let s = &self.sets;
+        let scalars = |f: fn(&StepRecord) -> f64| recs.iter().map(f).collect::<Vec<f64>>();
+        let counts =
+            |f: fn(&StepRecord) -> usize| recs.iter().map(|r| f(r) as u64).collect::<Vec<u64>>();
+        s.time.push_scalars(t0, &scalars(|r| r.time), path)?;
+        s.kinetic
+            .push_scalars(t0, &scalars(|r| r.energy.kinetic), path)?;
+        s.strain
+            .push_scalars(t0, &scalars(|r| r.energy.strain), path)?;
+        s.potential
+            .push_scalars(t0, &scalars(|r| r.energy.potential), path)?;
+        s.total
+            .push_scalars(t0, &scalars(|r| r.energy.total), path)?;
+        s.driver_work
+            .push_scalars(t0, &scalars(|r| r.energy.driver_work), path)?;
+        s.dissipated
+            .push_scalars(t0, &scalars(|r| r.energy.dissipated), path)?;
+        let rows = |f: fn(&StepRecord) -> [f64; 3]| recs.iter().map(f).collect::<Vec<_>>();
+        s.momentum_linear
+            .push_rows(t0, &rows(|r| r.momentum_linear), path)?;
+        s.momentum_angular
+            .push_rows(t0, &rows(|r| r.momentum_angular), path)?;
+        s.iterations
+            .push_scalars(t0, &counts(|r| r.iterations), path)?;
+        s.factorizations
+            .push_scalars(t0, &counts(|r| r.factorizations), path)?;
+        s.dt.push_scalars(t0, &scalars(|r| r.dt), path)?;
+        s.residual
+            .push_scalars(t0, &scalars(|r| r.residual), path)?;
+        s.beta.push_scalars(t0, &scalars(|r| r.beta), path)?;
+        if let Some(set) = &s.negative_pivots {
+            let counts: Vec<i64> = recs
+                .iter()
+                .map(|r| r.negative_pivots.map_or(-1, |n| n as i64))
+                .collect();
+            set.push_scalars(t0, &counts, path)?;
+        }
+
+        let history: Vec<f64> = recs
+            .iter()
+            .flat_map(|r| r.residual_history.iter().copied())
+            .collect();
+        let mut end = self.newton_len;
+        let offsets: Vec<u64> = recs
+            .iter()
+            .map(|r| {
+                end += r.residual_history.len();
+                end as u64
+            })
+            .collect();
+        s.newton_residuals.set_rows(end, path)?;
+        s.newton_residuals
+            .write_values(self.newton_len, &history, path)?;
+        s.newton_offsets.set_rows(t0 + recs.len() + 1, path)?;
+        s.newton_offsets.write_values(t0 + 1, &offsets, path)?;
+
+        for node in &s.nodes {
+            let p0 = self.initial_positions[node.index];
+            let p: Vec<[f64; 3]> = recs.iter().map(|r| r.positions[node.index]).collect();
+            let u: Vec<[f64; 3]> = p
+                .iter()
+                .map(|p| [p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]])
+                .collect();
+            let rot: Vec<[f64; 3]> = recs
+                .iter()
+                .map(|r| rotation_vector(r.quaternions[node.index]))
+                .collect();
+            node.position.push_rows(t0, &p, path)?;
+            node.displacement.push_rows(t0, &u, path)?;
+            node.rotation.push_rows(t0, &rot, path)?;
+        }
+        for (j, joint) in s.joints.iter().enumerate() {
+            let of = |r: &StepRecord| r.joints[j];
+            if let Some(angle) = &joint.angle {
+                let a: Vec<f64> = recs.iter().map(|r| of(r).angle).collect();
+                angle.push_scalars(t0, &a, path)?;
+            }
+            let released: Vec<[f64; 3]> = recs.iter().map(|r| of(r).released_translation).collect();
+            joint.released_translation.push_rows(t0, &released, path)?;
+            let error: Vec<f64> = recs.iter().map(|r| of(r).constraint_error).collect();
+            joint.constraint_error.push_scalars(t0, &error, path)?;
+            let (force, moment) = force_moment(recs.iter().map(|r| of(r).reaction));
+            joint.reaction_force.push_rows(t0, &force, path)?;
+            joint.reaction_moment.push_rows(t0, &moment, path)?;
+        }
+        for (k, [force, moment]) in s.supports.iter().enumerate() {
+            let (f, m) = force_moment(recs.iter().map(|r| r.support_reactions[k]));
+            force.push_rows(t0, &f, path)?;
+            moment.push_rows(t0, &m, path)?;
+        }
+        let blocks3 = |f: fn(&StepRecord) -> &[[f64; 3]]| recs.iter().map(f).collect::<Vec<_>>();
+        s.config_position
+            .push_blocks(t0, &blocks3(|r| &r.positions), path)?;
+        let quaternions: Vec<&[[f64; 4]]> = recs.iter().map(|r| &r.quaternions[..]).collect();
+        s.config_quaternion.push_blocks(t0, &quaternions, path)?;
+        if let Some([v, w]) = &s.config_velocity {
+            v.push_blocks(t0, &blocks3(|r| &r.velocities), path)?;
+            w.push_blocks(t0, &blocks3(|r| &r.angular_velocities), path)?;
+        }
+        if let (Some([n, m]), Some(meta)) = (&s.resultants, &self.resultants) {
+            let (force, moment): (Vec<_>, Vec<_>) = recs.iter().map(|r| meta.of(r)).unzip();
+            let force: Vec<&[[f64; 3]]> = force.iter().map(Vec::as_slice).collect();
+            let moment: Vec<&[[f64; 3]]> = moment.iter().map(Vec::as_slice).collect();
+            n.push_blocks(t0, &force, path)?;
+            m.push_blocks(t0, &moment, path)?;
+        }
+        Ok(())
+    }
+
+    /// Sets the root attributes `status` (`"completed"` or `"failed:
+    /// <reason>"`, see [`layout::failed_status`](super::layout::failed_status))
+    /// and `wall_time_s`, and closes the file. Returns its path.
+    pub fn finish(mut self, status: &str, wall_time_s: f64) -> Result<PathBuf, ResultError> {
+        // A write that fails here leaves the file trimmed to the steps
+        // written before, with this status, and the error returned.
+        let flushed = self.flush();
+        let Self {
+            path,
+            file,
+            lock,
+            sets,
+            steps,
+            newton_len,
+            inconsistent,
+            ..
+        } = self;
+        if inconsistent {
+            // Trim rows a failed append may have added.
+            for series in sets.per_step() {
+                series.set_rows(steps, &path)?;
+            }
+            sets.newton_residuals.set_rows(newton_len, &path)?;
+            sets.newton_offsets.set_rows(steps + 1, &path)?;
+        }
+        set_str_attr(&file, names::ATTR_STATUS, status).ctx(&path, || {
+            format!("writing root attribute {}", names::ATTR_STATUS)
+        })?;
+        file.new_attr::<f64>()
+            .shape(())
+            .create(names::ATTR_WALL_TIME)
+            .and_then(|a| a.as_writer().write_scalar(&wall_time_s))
+            .ctx(&path, || {
+                format!("writing root attribute {}", names::ATTR_WALL_TIME)
+            })?;
+        drop(sets);
+        file.close().ctx(&path, || "closing the file".to_owned())?;
+        flushed?;
+        // The result is complete: release the lock and remove its file.
+        if let Some((handle, lock_path)) = lock {
+            drop(handle);
+            let _ = std::fs::remove_file(lock_path);
+        }
+        Ok(path)
+    }
+
+    /// Sets the root attribute `warnings`: what the run's checks found
+    /// doubtful in a result that completed (e.g. an energy balance off by more
+    /// than its threshold). Absent when there is nothing to say.
+    pub fn warn(&mut self, text: &str) -> Result<(), ResultError> {
+        set_str_attr(&self.file, names::ATTR_WARNINGS, text).ctx(&self.path, || {
+            format!("writing root attribute {}", names::ATTR_WARNINGS)
+        })
+    }
+
+    /// Writes the run's figures of merit as root attributes (see
+    /// [`super::merit`]); called once, when the run ends.
+    pub fn figures(&mut self, merit: &super::merit::Merit) -> Result<(), ResultError> {
+        for (name, value) in merit.figures() {
+            self.file
+                .new_attr::<f64>()
+                .shape(())
+                .create(name)
+                .and_then(|a| a.as_writer().write_scalar(&value))
+                .ctx(&self.path, || format!("writing root attribute {name}"))?;
+        }
+        Ok(())
+    }
+
+    /// Sets the run's state at the step appended last as the restart state
+    /// `/restart` (see [`super::restart`]), written with that step.
+    pub fn checkpoint(
+        &mut self,
+        checkpoint: &flexmech_integrators::dynamics::Checkpoint,
+    ) -> Result<(), ResultError> {
+        self.held_checkpoint = Some(checkpoint.clone());
+        if self.held.is_empty() {
+            // Its step is in the file already.
+            return self.flush();
+        }
+        Ok(())
+    }
+
+    /// Sets the root attributes `restarted_from` (the result file this run
+    /// continues) and `restart_time` (the time it continues from).
+    pub fn restarted_from(&mut self, result: &Path, time: f64) -> Result<(), ResultError> {
+        set_str_attr(
+            &self.file,
+            names::ATTR_RESTARTED_FROM,
+            &result.display().to_string(),
+        )
+        .ctx(&self.path, || {
+            format!("writing root attribute {}", names::ATTR_RESTARTED_FROM)
+        })?;
+        self.file
+            .new_attr::<f64>()
+            .shape(())
+            .create(names::ATTR_RESTART_TIME)
+            .and_then(|a| a.as_writer().write_scalar(&time))
+            .ctx(&self.path, || {
+                format!("writing root attribute {}", names::ATTR_RESTART_TIME)
+            })
+    }
+
+    /// Number of steps appended (`T` once they are written; see
+    /// [`Self::append`]).
+    pub fn steps_written(&self) -> usize {
+        self.steps + self.held.len()
+    }
+
+    /// Path of the file being written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+/// Reactions `(force, moment)` split into the force rows and the moment rows.
+fn force_moment(reactions: impl Iterator<Item = [f64; 6]>) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    reactions
+        .map(|r| ([r[0], r[1], r[2]], [r[3], r[4], r[5]]))
+        .unzip()
+}
+
+/// Values a record holds, for the bound on held steps ([`HELD_VALUES`]).
+fn record_values(r: &StepRecord) -> usize {
+    32 + r.residual_history.len()
+        + 3 * r.positions.len()
+        + 4 * r.quaternions.len()
+        + 3 * (r.velocities.len() + r.angular_velocities.len())
+        + 6 * r.support_reactions.len()
+        + 11 * r.joints.len()
+}
+
+/// Takes the exclusive lock `<result>.lock` (an advisory lock the system
+/// releases when the process ends, so a killed run leaves no stale lock).
+fn lock_result(path: &Path) -> Result<Option<(std::fs::File, PathBuf)>, ResultError> {
+    let mut name = path.as_os_str().to_owned();
+    name.push(".lock");
+    let lock = PathBuf::from(name);
+    let Ok(handle) = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&lock)
+    else {
+        return Ok(None);
+    };
+    match handle.try_lock() {
+        Ok(()) => Ok(Some((handle, lock))),
+        Err(std::fs::TryLockError::WouldBlock) => Err(ResultError::Busy {
+            path: path.to_path_buf(),
+            lock,
+        }),
+        Err(std::fs::TryLockError::Error(source)) => Err(ResultError::Lock { lock, source }),
+    }
+}
