@@ -27,7 +27,7 @@ use std::process::ExitCode;
 use nalgebra::Vector3;
 
 use flexmech::model::{
-    Analysis, BeamGeometry, BeamSpec, LoadSpec, MassKind, Model, NodeRef, OutputSpec, SectionSpec,
+    Analysis, BeamGeometry, BeamSpec, LoadSpec, Model, NodeRef, OutputSpec, SectionSpec,
     SectionValues, SolverSpec, SupportSpec,
 };
 use flexmech::studies::{
@@ -52,8 +52,6 @@ fn cantilever(ei: f64, force: f64) -> Model {
     Model {
         name: "cantilever".into(),
         path: PathBuf::from("cantilever (built in Rust)"),
-        source_text: String::new(),
-        gravity: [0.0; 3],
         sections: vec![SectionSpec {
             name: "rod".into(),
             values: SectionValues {
@@ -81,7 +79,6 @@ fn cantilever(ei: f64, force: f64) -> Model {
             node: beam,
             fixed: [true; 6],
         }],
-        joints: Vec::new(),
         loads: vec![LoadSpec {
             node: tip,
             force: [0.0, 0.0, -force],
@@ -89,25 +86,15 @@ fn cantilever(ei: f64, force: f64) -> Model {
             time: None,
             follower: false,
         }],
-        distributed_loads: Vec::new(),
-        prescribed: Vec::new(),
-        initial_velocities: Vec::new(),
-        rigid_bodies: Vec::new(),
         solver: SolverSpec {
             analysis: Analysis::Static { load_steps: 1 },
-            tolerance: 1e-10,
-            max_iterations: 25,
-            max_halvings: 10,
-            mass: MassKind::Consistent,
-            modified_newton: false,
-            exact_tangent: false,
+            ..SolverSpec::default()
         },
         output: OutputSpec {
-            every: 1,
             track: vec![("beam.end".into(), tip)],
-            resultants: false,
-            vtk: false,
+            ..OutputSpec::default()
         },
+        ..Model::default()
     }
 }
 

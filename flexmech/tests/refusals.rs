@@ -63,6 +63,11 @@ fn overflowing_derived_quantities_are_refused_at_their_key() {
         ),
         (once(&base, "GJ = 60.0", "GJ = 1e308"), "section[0]"),
         (once(&base, "pitch = 0.02", "pitch = 1e308"), "joint[5]"),
+        // A finite map N times a finite rate, squared in the kinetic energy:
+        // once it completed with an infinite kinetic energy and NaN
+        // velocities in the file.
+        (once(&base, "rate = 1.0", "rate = 1e200"), "joint[1].rate"),
+        (once(&base, "rate = 1.0", "rate = 1e308"), "joint[1].rate"),
         (
             once(
                 &base,

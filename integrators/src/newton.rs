@@ -31,7 +31,15 @@ use crate::tolerances::TOLERANCES;
 /// it cannot be solved to more than two digits anyway.
 pub const SINGULAR_CONDITION: f64 = TOLERANCES.singular_condition;
 
-/// Iteration limits.
+/// Newton's default tolerance on the scaled residual (model files'
+/// `solver.tolerance` when left out).
+pub const DEFAULT_TOLERANCE: f64 = 1e-10;
+
+/// Newton's default iteration limit per step (`solver.max_iterations`).
+pub const DEFAULT_MAX_ITERATIONS: usize = 25;
+
+/// Iteration limits; [`Default`]: [`DEFAULT_TOLERANCE`],
+/// [`DEFAULT_MAX_ITERATIONS`], full Newton.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonSettings {
     /// Tolerance on the scaled residual.
@@ -53,6 +61,17 @@ pub struct NewtonSettings {
     /// it contracts slowly. Either way the solution meets the same
     /// tolerance.
     pub exact_tangent: bool,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        Self {
+            tolerance: DEFAULT_TOLERANCE,
+            max_iterations: DEFAULT_MAX_ITERATIONS,
+            modified: false,
+            exact_tangent: false,
+        }
+    }
 }
 
 /// Largest ratio of successive residuals modified Newton accepts before it

@@ -154,16 +154,48 @@ pub(crate) fn check(
             "the initial kinetic energy (mass × velocity²)".into(),
         );
     }
+    // The mechanism's mass and rotary inertia, with the moment arm of its
+    // size: a joint's rate moves the slave side at most that much.
+    let inertia: f64 = mech
+        .mesh
+        .elements
+        .iter()
+        .map(|e| {
+            let s = e.section();
+            let j = s.rho_j.iter().fold(0.0f64, |m, j| m.max(j.abs()));
+            e.length() * (s.rho_a * (1.0 + radius * radius) + j)
+        })
+        .chain(model.rigid_bodies.iter().map(|b| {
+            let spin = b
+                .inertia
+                .as_flattened()
+                .iter()
+                .fold(0.0f64, |m, j| m.max(j.abs()));
+            b.mass * (1.0 + radius * radius) + spin
+        }))
+        .sum();
     for (j, joint) in mech.joints.iter().enumerate() {
         let x = &mech.mesh.positions[joint.master];
         let n = joint.map.variation(x, &Matrix3::identity(), &joint.initial);
-        let rate = model.joints.get(j).map_or(0.0, |s| s.rate).abs().max(1.0);
+        let given = model.joints.get(j).map_or(0.0, |s| s.rate);
+        let rate = given.abs().max(1.0);
         if n.iter().any(|v| !(v * rate).is_finite()) {
             return fail(
                 format!("joint[{j}]"),
                 format!(
                     "joint `{}`: its map N at the initial angle (the derivative of the released \
                      translation, times the joint's rate)",
+                    joint.name
+                ),
+            );
+        }
+        let energy = n.iter().fold(0.0f64, |m, v| m.max((v * given).powi(2))) * inertia;
+        if !energy.is_finite() {
+            return fail(
+                format!("joint[{j}].rate"),
+                format!(
+                    "joint `{}`: the kinetic energy its rate gives the mechanism (mass × (N × \
+                     rate)²)",
                     joint.name
                 ),
             );

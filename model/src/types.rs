@@ -250,7 +250,25 @@ pub struct SolverSpec {
     pub exact_tangent: bool,
 }
 
-/// `[output]`.
+impl Default for SolverSpec {
+    /// What a model file without `[solver]` means: statics in 10 load
+    /// steps, Newton's default tolerance and iteration limit, 10 halvings,
+    /// the consistent mass, full Newton.
+    fn default() -> Self {
+        Self {
+            analysis: Analysis::Static { load_steps: 10 },
+            tolerance: flexmech_integrators::newton::DEFAULT_TOLERANCE,
+            max_iterations: flexmech_integrators::newton::DEFAULT_MAX_ITERATIONS,
+            max_halvings: flexmech_integrators::dynamics::DEFAULT_MAX_HALVINGS,
+            mass: MassKind::Consistent,
+            modified_newton: false,
+            exact_tangent: false,
+        }
+    }
+}
+
+/// `[output]`; [`Default`]: every step, no tracked node, no resultants or
+/// ParaView series.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutputSpec {
     /// Keep every k-th converged step (and the last).
@@ -265,8 +283,22 @@ pub struct OutputSpec {
     pub vtk: bool,
 }
 
-/// A validated model file.
-#[derive(Debug, Clone, PartialEq)]
+impl Default for OutputSpec {
+    fn default() -> Self {
+        Self {
+            every: 1,
+            track: Vec::new(),
+            resultants: false,
+            vtk: false,
+        }
+    }
+}
+
+/// A validated model file. [`Default`] is the empty model (no name, no
+/// beams, [`SolverSpec::default`]), for struct-update syntax in Rust:
+/// `Model { name: "arm".into(), sections, beams, ..Model::default() }`;
+/// [`crate::build`] checks what it is given.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Model {
     /// The model's name (result file `<name>.h5`).
     pub name: String,

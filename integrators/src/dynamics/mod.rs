@@ -83,6 +83,25 @@ pub struct DynamicSettings {
     pub mass: MassKind,
 }
 
+/// Consecutive halvings of one step allowed by default
+/// (`solver.max_halvings`).
+pub const DEFAULT_MAX_HALVINGS: usize = 10;
+
+impl DynamicSettings {
+    /// Steps of `dt` to `t_end` with default Newton settings
+    /// ([`NewtonSettings::default`]), [`DEFAULT_MAX_HALVINGS`] and the
+    /// consistent mass.
+    pub fn new(dt: f64, t_end: f64) -> Self {
+        Self {
+            dt,
+            t_end,
+            newton: NewtonSettings::default(),
+            max_halvings: DEFAULT_MAX_HALVINGS,
+            mass: MassKind::Consistent,
+        }
+    }
+}
+
 /// Nodal velocities: spatial translational `v` and body angular `W`
 /// (`Ṙ = R Ŵ`, `R` the nodal rotation from the initial configuration).
 #[derive(Debug, Clone, PartialEq)]

@@ -11,15 +11,7 @@ const DEFAULT_ARC_STEPS_PER_LOAD_STEP: usize = 100;
 impl Ctx<'_> {
     pub(super) fn solver(&self, raw: Option<&S<RawSolver>>) -> Res<SolverSpec> {
         let Some(entry) = raw else {
-            return Ok(SolverSpec {
-                analysis: Analysis::Static { load_steps: 10 },
-                tolerance: 1e-10,
-                max_iterations: 25,
-                max_halvings: 10,
-                mass: MassKind::Consistent,
-                modified_newton: false,
-                exact_tangent: false,
-            });
+            return Ok(SolverSpec::default());
         };
         let hs = entry.span();
         let s = entry.get_ref();
@@ -229,15 +221,15 @@ impl Ctx<'_> {
         };
         let tolerance = match &s.tolerance {
             Some(t) => self.positive(t, "solver.tolerance")?,
-            None => 1e-10,
+            None => SolverSpec::default().tolerance,
         };
         let max_iterations = match &s.max_iterations {
             Some(m) => self.int_in(m, "solver.max_iterations", 1, limits::MAX_ITERATIONS)?,
-            None => 25,
+            None => SolverSpec::default().max_iterations,
         };
         let max_halvings = match &s.max_halvings {
             Some(m) => self.int_in(m, "solver.max_halvings", 0, limits::MAX_HALVINGS)?,
-            None => 10,
+            None => SolverSpec::default().max_halvings,
         };
         let mass = match &s.mass {
             None => MassKind::Consistent,
