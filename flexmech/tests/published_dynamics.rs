@@ -12,7 +12,7 @@
 //! that checks physics — balance laws, conservation after the loads stop, the
 //! first published extreme where it falls early — and an `#[ignore]`d full
 //! run that checks the published figures (`cargo test -p flexmech
-//! --test published_dynamics -- --ignored`, best in release).
+//! --test main published_dynamics -- --ignored`, best in release).
 //!
 //! Every test runs every integrator of [`INTEGRATORS`].
 

@@ -96,37 +96,6 @@ pub struct DatasetFigure {
     pub reduce: Reduce,
 }
 
-impl super::spec::Figure {
-    /// A figure of a result dataset, as a study file's
-    /// `{ name, dataset, component, reduce }` table: `dataset` is a path,
-    /// with a column `[x]`, `[y]`, `[z]`, `[k]` or `[norm]` where it has
-    /// several (the norm when none is given), `reduce` one of `max`, `min`,
-    /// `max-abs`, `mean`, `final`, `initial`. The error says what is wrong.
-    ///
-    /// ```
-    /// use flexmech_studies::Figure;
-    /// let lift = Figure::dataset("lift", "/nodes/arm.end/displacement[z]", "max-abs")?;
-    /// assert_eq!(lift.name(), "lift");
-    /// # Ok::<(), String>(())
-    /// ```
-    pub fn dataset(name: &str, dataset: &str, reduce: &str) -> Result<Self, String> {
-        let mut t = toml::Table::new();
-        let (path, column) = match dataset.split_once('[') {
-            Some((path, rest)) => (path, rest.strip_suffix(']')),
-            None => (dataset, None),
-        };
-        t.insert("name".into(), name.into());
-        t.insert("dataset".into(), path.into());
-        t.insert("reduce".into(), reduce.into());
-        if let Some(c) = column {
-            let c = c.trim();
-            let value = c.parse::<i64>().map_or_else(|_| c.into(), Value::Integer);
-            t.insert("component".into(), value);
-        }
-        DatasetFigure::parse(&Value::Table(t)).map(Self::Dataset)
-    }
-}
-
 impl DatasetFigure {
     /// Parses `{ name, dataset, component, reduce }`; the error says what is
     /// wrong and what is expected.
