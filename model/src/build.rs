@@ -1,8 +1,12 @@
 //! From a validated [`Model`] to the [`Mechanism`] the solvers work on: mesh
 //! the beams, number the nodes, apply supports, loads and gravity.
 
-use crate::{Analysis, IntegratorKind, Model, ModelError, NodeRef, PrescribedSpec, TimeFunction};
-use flexmech_integrators::builder::{BeamDef, BuildError, Dof, JointDef, MechanismBuilder, NodeId};
+use crate::{
+    Analysis, BeamSpec, IntegratorKind, Model, ModelError, NodeRef, PrescribedSpec, TimeFunction,
+};
+use flexmech_integrators::builder::{
+    Beam, BeamDef, BuildError, Dof, JointDef, JointId, MechanismBuilder, NodeId,
+};
 use flexmech_integrators::dynamics::Motion;
 use flexmech_integrators::{Mechanism, Schedule};
 use nalgebra::{Matrix3, Vector3};
@@ -150,22 +154,41 @@ fn refused(model: &Model, key: String, e: BuildError) -> ModelError {
 pub fn build(model: &Model) -> Result<Built, ModelError> {
     model.check()?;
     let mut b = MechanismBuilder::new();
+    let (beam_nodes, beams) = add_beams(model, &mut b)?;
+    add_supports(model, &mut b, &beam_nodes)?;
+    add_loads(model, &mut b, &beam_nodes, &beams)?;
+    let (joints, ground_nodes) = add_joints(model, &mut b, &beam_nodes)?;
+    let body_nodes = add_rigid_bodies(model, &mut b, &beam_nodes)?;
+    add_prescribed(model, &mut b, &beam_nodes, &joints)?;
+    let mechanism = b.build();
+    let beam_nodes = beam_nodes
+        .into_iter()
+        .map(|nodes| nodes.into_iter().map(NodeId::index).collect())
+        .collect();
+    let beam_elements = beams.iter().map(|b| b.elements()).collect();
+    let mut built = Built {
+        mechanism,
+        beam_nodes,
+        beam_elements,
+        motion: Motion::rest(0),
+        ground_nodes,
+        body_nodes,
+    };
+    built.motion = initial_motion(model, &built);
+    crate::initial_check::check(model, &built.mechanism, &built.beam_nodes, &built.motion)?;
+    Ok(built)
+}
+
+/// Meshes the beams of `model` in `b`, with their sections' structural
+/// damping: every beam's node ids (`[b][k]`) and the beams.
+fn add_beams(
+    model: &Model,
+    b: &mut MechanismBuilder,
+) -> Result<(Vec<Vec<NodeId>>, Vec<Beam>), ModelError> {
     let mut beam_nodes: Vec<Vec<NodeId>> = Vec::with_capacity(model.beams.len());
     let mut beams = Vec::with_capacity(model.beams.len());
     for (i, beam) in model.beams.iter().enumerate() {
-        if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
-            if integrator == IntegratorKind::EnergyMomentumPaper && beam.nodes_per_element != 2 {
-                return Err(ModelError::new(
-                    &model.path,
-                    format!("beam[{i}].nodes_per_element"),
-                    None,
-                    format!(
-                        "integrator = \"{}\" runs on 2-node elements (the paper's internal force is the midpoint form of the linear element); use nodes_per_element = 2 with more elements, or integrator = \"energy-momentum\"",
-                        integrator.name()
-                    ),
-                ));
-            }
-        }
+        check_paper_elements(model, i, beam)?;
         let s = &model.sections[beam.section];
         let nodes = b
             .beam(BeamDef {
@@ -176,31 +199,66 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
             })
             .map_err(|e| refused(model, format!("beam[{i}]"), e))?;
         if s.damping > 0.0 {
-            if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
-                if !matches!(
-                    integrator,
-                    IntegratorKind::Newmark | IntegratorKind::GeneralizedAlpha { .. }
-                ) {
-                    return Err(ModelError::new(
-                        &model.path,
-                        format!("section[{}].damping", beam.section),
-                        None,
-                        format!(
-                            "structural damping runs with integrator = \"newmark\" or \
-                             \"generalized-alpha\", not \"{}\" (the midpoint schemes' \
-                             conservation statements have no place for it); change the \
-                             integrator or remove `damping`",
-                            integrator.name()
-                        ),
-                    ));
-                }
-            }
+            check_damping_integrator(model, beam)?;
             b.damping(&nodes, s.damping)
                 .map_err(|e| refused(model, format!("section[{}].damping", beam.section), e))?;
         }
         beam_nodes.push(nodes.nodes().to_vec());
         beams.push(nodes);
     }
+    Ok((beam_nodes, beams))
+}
+
+/// The paper's energy-momentum integrator runs on 2-node elements only:
+/// checks beam `beam` (`beam[i]`) of `model`.
+fn check_paper_elements(model: &Model, i: usize, beam: &BeamSpec) -> Result<(), ModelError> {
+    if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
+        if integrator == IntegratorKind::EnergyMomentumPaper && beam.nodes_per_element != 2 {
+            return Err(ModelError::new(
+                &model.path,
+                format!("beam[{i}].nodes_per_element"),
+                None,
+                format!(
+                    "integrator = \"{}\" runs on 2-node elements (the paper's internal force is the midpoint form of the linear element); use nodes_per_element = 2 with more elements, or integrator = \"energy-momentum\"",
+                    integrator.name()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Structural damping runs with the Newmark and generalized-alpha
+/// integrators only: checks the damped section of beam `beam` of `model`.
+fn check_damping_integrator(model: &Model, beam: &BeamSpec) -> Result<(), ModelError> {
+    if let Analysis::Dynamic { integrator, .. } = model.solver.analysis {
+        if !matches!(
+            integrator,
+            IntegratorKind::Newmark | IntegratorKind::GeneralizedAlpha { .. }
+        ) {
+            return Err(ModelError::new(
+                &model.path,
+                format!("section[{}].damping", beam.section),
+                None,
+                format!(
+                    "structural damping runs with integrator = \"newmark\" or \
+                     \"generalized-alpha\", not \"{}\" (the midpoint schemes' \
+                     conservation statements have no place for it); change the \
+                     integrator or remove `damping`",
+                    integrator.name()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Fixes the supported DOFs of `model` in `b` (beam node ids `beam_nodes`).
+fn add_supports(
+    model: &Model,
+    b: &mut MechanismBuilder,
+    beam_nodes: &[Vec<NodeId>],
+) -> Result<(), ModelError> {
     let node = |r: NodeRef| beam_nodes[r.beam][r.node];
     for (i, s) in model.supports.iter().enumerate() {
         let dofs: Vec<Dof> = (0..6)
@@ -210,6 +268,18 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         b.fix(node(s.node), &dofs)
             .map_err(|e| refused(model, format!("support[{i}]"), e))?;
     }
+    Ok(())
+}
+
+/// Applies the concentrated and distributed loads of `model` and its
+/// gravity in `b` (beam node ids `beam_nodes`, meshed beams `beams`).
+fn add_loads(
+    model: &Model,
+    b: &mut MechanismBuilder,
+    beam_nodes: &[Vec<NodeId>],
+    beams: &[Beam],
+) -> Result<(), ModelError> {
+    let node = |r: NodeRef| beam_nodes[r.beam][r.node];
     for (i, l) in model.loads.iter().enumerate() {
         let scale = schedule(&l.time, &model.solver.analysis);
         if l.follower {
@@ -230,7 +300,22 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         .map_err(|e| refused(model, format!("distributed_load[{i}]"), e))?;
     }
     b.gravity(v(model.gravity), schedule(&None, &model.solver.analysis))
-        .map_err(|e| refused(model, "gravity".into(), e))?;
+        .map_err(|e| refused(model, "gravity".into(), e))
+}
+
+/// The ids of placed joints, and the ground node of every joint to the
+/// ground as `(joint index, node)`.
+type PlacedJoints = (Vec<JointId>, Vec<(usize, usize)>);
+
+/// Places the joints of `model` in `b` (beam node ids `beam_nodes`): their
+/// ids, and the ground node of every joint to the ground as
+/// `(joint index, node)`.
+fn add_joints(
+    model: &Model,
+    b: &mut MechanismBuilder,
+    beam_nodes: &[Vec<NodeId>],
+) -> Result<PlacedJoints, ModelError> {
+    let node = |r: NodeRef| beam_nodes[r.beam][r.node];
     let mut joints = Vec::with_capacity(model.joints.len());
     let mut ground_nodes = Vec::new();
     for (j, spec) in model.joints.iter().enumerate() {
@@ -268,6 +353,18 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         })?;
         joints.push(id);
     }
+    Ok((joints, ground_nodes))
+}
+
+/// Attaches the rigid bodies of `model` in `b` (beam node ids
+/// `beam_nodes`): the centre-of-mass node of every body with an offset as
+/// `(body index, node)`.
+fn add_rigid_bodies(
+    model: &Model,
+    b: &mut MechanismBuilder,
+    beam_nodes: &[Vec<NodeId>],
+) -> Result<Vec<(usize, usize)>, ModelError> {
+    let node = |r: NodeRef| beam_nodes[r.beam][r.node];
     let mut body_nodes = Vec::new();
     for (i, body) in model.rigid_bodies.iter().enumerate() {
         let carrier = node(body.node);
@@ -285,6 +382,18 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
             body_nodes.push((i, centre.index()));
         }
     }
+    Ok(body_nodes)
+}
+
+/// Drives the prescribed joint angles and node DOFs of `model` in `b` (beam
+/// node ids `beam_nodes`, joint ids `joints`).
+fn add_prescribed(
+    model: &Model,
+    b: &mut MechanismBuilder,
+    beam_nodes: &[Vec<NodeId>],
+    joints: &[JointId],
+) -> Result<(), ModelError> {
+    let node = |r: NodeRef| beam_nodes[r.beam][r.node];
     for (i, p) in model.prescribed.iter().enumerate() {
         match p {
             PrescribedSpec::JointAngle { joint, angle } => {
@@ -304,21 +413,5 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         }
         .map_err(|e| refused(model, format!("prescribed[{i}]"), e))?;
     }
-    let mechanism = b.build();
-    let beam_nodes = beam_nodes
-        .into_iter()
-        .map(|nodes| nodes.into_iter().map(NodeId::index).collect())
-        .collect();
-    let beam_elements = beams.iter().map(|b| b.elements()).collect();
-    let mut built = Built {
-        mechanism,
-        beam_nodes,
-        beam_elements,
-        motion: Motion::rest(0),
-        ground_nodes,
-        body_nodes,
-    };
-    built.motion = initial_motion(model, &built);
-    crate::initial_check::check(model, &built.mechanism, &built.beam_nodes, &built.motion)?;
-    Ok(built)
+    Ok(())
 }

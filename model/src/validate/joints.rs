@@ -22,8 +22,30 @@ pub(crate) const GROUND: &str = "ground";
 
 impl Ctx<'_> {
     pub(super) fn joints(&self, raw: &[S<RawJoint>], beams: &[BeamSpec]) -> Res<Vec<JointSpec>> {
-        // The joint tables as plain TOML values: the kinds' parameters.
-        let tables: Vec<toml::Table> = toml::from_str::<toml::Table>(self.text)
+        let tables = self.joint_tables();
+        let mut out: Vec<JointSpec> = Vec::new();
+        for (i, entry) in raw.iter().enumerate() {
+            let j = entry.get_ref();
+            let name = self.joint_name(i, entry, &out)?;
+            let (type_name, kind) = self.joint_type(i, entry, &tables)?;
+            self.angle_keys(i, j, type_name, &kind)?;
+            let (master, slave) = self.joint_nodes(i, entry, &name, beams, &out)?;
+            out.push(JointSpec {
+                name,
+                kind,
+                master,
+                slave,
+                angle: j.angle.as_ref().map_or(0.0, |a| a.get_ref().0),
+                rate: j.rate.as_ref().map_or(0.0, |a| a.get_ref().0),
+            });
+        }
+        Ok(out)
+    }
+
+    /// The joint tables of the file as plain TOML values: the kinds'
+    /// parameters.
+    fn joint_tables(&self) -> Vec<toml::Table> {
+        toml::from_str::<toml::Table>(self.text)
             .ok()
             .and_then(|mut doc| doc.remove("joint"))
             .and_then(|v| match v {
@@ -36,138 +58,169 @@ impl Ctx<'_> {
                 toml::Value::Table(t) => t,
                 _ => toml::Table::new(),
             })
-            .collect();
-        let mut out: Vec<JointSpec> = Vec::new();
-        for (i, entry) in raw.iter().enumerate() {
-            let tk = format!("joint[{i}]");
-            let k = |f: &str| format!("{tk}.{f}");
-            let hs = entry.span();
-            let j = entry.get_ref();
-            let name_s = self.entity_name(&j.name, &tk, &hs, "joint")?;
-            let name = name_s.get_ref().clone();
-            if name.contains('/') {
-                return Err(self.at(
-                    k("name"),
-                    name_s,
-                    format!("must not contain '/' (joint names become group names /joints/<name> in the result file), found \"{name}\""),
-                ));
-            }
-            if let Some(o) = out.iter().position(|o| o.name == name) {
-                return Err(self.at(
-                    k("name"),
-                    name_s,
-                    format!("duplicate joint name \"{name}\" (joint[{o}] has it too); joint names must be unique"),
-                ));
-            }
-            let all_types = self.registry.names().collect::<Vec<_>>().join("|");
-            let type_s = self.need(
-                &j.kind,
-                &k("type"),
-                &hs,
-                &format!("the joint type, one of {all_types}"),
-            )?;
-            let type_name = type_s.get_ref().as_str();
-            if !self.registry.contains(type_name) {
-                return Err(self.at(
-                    k("type"),
-                    type_s,
-                    format!(
-                        "unknown joint type \"{type_name}\"; expected one of {all_types} (a \
-                         kind written in Rust is known once registered with the program that \
-                         reads the model: `App::new().joint::<MyJoint>()`)"
-                    ),
-                ));
-            }
-            let mut params = tables.get(i).cloned().unwrap_or_default();
-            params.retain(|key, _| !COMMON_KEYS.contains(&key));
-            let kind = self.joint_kind(type_name, &params, i, &hs)?;
+            .collect()
+    }
 
-            // `angle` and `rate` belong to kinds whose first released
-            // coordinate is an angle.
-            for (key, value) in [("angle", &j.angle), ("rate", &j.rate)] {
-                if let (Some(v), false) = (value, kind.has_angle()) {
-                    let names = kind.map().coordinate_names();
-                    let why = if names.is_empty() {
-                        " (it has no released angle)".to_string()
-                    } else if names.len() == 3 {
-                        " (it releases three rotations, not one angle)".to_string()
-                    } else {
-                        format!(
-                            " (its released coordinates are {}, not an angle)",
-                            names.join(", ")
-                        )
-                    };
-                    return Err(self.at(
-                        k(key),
-                        v,
-                        format!(
-                            "`{key}` does not belong to a {type_name} joint{why}; a {type_name} joint takes {}",
-                            self.takes(type_name)
-                        ),
-                    ));
-                }
-            }
-
-            let master_s = self.need(
-                &j.master,
-                &k("master"),
-                &hs,
-                "the master node's label, e.g. master = \"post.end\", or master = \"ground\"",
-            )?;
-            let slave_s = self.need(
-                &j.slave,
-                &k("slave"),
-                &hs,
-                "the slave node's label, e.g. slave = \"arm.start\"",
-            )?;
-            let master = if master_s.get_ref() == GROUND {
-                None
-            } else {
-                Some(self.node(master_s, &k("master"), beams)?)
-            };
-            if slave_s.get_ref() == GROUND {
-                return Err(self.at(
-                    k("slave"),
-                    slave_s,
-                    "the ground cannot be a slave (its DOFs are not unknowns); make it the \
-                     master, master = \"ground\", and the node the slave",
-                ));
-            }
-            let slave = self.node(slave_s, &k("slave"), beams)?;
-            if master == Some(slave) {
-                return Err(self.at(
-                    k("slave"),
-                    slave_s,
-                    format!(
-                        "the slave \"{}\" is the master node (\"{}\"); a joint connects two different nodes",
-                        slave_s.get_ref(),
-                        master_s.get_ref()
-                    ),
-                ));
-            }
-            if let Some(o) = out.iter().position(|o| o.slave == slave) {
-                return Err(self.at(
-                    k("slave"),
-                    slave_s,
-                    format!(
-                        "node \"{}\" is the slave of two joints: \"{}\" (joint[{o}]) and \"{name}\" \
-                         (joint[{i}]); a node can be the slave of one joint only (chains, where a \
-                         slave is the master of another joint, are allowed)",
-                        slave_s.get_ref(),
-                        out[o].name
-                    ),
-                ));
-            }
-            out.push(JointSpec {
-                name,
-                kind,
-                master,
-                slave,
-                angle: j.angle.as_ref().map_or(0.0, |a| a.get_ref().0),
-                rate: j.rate.as_ref().map_or(0.0, |a| a.get_ref().0),
-            });
+    /// The name of `joint[i]` (`entry`): present, non-empty, without '/',
+    /// and none of the earlier joints `out` has it.
+    fn joint_name(&self, i: usize, entry: &S<RawJoint>, out: &[JointSpec]) -> Res<String> {
+        let tk = format!("joint[{i}]");
+        let k = |f: &str| format!("{tk}.{f}");
+        let hs = entry.span();
+        let j = entry.get_ref();
+        let name_s = self.entity_name(&j.name, &tk, &hs, "joint")?;
+        let name = name_s.get_ref().clone();
+        if name.contains('/') {
+            return Err(self.at(
+                k("name"),
+                name_s,
+                format!("must not contain '/' (joint names become group names /joints/<name> in the result file), found \"{name}\""),
+            ));
         }
-        Ok(out)
+        if let Some(o) = out.iter().position(|o| o.name == name) {
+            return Err(self.at(
+                k("name"),
+                name_s,
+                format!("duplicate joint name \"{name}\" (joint[{o}] has it too); joint names must be unique"),
+            ));
+        }
+        Ok(name)
+    }
+
+    /// The type name of `joint[i]` (`entry`), a registered kind, and the
+    /// joint of that kind from its parameters (its table in `tables`).
+    fn joint_type<'e>(
+        &self,
+        i: usize,
+        entry: &'e S<RawJoint>,
+        tables: &[toml::Table],
+    ) -> Res<(&'e str, JointKind)> {
+        let tk = format!("joint[{i}]");
+        let k = |f: &str| format!("{tk}.{f}");
+        let hs = entry.span();
+        let j = entry.get_ref();
+        let all_types = self.registry.names().collect::<Vec<_>>().join("|");
+        let type_s = self.need(
+            &j.kind,
+            &k("type"),
+            &hs,
+            &format!("the joint type, one of {all_types}"),
+        )?;
+        let type_name = type_s.get_ref().as_str();
+        if !self.registry.contains(type_name) {
+            return Err(self.at(
+                k("type"),
+                type_s,
+                format!(
+                    "unknown joint type \"{type_name}\"; expected one of {all_types} (a \
+                     kind written in Rust is known once registered with the program that \
+                     reads the model: `App::new().joint::<MyJoint>()`)"
+                ),
+            ));
+        }
+        let mut params = tables.get(i).cloned().unwrap_or_default();
+        params.retain(|key, _| !COMMON_KEYS.contains(&key));
+        let kind = self.joint_kind(type_name, &params, i, &hs)?;
+        Ok((type_name, kind))
+    }
+
+    /// `angle` and `rate` of `joint[i]` (`j`, of type `type_name`, `kind`)
+    /// belong to kinds whose first released coordinate is an angle.
+    fn angle_keys(&self, i: usize, j: &RawJoint, type_name: &str, kind: &JointKind) -> Res<()> {
+        let tk = format!("joint[{i}]");
+        let k = |f: &str| format!("{tk}.{f}");
+        for (key, value) in [("angle", &j.angle), ("rate", &j.rate)] {
+            if let (Some(v), false) = (value, kind.has_angle()) {
+                let names = kind.map().coordinate_names();
+                let why = if names.is_empty() {
+                    " (it has no released angle)".to_string()
+                } else if names.len() == 3 {
+                    " (it releases three rotations, not one angle)".to_string()
+                } else {
+                    format!(
+                        " (its released coordinates are {}, not an angle)",
+                        names.join(", ")
+                    )
+                };
+                return Err(self.at(
+                    k(key),
+                    v,
+                    format!(
+                        "`{key}` does not belong to a {type_name} joint{why}; a {type_name} joint takes {}",
+                        self.takes(type_name)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The master (`None`: the ground) and slave nodes of `joint[i]`
+    /// (`entry`, named `name`): two different nodes, the slave not the
+    /// ground and the slave of none of the earlier joints `out`.
+    fn joint_nodes(
+        &self,
+        i: usize,
+        entry: &S<RawJoint>,
+        name: &str,
+        beams: &[BeamSpec],
+        out: &[JointSpec],
+    ) -> Res<(Option<NodeRef>, NodeRef)> {
+        let tk = format!("joint[{i}]");
+        let k = |f: &str| format!("{tk}.{f}");
+        let hs = entry.span();
+        let j = entry.get_ref();
+        let master_s = self.need(
+            &j.master,
+            &k("master"),
+            &hs,
+            "the master node's label, e.g. master = \"post.end\", or master = \"ground\"",
+        )?;
+        let slave_s = self.need(
+            &j.slave,
+            &k("slave"),
+            &hs,
+            "the slave node's label, e.g. slave = \"arm.start\"",
+        )?;
+        let master = if master_s.get_ref() == GROUND {
+            None
+        } else {
+            Some(self.node(master_s, &k("master"), beams)?)
+        };
+        if slave_s.get_ref() == GROUND {
+            return Err(self.at(
+                k("slave"),
+                slave_s,
+                "the ground cannot be a slave (its DOFs are not unknowns); make it the \
+                 master, master = \"ground\", and the node the slave",
+            ));
+        }
+        let slave = self.node(slave_s, &k("slave"), beams)?;
+        if master == Some(slave) {
+            return Err(self.at(
+                k("slave"),
+                slave_s,
+                format!(
+                    "the slave \"{}\" is the master node (\"{}\"); a joint connects two different nodes",
+                    slave_s.get_ref(),
+                    master_s.get_ref()
+                ),
+            ));
+        }
+        if let Some(o) = out.iter().position(|o| o.slave == slave) {
+            return Err(self.at(
+                k("slave"),
+                slave_s,
+                format!(
+                    "node \"{}\" is the slave of two joints: \"{}\" (joint[{o}]) and \"{name}\" \
+                     (joint[{i}]); a node can be the slave of one joint only (chains, where a \
+                     slave is the master of another joint, are allowed)",
+                    slave_s.get_ref(),
+                    out[o].name
+                ),
+            ));
+        }
+        Ok((master, slave))
     }
 
     /// "`axis`, `pitch`": the parameter keys of a kind.

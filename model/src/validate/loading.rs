@@ -179,166 +179,250 @@ impl Ctx<'_> {
     ) -> Res<Vec<PrescribedSpec>> {
         let mut out: Vec<PrescribedSpec> = Vec::new();
         for (i, entry) in raw.iter().enumerate() {
-            let tk = format!("prescribed[{i}]");
-            let k = |f: &str| format!("{tk}.{f}");
-            let hs = entry.span();
             let p = entry.get_ref();
-            if let Some(joint_s) = &p.joint {
-                let node_keys = [
-                    ("node", p.node.as_ref().map(S::span)),
-                    ("dof", p.dof.as_ref().map(S::span)),
-                    ("value", p.value.as_ref().map(S::span)),
-                ];
-                if let Some((key, span)) = node_keys.iter().find(|(_, s)| s.is_some()) {
-                    return Err(self.err(
-                        k(key),
-                        span.clone(),
-                        format!(
-                            "`{key}` belongs to a prescribed node DOF (node + dof + value), but this \
-                             entry drives joint \"{}\" (joint + angle); use two [[prescribed]] entries",
-                            joint_s.get_ref()
-                        ),
-                    ));
-                }
-                let jname = joint_s.get_ref();
-                let Some(ji) = joints.iter().position(|j| j.name == *jname) else {
-                    let known = if joints.is_empty() {
-                        "the file defines no [[joint]]".to_string()
-                    } else {
-                        format!(
-                            "joints are {}",
-                            quoted_list(joints.iter().map(|j| j.name.as_str()))
-                        )
-                    };
-                    return Err(self.at(
-                        k("joint"),
-                        joint_s,
-                        format!("unknown joint \"{jname}\"; {known}"),
-                    ));
-                };
-                let kind = &joints[ji].kind;
-                if !kind.has_angle() {
-                    let names = kind.map().coordinate_names();
-                    let message = if names.len() == 3 {
-                        format!(
-                            "joint \"{jname}\" is {}: it releases three rotations, and \
-                             prescribing its rotation is not supported yet; use a revolute \
-                             joint, or prescribe node DOFs (node + dof + value)",
-                            kind.type_name()
-                        )
-                    } else {
-                        format!(
-                            "joint \"{jname}\" is a {} joint: it has no released rotation, so \
-                             there is no angle to prescribe",
-                            kind.type_name()
-                        )
-                    };
-                    return Err(self.at(k("joint"), joint_s, message));
-                }
-                if let Some(o) = out.iter().position(
-                    |q| matches!(q, PrescribedSpec::JointAngle { joint, .. } if *joint == ji),
-                ) {
-                    return Err(self.at(
-                        k("joint"),
-                        joint_s,
-                        format!("the angle of joint \"{jname}\" is already prescribed by prescribed[{o}]"),
-                    ));
-                }
-                let angle_s = self.need(
-                    &p.angle,
-                    &k("angle"),
-                    &hs,
-                    "the released angle as a function of time, e.g. angle = { table = [[0.0, 0.0], [1.0, 6.2832]] }",
-                )?;
-                let angle = self.time_fn(angle_s, &k("angle"))?;
-                out.push(PrescribedSpec::JointAngle { joint: ji, angle });
+            let spec = if let Some(joint_s) = &p.joint {
+                self.prescribed_angle(i, entry, joint_s, joints, &out)?
             } else {
-                if let Some(a) = &p.angle {
-                    return Err(self.at(
-                        k("angle"),
-                        a,
-                        "`angle` drives a joint's released angle and needs `joint = \"<joint name>\"`; \
-                         to drive a node DOF use node + dof + value",
-                    ));
-                }
-                if p.node.is_none() && p.dof.is_none() && p.value.is_none() {
-                    return Err(self.err(
-                        tk.clone(),
-                        Some(hs.clone()),
-                        "expected `joint` + `angle` (drive a joint's released angle) or `node` + \
-                         `dof` + `value` (drive a node DOF)",
-                    ));
-                }
-                let node_s = self.need(
-                    &p.node,
-                    &k("node"),
-                    &hs,
-                    "the driven node's label, e.g. node = \"post.start\"",
-                )?;
-                let dof_s = self.need(
-                    &p.dof,
-                    &k("dof"),
-                    &hs,
-                    &format!("the driven DOF, one of {DOF_LIST}"),
-                )?;
-                let value_s = self.need(
-                    &p.value,
-                    &k("value"),
-                    &hs,
-                    "the DOF's value as a function of time, e.g. value = { table = [[0.0, 0.0], [1.0, 0.1]] }",
-                )?;
-                let node = self.node(node_s, &k("node"), beams)?;
-                let dof_name = dof_s.get_ref();
-                let Some(dof) = DOFS.iter().position(|d| d == dof_name) else {
-                    return Err(self.at(
-                        k("dof"),
-                        dof_s,
-                        format!("unknown DOF name \"{dof_name}\"; expected one of {DOF_LIST}"),
-                    ));
-                };
-                if let Some(j) = joints.iter().position(|j| j.slave == node) {
-                    return Err(self.at(
-                        k("node"),
-                        node_s,
-                        format!(
-                            "node \"{}\" is the slave of joint \"{}\" (joint[{j}]): its motion follows \
-                             the master; prescribe the master node or the joint angle instead",
-                            node_s.get_ref(),
-                            joints[j].name
-                        ),
-                    ));
-                }
-                // A support holds the DOF at zero; prescribing it too would
-                // silently override one of the two.
-                if let Some(s) = supports.iter().position(|s| s.node == node && s.fixed[dof]) {
-                    return Err(self.at(
-                        k("dof"),
-                        dof_s,
-                        format!(
-                            "DOF \"{dof_name}\" of node \"{}\" is also held by support[{s}].fixed; a DOF is \
-                             either supported or prescribed: remove \"{dof_name}\" from support[{s}].fixed, \
-                             or remove this prescribed entry",
-                            node_s.get_ref()
-                        ),
-                    ));
-                }
-                if let Some(o) = out.iter().position(|q| {
-                    matches!(q, PrescribedSpec::NodeDof { node: n, dof: d, .. } if *n == node && *d == dof)
-                }) {
-                    return Err(self.at(
-                        k("dof"),
-                        dof_s,
-                        format!(
-                            "DOF \"{dof_name}\" of node \"{}\" is already prescribed by prescribed[{o}]",
-                            node_s.get_ref()
-                        ),
-                    ));
-                }
-                let value = self.time_fn(value_s, &k("value"))?;
-                out.push(PrescribedSpec::NodeDof { node, dof, value });
-            }
+                self.prescribed_dof(i, entry, beams, joints, supports, &out)?
+            };
+            out.push(spec);
         }
         Ok(out)
+    }
+
+    /// `prescribed[i]` (`entry`) driving the angle of joint `joint_s`: no
+    /// node-DOF keys, a joint with a released angle not driven before (by
+    /// the entries `out`), and the angle's time function.
+    fn prescribed_angle(
+        &self,
+        i: usize,
+        entry: &S<RawPrescribed>,
+        joint_s: &S<String>,
+        joints: &[JointSpec],
+        out: &[PrescribedSpec],
+    ) -> Res<PrescribedSpec> {
+        let tk = format!("prescribed[{i}]");
+        let k = |f: &str| format!("{tk}.{f}");
+        let hs = entry.span();
+        let p = entry.get_ref();
+        let node_keys = [
+            ("node", p.node.as_ref().map(S::span)),
+            ("dof", p.dof.as_ref().map(S::span)),
+            ("value", p.value.as_ref().map(S::span)),
+        ];
+        if let Some((key, span)) = node_keys.iter().find(|(_, s)| s.is_some()) {
+            return Err(self.err(
+                k(key),
+                span.clone(),
+                format!(
+                    "`{key}` belongs to a prescribed node DOF (node + dof + value), but this \
+                     entry drives joint \"{}\" (joint + angle); use two [[prescribed]] entries",
+                    joint_s.get_ref()
+                ),
+            ));
+        }
+        let jname = joint_s.get_ref();
+        let ji = self.driven_joint(&k("joint"), joint_s, joints)?;
+        if let Some(o) = out
+            .iter()
+            .position(|q| matches!(q, PrescribedSpec::JointAngle { joint, .. } if *joint == ji))
+        {
+            return Err(self.at(
+                k("joint"),
+                joint_s,
+                format!("the angle of joint \"{jname}\" is already prescribed by prescribed[{o}]"),
+            ));
+        }
+        let angle_s = self.need(
+            &p.angle,
+            &k("angle"),
+            &hs,
+            "the released angle as a function of time, e.g. angle = { table = [[0.0, 0.0], [1.0, 6.2832]] }",
+        )?;
+        let angle = self.time_fn(angle_s, &k("angle"))?;
+        Ok(PrescribedSpec::JointAngle { joint: ji, angle })
+    }
+
+    /// The index of joint `joint_s` (at key `key`) in `joints`: a known
+    /// joint with one released angle to drive.
+    fn driven_joint(&self, key: &str, joint_s: &S<String>, joints: &[JointSpec]) -> Res<usize> {
+        let jname = joint_s.get_ref();
+        let Some(ji) = joints.iter().position(|j| j.name == *jname) else {
+            let known = if joints.is_empty() {
+                "the file defines no [[joint]]".to_string()
+            } else {
+                format!(
+                    "joints are {}",
+                    quoted_list(joints.iter().map(|j| j.name.as_str()))
+                )
+            };
+            return Err(self.at(key, joint_s, format!("unknown joint \"{jname}\"; {known}")));
+        };
+        let kind = &joints[ji].kind;
+        if !kind.has_angle() {
+            let names = kind.map().coordinate_names();
+            let message = if names.len() == 3 {
+                format!(
+                    "joint \"{jname}\" is {}: it releases three rotations, and \
+                     prescribing its rotation is not supported yet; use a revolute \
+                     joint, or prescribe node DOFs (node + dof + value)",
+                    kind.type_name()
+                )
+            } else {
+                format!(
+                    "joint \"{jname}\" is a {} joint: it has no released rotation, so \
+                     there is no angle to prescribe",
+                    kind.type_name()
+                )
+            };
+            return Err(self.at(key, joint_s, message));
+        }
+        Ok(ji)
+    }
+
+    /// `prescribed[i]` (`entry`) driving a node DOF: no `angle`, the node,
+    /// the DOF and its time function, for a DOF that no joint, support or
+    /// earlier entry (of `out`) constrains already.
+    fn prescribed_dof(
+        &self,
+        i: usize,
+        entry: &S<RawPrescribed>,
+        beams: &[BeamSpec],
+        joints: &[JointSpec],
+        supports: &[SupportSpec],
+        out: &[PrescribedSpec],
+    ) -> Res<PrescribedSpec> {
+        let tk = format!("prescribed[{i}]");
+        let k = |f: &str| format!("{tk}.{f}");
+        let hs = entry.span();
+        let p = entry.get_ref();
+        if let Some(a) = &p.angle {
+            return Err(self.at(
+                k("angle"),
+                a,
+                "`angle` drives a joint's released angle and needs `joint = \"<joint name>\"`; \
+                 to drive a node DOF use node + dof + value",
+            ));
+        }
+        if p.node.is_none() && p.dof.is_none() && p.value.is_none() {
+            return Err(self.err(
+                tk.clone(),
+                Some(hs.clone()),
+                "expected `joint` + `angle` (drive a joint's released angle) or `node` + \
+                 `dof` + `value` (drive a node DOF)",
+            ));
+        }
+        let node_s = self.need(
+            &p.node,
+            &k("node"),
+            &hs,
+            "the driven node's label, e.g. node = \"post.start\"",
+        )?;
+        let dof_s = self.need(
+            &p.dof,
+            &k("dof"),
+            &hs,
+            &format!("the driven DOF, one of {DOF_LIST}"),
+        )?;
+        let value_s = self.need(
+            &p.value,
+            &k("value"),
+            &hs,
+            "the DOF's value as a function of time, e.g. value = { table = [[0.0, 0.0], [1.0, 0.1]] }",
+        )?;
+        let node = self.node(node_s, &k("node"), beams)?;
+        let dof_name = dof_s.get_ref();
+        let Some(dof) = DOFS.iter().position(|d| d == dof_name) else {
+            return Err(self.at(
+                k("dof"),
+                dof_s,
+                format!("unknown DOF name \"{dof_name}\"; expected one of {DOF_LIST}"),
+            ));
+        };
+        self.driven_node_not_slave(&k("node"), node_s, node, joints)?;
+        self.driven_dof_not_supported(&k("dof"), node_s, node, dof_s, dof, supports)?;
+        self.driven_dof_not_prescribed(&k("dof"), node_s, node, dof_s, dof, out)?;
+        let value = self.time_fn(value_s, &k("value"))?;
+        Ok(PrescribedSpec::NodeDof { node, dof, value })
+    }
+
+    /// The driven node `node_s` (`node`, at key `key`) is no joint's slave.
+    fn driven_node_not_slave(
+        &self,
+        key: &str,
+        node_s: &S<String>,
+        node: NodeRef,
+        joints: &[JointSpec],
+    ) -> Res<()> {
+        if let Some(j) = joints.iter().position(|j| j.slave == node) {
+            return Err(self.at(
+                key,
+                node_s,
+                format!(
+                    "node \"{}\" is the slave of joint \"{}\" (joint[{j}]): its motion follows \
+                     the master; prescribe the master node or the joint angle instead",
+                    node_s.get_ref(),
+                    joints[j].name
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The driven DOF `dof_s` (`dof`, at key `key`) of node `node_s`
+    /// (`node`) is held by none of the `supports`.
+    fn driven_dof_not_supported(
+        &self,
+        key: &str,
+        node_s: &S<String>,
+        node: NodeRef,
+        dof_s: &S<String>,
+        dof: usize,
+        supports: &[SupportSpec],
+    ) -> Res<()> {
+        let dof_name = dof_s.get_ref();
+        // A support holds the DOF at zero; prescribing it too would
+        // silently override one of the two.
+        if let Some(s) = supports.iter().position(|s| s.node == node && s.fixed[dof]) {
+            return Err(self.at(
+                key,
+                dof_s,
+                format!(
+                    "DOF \"{dof_name}\" of node \"{}\" is also held by support[{s}].fixed; a DOF is \
+                     either supported or prescribed: remove \"{dof_name}\" from support[{s}].fixed, \
+                     or remove this prescribed entry",
+                    node_s.get_ref()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The driven DOF `dof_s` (`dof`, at key `key`) of node `node_s`
+    /// (`node`) is driven by none of the earlier entries `out`.
+    fn driven_dof_not_prescribed(
+        &self,
+        key: &str,
+        node_s: &S<String>,
+        node: NodeRef,
+        dof_s: &S<String>,
+        dof: usize,
+        out: &[PrescribedSpec],
+    ) -> Res<()> {
+        let dof_name = dof_s.get_ref();
+        if let Some(o) = out.iter().position(|q| {
+            matches!(q, PrescribedSpec::NodeDof { node: n, dof: d, .. } if *n == node && *d == dof)
+        }) {
+            return Err(self.at(
+                key,
+                dof_s,
+                format!(
+                    "DOF \"{dof_name}\" of node \"{}\" is already prescribed by prescribed[{o}]",
+                    node_s.get_ref()
+                ),
+            ));
+        }
+        Ok(())
     }
 
     pub(super) fn initial_velocities(

@@ -1,5 +1,7 @@
 //! The `[solver]` and `[output]` tables.
 
+use std::ops::Range;
+
 use super::{limits, quoted_list, Ctx, Res};
 use crate::raw::{RawOutput, RawSolver, S};
 use crate::types::*;
@@ -15,209 +17,11 @@ impl Ctx<'_> {
         };
         let hs = entry.span();
         let s = entry.get_ref();
-        let dynamic = match &s.analysis {
-            None => false,
-            Some(a) => match a.get_ref().as_str() {
-                "static" => false,
-                "dynamic" => true,
-                other => {
-                    return Err(self.at(
-                        "solver.analysis",
-                        a,
-                        format!("expected \"static\" or \"dynamic\", found \"{other}\""),
-                    ))
-                }
-            },
-        };
+        let dynamic = self.analysis_is_dynamic(s)?;
         let analysis = if dynamic {
-            if let Some(l) = &s.load_steps {
-                return Err(self.at(
-                    "solver.load_steps",
-                    l,
-                    "`load_steps` belongs to a static analysis, but analysis = \"dynamic\"; a \
-                     dynamic analysis steps with `dt` up to `t_end`: remove `load_steps`",
-                ));
-            }
-            for (key, v) in [
-                ("control", s.control.as_ref().map(S::span)),
-                ("max_arc_steps", s.max_arc_steps.as_ref().map(S::span)),
-                ("branch_switch", s.branch_switch.as_ref().map(S::span)),
-            ] {
-                if let Some(span) = v {
-                    return Err(self.err(
-                        format!("solver.{key}"),
-                        Some(span),
-                        format!(
-                            "`{key}` belongs to a static analysis (load or arc-length control), \
-                             but analysis = \"dynamic\"; remove `{key}`"
-                        ),
-                    ));
-                }
-            }
-            let integrators = [
-                IntegratorKind::Newmark,
-                IntegratorKind::GeneralizedAlpha {
-                    rho_inf: DEFAULT_RHO_INF,
-                },
-                IntegratorKind::Momentum,
-                IntegratorKind::EnergyMomentum,
-                IntegratorKind::EnergyMomentumPaper,
-            ];
-            let names = quoted_list(integrators.iter().map(|i| i.name()));
-            let int_s = self.need(
-                &s.integrator,
-                "solver.integrator",
-                &hs,
-                &format!("a dynamic analysis needs an integrator, one of {names}"),
-            )?;
-            let Some(&integrator) = integrators.iter().find(|i| i.name() == int_s.get_ref()) else {
-                return Err(self.at(
-                    "solver.integrator",
-                    int_s,
-                    format!(
-                        "unknown integrator \"{}\"; expected one of {names}",
-                        int_s.get_ref()
-                    ),
-                ));
-            };
-            let integrator = match (integrator, &s.rho_inf) {
-                (IntegratorKind::GeneralizedAlpha { .. }, Some(r)) => {
-                    let rho_inf = r.get_ref().0;
-                    if !(0.0..=1.0).contains(&rho_inf) {
-                        return Err(self.at(
-                            "solver.rho_inf",
-                            r,
-                            format!(
-                                "the spectral radius at infinite frequency must lie in [0, 1] \
-                                 (1: no numerical damping, 0: the most), found {rho_inf:?}"
-                            ),
-                        ));
-                    }
-                    IntegratorKind::GeneralizedAlpha { rho_inf }
-                }
-                (_, Some(r)) => {
-                    return Err(self.at(
-                        "solver.rho_inf",
-                        r,
-                        format!(
-                            "`rho_inf` belongs to integrator = \"generalized-alpha\", but this \
-                             run uses \"{}\"; remove `rho_inf` or change the integrator",
-                            integrator.name()
-                        ),
-                    ))
-                }
-                (integrator, None) => integrator,
-            };
-            let dt_s = self.need(
-                &s.dt,
-                "solver.dt",
-                &hs,
-                "a dynamic analysis needs the time step, e.g. dt = 0.01",
-            )?;
-            let dt = self.positive(dt_s, "solver.dt")?;
-            let t_end_s = self.need(
-                &s.t_end,
-                "solver.t_end",
-                &hs,
-                "a dynamic analysis needs the end time, e.g. t_end = 1.0",
-            )?;
-            let t_end = self.positive(t_end_s, "solver.t_end")?;
-            if dt > t_end {
-                return Err(self.at(
-                    "solver.dt",
-                    dt_s,
-                    format!("must be <= t_end = {t_end:?}, found {dt:?}"),
-                ));
-            }
-            if t_end / dt > limits::MAX_TIME_STEPS {
-                return Err(self.at(
-                    "solver.dt",
-                    dt_s,
-                    format!(
-                        "gives t_end/dt = {:.3e} steps, more than the {:.0e} a run may take \
-                         (one stored record each); use a larger dt or a shorter t_end",
-                        t_end / dt,
-                        limits::MAX_TIME_STEPS
-                    ),
-                ));
-            }
-            Analysis::Dynamic {
-                integrator,
-                dt,
-                t_end,
-            }
+            self.dynamic_analysis(s, &hs)?
         } else {
-            let dynamic_only = [
-                ("dt", s.dt.as_ref().map(S::span)),
-                ("t_end", s.t_end.as_ref().map(S::span)),
-                ("integrator", s.integrator.as_ref().map(S::span)),
-                ("rho_inf", s.rho_inf.as_ref().map(S::span)),
-            ];
-            if let Some((key, span)) = dynamic_only.iter().find(|(_, sp)| sp.is_some()) {
-                let default = if s.analysis.is_none() {
-                    " (the default)"
-                } else {
-                    ""
-                };
-                return Err(self.err(
-                    format!("solver.{key}"),
-                    span.clone(),
-                    format!(
-                        "`{key}` belongs to a dynamic analysis, but this analysis is static{default}; \
-                         set analysis = \"dynamic\", or remove `{key}` (a static analysis takes `load_steps`)"
-                    ),
-                ));
-            }
-            let load_steps = match &s.load_steps {
-                Some(l) => self.int_in(l, "solver.load_steps", 1, limits::MAX_LOAD_STEPS)?,
-                None => 10,
-            };
-            let arc_length = match &s.control {
-                None => false,
-                Some(c) => match c.get_ref().as_str() {
-                    "load" => false,
-                    "arc-length" => true,
-                    other => {
-                        return Err(self.at(
-                            "solver.control",
-                            c,
-                            format!("expected \"load\" or \"arc-length\", found \"{other}\""),
-                        ))
-                    }
-                },
-            };
-            let branch_switch = match (&s.branch_switch, arc_length) {
-                (Some(b), false) => {
-                    return Err(self.at(
-                        "solver.branch_switch",
-                        b,
-                        "`branch_switch` belongs to control = \"arc-length\"; set it, or \
-                         remove `branch_switch`",
-                    ))
-                }
-                (b, _) => b.as_ref().is_some_and(|b| *b.get_ref()),
-            };
-            match (&s.max_arc_steps, arc_length) {
-                (Some(m), true) => Analysis::ArcLength {
-                    load_steps,
-                    max_steps: self.int_in(m, "solver.max_arc_steps", 1, limits::MAX_LOAD_STEPS)?,
-                    branch_switch,
-                },
-                (None, true) => Analysis::ArcLength {
-                    load_steps,
-                    max_steps: DEFAULT_ARC_STEPS_PER_LOAD_STEP * load_steps,
-                    branch_switch,
-                },
-                (Some(m), false) => {
-                    return Err(self.at(
-                        "solver.max_arc_steps",
-                        m,
-                        "`max_arc_steps` belongs to control = \"arc-length\"; set it, or \
-                         remove `max_arc_steps`",
-                    ))
-                }
-                (None, false) => Analysis::Static { load_steps },
-            }
+            self.static_analysis(s)?
         };
         let tolerance = match &s.tolerance {
             Some(t) => self.positive(t, "solver.tolerance")?,
@@ -231,7 +35,255 @@ impl Ctx<'_> {
             Some(m) => self.int_in(m, "solver.max_halvings", 0, limits::MAX_HALVINGS)?,
             None => SolverSpec::default().max_halvings,
         };
-        let mass = match &s.mass {
+        let mass = self.mass_kind(s)?;
+        let (modified_newton, exact_tangent) = self.newton_kind(s, &analysis)?;
+        Ok(SolverSpec {
+            analysis,
+            tolerance,
+            max_iterations,
+            max_halvings,
+            mass,
+            modified_newton,
+            exact_tangent,
+        })
+    }
+
+    /// `solver.analysis`: whether it is "dynamic" (absent: static).
+    fn analysis_is_dynamic(&self, s: &RawSolver) -> Res<bool> {
+        Ok(match &s.analysis {
+            None => false,
+            Some(a) => match a.get_ref().as_str() {
+                "static" => false,
+                "dynamic" => true,
+                other => {
+                    return Err(self.at(
+                        "solver.analysis",
+                        a,
+                        format!("expected \"static\" or \"dynamic\", found \"{other}\""),
+                    ))
+                }
+            },
+        })
+    }
+
+    /// The dynamic analysis of `[solver]` (spanning `hs`): no static keys,
+    /// the integrator, and `dt` and `t_end`.
+    fn dynamic_analysis(&self, s: &RawSolver, hs: &Range<usize>) -> Res<Analysis> {
+        self.no_static_keys(s)?;
+        let integrator = self.integrator(s, hs)?;
+        let dt_s = self.need(
+            &s.dt,
+            "solver.dt",
+            hs,
+            "a dynamic analysis needs the time step, e.g. dt = 0.01",
+        )?;
+        let dt = self.positive(dt_s, "solver.dt")?;
+        let t_end_s = self.need(
+            &s.t_end,
+            "solver.t_end",
+            hs,
+            "a dynamic analysis needs the end time, e.g. t_end = 1.0",
+        )?;
+        let t_end = self.positive(t_end_s, "solver.t_end")?;
+        if dt > t_end {
+            return Err(self.at(
+                "solver.dt",
+                dt_s,
+                format!("must be <= t_end = {t_end:?}, found {dt:?}"),
+            ));
+        }
+        if t_end / dt > limits::MAX_TIME_STEPS {
+            return Err(self.at(
+                "solver.dt",
+                dt_s,
+                format!(
+                    "gives t_end/dt = {:.3e} steps, more than the {:.0e} a run may take \
+                     (one stored record each); use a larger dt or a shorter t_end",
+                    t_end / dt,
+                    limits::MAX_TIME_STEPS
+                ),
+            ));
+        }
+        Ok(Analysis::Dynamic {
+            integrator,
+            dt,
+            t_end,
+        })
+    }
+
+    /// A dynamic analysis has none of the static keys: `load_steps`, then
+    /// `control`, `max_arc_steps` and `branch_switch`.
+    fn no_static_keys(&self, s: &RawSolver) -> Res<()> {
+        if let Some(l) = &s.load_steps {
+            return Err(self.at(
+                "solver.load_steps",
+                l,
+                "`load_steps` belongs to a static analysis, but analysis = \"dynamic\"; a \
+                 dynamic analysis steps with `dt` up to `t_end`: remove `load_steps`",
+            ));
+        }
+        for (key, v) in [
+            ("control", s.control.as_ref().map(S::span)),
+            ("max_arc_steps", s.max_arc_steps.as_ref().map(S::span)),
+            ("branch_switch", s.branch_switch.as_ref().map(S::span)),
+        ] {
+            if let Some(span) = v {
+                return Err(self.err(
+                    format!("solver.{key}"),
+                    Some(span),
+                    format!(
+                        "`{key}` belongs to a static analysis (load or arc-length control), \
+                         but analysis = \"dynamic\"; remove `{key}`"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// `solver.integrator` of a dynamic analysis (`[solver]` spanning `hs`),
+    /// with `rho_inf` for the generalized-alpha scheme only.
+    fn integrator(&self, s: &RawSolver, hs: &Range<usize>) -> Res<IntegratorKind> {
+        let integrators = [
+            IntegratorKind::Newmark,
+            IntegratorKind::GeneralizedAlpha {
+                rho_inf: DEFAULT_RHO_INF,
+            },
+            IntegratorKind::Momentum,
+            IntegratorKind::EnergyMomentum,
+            IntegratorKind::EnergyMomentumPaper,
+        ];
+        let names = quoted_list(integrators.iter().map(|i| i.name()));
+        let int_s = self.need(
+            &s.integrator,
+            "solver.integrator",
+            hs,
+            &format!("a dynamic analysis needs an integrator, one of {names}"),
+        )?;
+        let Some(&integrator) = integrators.iter().find(|i| i.name() == int_s.get_ref()) else {
+            return Err(self.at(
+                "solver.integrator",
+                int_s,
+                format!(
+                    "unknown integrator \"{}\"; expected one of {names}",
+                    int_s.get_ref()
+                ),
+            ));
+        };
+        Ok(match (integrator, &s.rho_inf) {
+            (IntegratorKind::GeneralizedAlpha { .. }, Some(r)) => {
+                let rho_inf = r.get_ref().0;
+                if !(0.0..=1.0).contains(&rho_inf) {
+                    return Err(self.at(
+                        "solver.rho_inf",
+                        r,
+                        format!(
+                            "the spectral radius at infinite frequency must lie in [0, 1] \
+                             (1: no numerical damping, 0: the most), found {rho_inf:?}"
+                        ),
+                    ));
+                }
+                IntegratorKind::GeneralizedAlpha { rho_inf }
+            }
+            (_, Some(r)) => {
+                return Err(self.at(
+                    "solver.rho_inf",
+                    r,
+                    format!(
+                        "`rho_inf` belongs to integrator = \"generalized-alpha\", but this \
+                         run uses \"{}\"; remove `rho_inf` or change the integrator",
+                        integrator.name()
+                    ),
+                ))
+            }
+            (integrator, None) => integrator,
+        })
+    }
+
+    /// The static analysis of `[solver]`: no dynamic keys, `load_steps`,
+    /// and load or arc-length control with its keys.
+    fn static_analysis(&self, s: &RawSolver) -> Res<Analysis> {
+        let dynamic_only = [
+            ("dt", s.dt.as_ref().map(S::span)),
+            ("t_end", s.t_end.as_ref().map(S::span)),
+            ("integrator", s.integrator.as_ref().map(S::span)),
+            ("rho_inf", s.rho_inf.as_ref().map(S::span)),
+        ];
+        if let Some((key, span)) = dynamic_only.iter().find(|(_, sp)| sp.is_some()) {
+            let default = if s.analysis.is_none() {
+                " (the default)"
+            } else {
+                ""
+            };
+            return Err(self.err(
+                format!("solver.{key}"),
+                span.clone(),
+                format!(
+                    "`{key}` belongs to a dynamic analysis, but this analysis is static{default}; \
+                     set analysis = \"dynamic\", or remove `{key}` (a static analysis takes `load_steps`)"
+                ),
+            ));
+        }
+        let load_steps = match &s.load_steps {
+            Some(l) => self.int_in(l, "solver.load_steps", 1, limits::MAX_LOAD_STEPS)?,
+            None => 10,
+        };
+        let arc_length = self.is_arc_length(s)?;
+        let branch_switch = match (&s.branch_switch, arc_length) {
+            (Some(b), false) => {
+                return Err(self.at(
+                    "solver.branch_switch",
+                    b,
+                    "`branch_switch` belongs to control = \"arc-length\"; set it, or \
+                     remove `branch_switch`",
+                ))
+            }
+            (b, _) => b.as_ref().is_some_and(|b| *b.get_ref()),
+        };
+        Ok(match (&s.max_arc_steps, arc_length) {
+            (Some(m), true) => Analysis::ArcLength {
+                load_steps,
+                max_steps: self.int_in(m, "solver.max_arc_steps", 1, limits::MAX_LOAD_STEPS)?,
+                branch_switch,
+            },
+            (None, true) => Analysis::ArcLength {
+                load_steps,
+                max_steps: DEFAULT_ARC_STEPS_PER_LOAD_STEP * load_steps,
+                branch_switch,
+            },
+            (Some(m), false) => {
+                return Err(self.at(
+                    "solver.max_arc_steps",
+                    m,
+                    "`max_arc_steps` belongs to control = \"arc-length\"; set it, or \
+                     remove `max_arc_steps`",
+                ))
+            }
+            (None, false) => Analysis::Static { load_steps },
+        })
+    }
+
+    /// `solver.control`: whether it is "arc-length" (absent: load control).
+    fn is_arc_length(&self, s: &RawSolver) -> Res<bool> {
+        Ok(match &s.control {
+            None => false,
+            Some(c) => match c.get_ref().as_str() {
+                "load" => false,
+                "arc-length" => true,
+                other => {
+                    return Err(self.at(
+                        "solver.control",
+                        c,
+                        format!("expected \"load\" or \"arc-length\", found \"{other}\""),
+                    ))
+                }
+            },
+        })
+    }
+
+    /// `solver.mass`: consistent (the default) or lumped.
+    fn mass_kind(&self, s: &RawSolver) -> Res<MassKind> {
+        Ok(match &s.mass {
             None => MassKind::Consistent,
             Some(m) => match m.get_ref().as_str() {
                 "consistent" => MassKind::Consistent,
@@ -244,13 +296,18 @@ impl Ctx<'_> {
                     ))
                 }
             },
-        };
-        let (modified_newton, exact_tangent) = match &s.newton {
+        })
+    }
+
+    /// `solver.newton` as `(modified_newton, exact_tangent)`: modified Newton
+    /// only for a dynamic analysis whose integrator allows it.
+    fn newton_kind(&self, s: &RawSolver, analysis: &Analysis) -> Res<(bool, bool)> {
+        Ok(match &s.newton {
             None => (false, false),
             Some(m) => match m.get_ref().as_str() {
                 "full" => (false, false),
                 "exact" => (false, true),
-                "modified" => match &analysis {
+                "modified" => match analysis {
                     Analysis::Static { .. } | Analysis::ArcLength { .. } => {
                         return Err(self.at(
                             "solver.newton",
@@ -282,15 +339,6 @@ impl Ctx<'_> {
                     ))
                 }
             },
-        };
-        Ok(SolverSpec {
-            analysis,
-            tolerance,
-            max_iterations,
-            max_halvings,
-            mass,
-            modified_newton,
-            exact_tangent,
         })
     }
 
