@@ -2,6 +2,7 @@
 //! as `flexmech run` runs them, and their result files are checked against
 //! analytic solutions and published values.
 
+use crate::common;
 use flexmech::model::{load_model, parse_model, Model};
 use flexmech::results::run_model;
 use std::path::{Path, PathBuf};
@@ -14,15 +15,12 @@ fn data(name: &str) -> PathBuf {
 
 /// A time series of a result file, as rows of `width` values.
 fn read(file: &Path, dataset: &str, width: usize) -> Vec<Vec<f64>> {
-    let f = hdf5::File::open(file).unwrap();
-    let flat: Vec<f64> = f.dataset(dataset).unwrap().read_raw().unwrap();
+    let flat = common::read(file, dataset);
     flat.chunks(width).map(<[f64]>::to_vec).collect()
 }
 
 fn status(file: &Path) -> String {
-    let f = hdf5::File::open(file).unwrap();
-    let s: hdf5::types::VarLenUnicode = f.attr("status").unwrap().read_scalar().unwrap();
-    s.to_string()
+    common::reader(file).status().unwrap()
 }
 
 /// The benchmark file `name` with its (single) beam re-meshed into `elements`

@@ -2,6 +2,7 @@
 //! files; bad input prints a message naming the file, key and problem and
 //! exits non-zero without losing the other models' results.
 
+use crate::common::{read, reader, string_attr};
 use std::path::Path;
 use std::process::Command;
 
@@ -142,15 +143,12 @@ fn failed_solve_keeps_a_valid_file_with_the_steps_so_far() {
         stderr.contains("hard.toml: model \"rollup-linear\""),
         "{stderr}"
     );
-    let f = hdf5::File::open(dir.path().join("rollup-linear.h5")).unwrap();
-    let status: hdf5::types::VarLenUnicode = f.attr("status").unwrap().read_scalar().unwrap();
-    assert!(
-        status.as_str().starts_with("failed: no convergence"),
-        "{status}"
-    );
-    let t: Vec<f64> = f.dataset("/time").unwrap().read_raw().unwrap();
-    let pos = f.dataset("/configuration/position").unwrap();
-    assert_eq!(pos.shape()[0], t.len());
+    let f = dir.path().join("rollup-linear.h5");
+    let status = string_attr(&f, "status");
+    assert!(status.starts_with("failed: no convergence"), "{status}");
+    let t = read(&f, "/time");
+    let pos = reader(&f).shape("/configuration/position").unwrap();
+    assert_eq!(pos[0], t.len());
 }
 
 #[test]
@@ -232,14 +230,7 @@ fn a_completed_run_whose_energy_balance_is_off_says_so() {
             && stderr.contains("smaller dt"),
         "{stderr}"
     );
-    let attr = |file: &str| {
-        let h = hdf5::File::open(dir.path().join(file)).unwrap();
-        h.attr("warnings").ok().map(|a| {
-            a.read_scalar::<hdf5::types::VarLenUnicode>()
-                .unwrap()
-                .to_string()
-        })
-    };
+    let attr = |file: &str| reader(&dir.path().join(file)).string_attr("warnings");
     let w = attr("screw-newmark.h5").expect("a warnings attribute");
     assert!(w.contains("energy balance"), "{w}");
     assert!(attr("screw-energy-momentum.h5").is_none());

@@ -7,7 +7,7 @@ use flexmech::results::run_model;
 use std::path::{Path, PathBuf};
 
 use crate::common;
-use common::{drift, read};
+use common::{drift, read, string_attr};
 
 fn data(name: &str) -> PathBuf {
     common::data(&format!("dynamics/{name}"))
@@ -28,35 +28,30 @@ fn run(integrator: &str) -> (PathBuf, tempfile::TempDir) {
 #[test]
 fn energy_momentum_conserves_everything_from_a_model_file() {
     let (file, _dir) = run("energy-momentum");
-    let t = read::<f64>(&file, "/time");
+    let t = read(&file, "/time");
     assert!((t.last().unwrap() - 20.0).abs() < 1e-9 && t[0] == 0.0);
-    let e = read::<f64>(&file, "/energy/total");
+    let e = read(&file, "/energy/total");
     let de = e
         .iter()
         .map(|v| (v - e[0]).abs() / e[0])
         .fold(0.0, f64::max);
     assert!(de <= 1e-9, "energy drift {de:e}");
-    assert!(drift(&read::<f64>(&file, "/momentum/linear"), 3) <= 1e-9);
-    assert!(drift(&read::<f64>(&file, "/momentum/angular"), 3) <= 1e-9);
+    assert!(drift(&read(&file, "/momentum/linear"), 3) <= 1e-9);
+    assert!(drift(&read(&file, "/momentum/angular"), 3) <= 1e-9);
     // β is reported for every step after the first record.
-    let beta = read::<f64>(&file, "/solver/beta");
+    let beta = read(&file, "/solver/beta");
     assert!(beta[0].is_nan() && beta[1..].iter().all(|b| b.is_finite()));
-    let f = hdf5::File::open(&file).unwrap();
-    let integrator: hdf5::types::VarLenUnicode =
-        f.attr("integrator").unwrap().read_scalar().unwrap();
-    assert_eq!(integrator.as_str(), "energy-momentum");
+    assert_eq!(string_attr(&file, "integrator"), "energy-momentum");
 }
 
 #[test]
 fn momentum_and_newmark_from_the_same_file() {
     let (file, _dir) = run("momentum");
-    assert!(drift(&read::<f64>(&file, "/momentum/angular"), 3) <= 1e-9);
-    assert!(read::<f64>(&file, "/solver/beta")
-        .iter()
-        .all(|b| b.is_nan()));
+    assert!(drift(&read(&file, "/momentum/angular"), 3) <= 1e-9);
+    assert!(read(&file, "/solver/beta").iter().all(|b| b.is_nan()));
     let (file, _dir2) = run("newmark");
-    assert!(drift(&read::<f64>(&file, "/momentum/linear"), 3) <= 1e-9);
-    let e = read::<f64>(&file, "/energy/total");
+    assert!(drift(&read(&file, "/momentum/linear"), 3) <= 1e-9);
+    let e = read(&file, "/energy/total");
     assert!(e.iter().all(|v| v.is_finite()));
 }
 
@@ -91,9 +86,9 @@ fn every_joint_kind_runs_with_every_integrator_from_a_model_file() {
     ];
     for integrator in ["newmark", "momentum", "energy-momentum"] {
         let (file, _dir) = run_chain(integrator);
-        assert!((read::<f64>(&file, "/time").last().unwrap() - 1.0).abs() < 1e-9);
+        assert!((read(&file, "/time").last().unwrap() - 1.0).abs() < 1e-9);
         for joint in JOINTS {
-            let c = read::<f64>(&file, &format!("/joints/{joint}/constraint_error"));
+            let c = read(&file, &format!("/joints/{joint}/constraint_error"));
             let worst = c.iter().copied().fold(0.0, f64::max);
             assert!(
                 worst <= 1e-12,
@@ -101,10 +96,10 @@ fn every_joint_kind_runs_with_every_integrator_from_a_model_file() {
             );
         }
         let (dl, dh) = (
-            drift(&read::<f64>(&file, "/momentum/linear"), 3),
-            drift(&read::<f64>(&file, "/momentum/angular"), 3),
+            drift(&read(&file, "/momentum/linear"), 3),
+            drift(&read(&file, "/momentum/angular"), 3),
         );
-        let e = read::<f64>(&file, "/energy/total");
+        let e = read(&file, "/energy/total");
         let de = e
             .iter()
             .map(|v| (v - e[0]).abs() / e[0])
@@ -159,10 +154,7 @@ fn the_jointed_chain_is_bitwise_the_same_on_one_two_and_three_threads() {
                 })
             });
             let bits = |name: &str| -> Vec<u64> {
-                read::<f64>(&file, name)
-                    .iter()
-                    .map(|v| v.to_bits())
-                    .collect()
+                read(&file, name).iter().map(|v| v.to_bits()).collect()
             };
             (
                 bits("/configuration/position"),
@@ -225,14 +217,14 @@ fn a_long_run_does_not_stall_as_the_beam_travels() {
     let model = parse_model(&text, &path).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let file = run_model(&model, dir.path()).unwrap().file;
-    let t = read::<f64>(&file, "/time");
+    let t = read(&file, "/time");
     assert!((t.last().unwrap() - 70.0).abs() < 1e-9);
-    let e = read::<f64>(&file, "/energy/total");
+    let e = read(&file, "/energy/total");
     let de = e
         .iter()
         .map(|v| (v - e[0]).abs() / e[0])
         .fold(0.0, f64::max);
     assert!(de <= 1e-9, "energy drift {de:e}");
-    assert!(drift(&read::<f64>(&file, "/momentum/linear"), 3) <= 1e-9);
-    assert!(drift(&read::<f64>(&file, "/momentum/angular"), 3) <= 1e-9);
+    assert!(drift(&read(&file, "/momentum/linear"), 3) <= 1e-9);
+    assert!(drift(&read(&file, "/momentum/angular"), 3) <= 1e-9);
 }

@@ -5,6 +5,7 @@
 //! Such runs now stop with an error naming the beam, the element, the load
 //! factor and the fix; the run's file keeps the steps before and says so.
 
+use crate::common::{read, string_attr};
 use flexmech::model::parse_model;
 use flexmech::results::{run_model, RunError};
 use std::path::Path;
@@ -28,13 +29,7 @@ fn refused(text: &str) -> (String, String) {
     let dir = tempfile::tempdir().unwrap();
     match run_model(&model, dir.path()) {
         Err(RunError::Solve { error, file, .. }) => {
-            let status: String = hdf5::File::open(&file)
-                .unwrap()
-                .attr("status")
-                .unwrap()
-                .read_scalar::<hdf5::types::VarLenUnicode>()
-                .unwrap()
-                .to_string();
+            let status = string_attr(&file, "status");
             (error.to_string(), status)
         }
         other => panic!("expected a refusal, got {other:?}"),
@@ -73,12 +68,7 @@ fn a_prescribed_turn_too_large_for_one_step_is_retried_smaller_or_refused() {
     let model = parse_model(&rolled(2.0, 20, 1), Path::new("rolled.toml")).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let file = run_model(&model, dir.path()).unwrap().file;
-    let strain: Vec<f64> = hdf5::File::open(file)
-        .unwrap()
-        .dataset("/energy/strain")
-        .unwrap()
-        .read_raw()
-        .unwrap();
+    let strain = read(&file, "/energy/strain");
     let kappa = 2.0 * std::f64::consts::TAU / 10.0;
     let exact = 0.5 * 100.0 * kappa * kappa * 10.0;
     let last = *strain.last().unwrap();
@@ -106,8 +96,7 @@ fn many_turns_on_enough_elements_still_roll_up_exactly() {
     let model = parse_model(&rolled(6.0, 60, 60), Path::new("rolled.toml")).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let file = run_model(&model, dir.path()).unwrap().file;
-    let h = hdf5::File::open(file).unwrap();
-    let strain: Vec<f64> = h.dataset("/energy/strain").unwrap().read_raw().unwrap();
+    let strain = read(&file, "/energy/strain");
     let kappa = 6.0 * std::f64::consts::TAU / 10.0;
     let exact = 0.5 * 100.0 * kappa * kappa * 10.0;
     let last = *strain.last().unwrap();

@@ -3,18 +3,10 @@
 //! the balance once left out (time-varying loads were not checked at all,
 //! and a dead moment's work was missing from it).
 
+use crate::common::read;
 use flexmech::model::parse_model;
 use flexmech::results::run_model;
 use std::path::Path;
-
-fn read(file: &Path, dataset: &str) -> Vec<f64> {
-    hdf5::File::open(file)
-        .unwrap()
-        .dataset(dataset)
-        .unwrap()
-        .read_raw()
-        .unwrap()
-}
 
 /// A cantilever with mass struck by a tip load `load` (TOML fields).
 fn cantilever(integrator: &str, dt: f64, t_end: f64, load: &str) -> String {

@@ -6,6 +6,7 @@
 //! misbehaves in each way shows the harness sees every kind of defect.
 
 use crate::fuzz_engine::{run, FuzzOptions, Outcome};
+use flexmech::results::table::{write_table, TableColumn, TableValues};
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -71,13 +72,16 @@ fn the_harness_sees_every_kind_of_defect() {
     // A result file with a NaN where none belongs.
     let tmp = tempfile::tempdir().unwrap();
     let h5 = tmp.path().join("nan.h5");
-    {
-        let f = hdf5::File::create(&h5).unwrap();
-        f.new_dataset_builder()
-            .with_data(&[0.0, f64::NAN])
-            .create("time")
-            .unwrap();
-    }
+    write_table(
+        &h5,
+        &[TableColumn {
+            name: "time".into(),
+            description: "a NaN where none belongs".into(),
+            values: TableValues::Numbers(vec![0.0, f64::NAN]),
+        }],
+        &[],
+    )
+    .unwrap();
     let copy_nan = format!("cp '{}' \"$3/r.h5\"; echo completed", h5.display());
     let cases = [
         (

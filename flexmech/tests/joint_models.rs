@@ -3,6 +3,7 @@
 //! `r_R = f(ψ)` hold to round-off at every stored step of several turns, the
 //! driven angle follows its table, and the joint datasets are in the file.
 
+use crate::common::read;
 use flexmech::model::load_model;
 use flexmech::results::run_model;
 use std::path::{Path, PathBuf};
@@ -11,15 +12,6 @@ fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../data/statics")
         .join(name)
-}
-
-fn read(file: &Path, dataset: &str) -> Vec<f64> {
-    hdf5::File::open(file)
-        .unwrap()
-        .dataset(dataset)
-        .unwrap()
-        .read_raw()
-        .unwrap()
 }
 
 /// The joint histories of one run.

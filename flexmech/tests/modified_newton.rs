@@ -12,7 +12,7 @@ use flexmech::results::run_model;
 use std::path::{Path, PathBuf};
 
 use crate::common;
-use common::{data, drift, read};
+use common::{data, drift, read, read_counts};
 
 /// Runs `model` (a data/ path) with `integrator` and `newton`.
 fn run(model: &str, integrator: &str, newton: &str) -> (PathBuf, tempfile::TempDir) {
@@ -33,8 +33,8 @@ fn run(model: &str, integrator: &str, newton: &str) -> (PathBuf, tempfile::TempD
 /// of the same model (which must have the same steps).
 fn largest_position_difference(a: &Path, b: &Path) -> f64 {
     let (a, b) = (
-        read::<f64>(a, "/configuration/position"),
-        read::<f64>(b, "/configuration/position"),
+        read(a, "/configuration/position"),
+        read(b, "/configuration/position"),
     );
     assert_eq!(a.len(), b.len());
     a.iter()
@@ -54,13 +54,13 @@ fn the_free_chain_follows_full_newton_with_every_joint_kind() {
         let (full, _d1) = run("dynamics/free_chain.toml", integrator, "full");
         let (modified, _d2) = run("dynamics/free_chain.toml", integrator, "modified");
         let worst = largest_position_difference(&full, &modified);
-        let steps = read::<u64>(&modified, "/solver/iterations").len() - 1;
-        let factorizations: u64 = read::<u64>(&modified, "/solver/factorizations")
+        let steps = read_counts(&modified, "/solver/iterations").len() - 1;
+        let factorizations: u64 = read_counts(&modified, "/solver/factorizations")
             .iter()
             .sum();
-        let iterations: u64 = read::<u64>(&modified, "/solver/iterations").iter().sum();
-        let full_factorizations: u64 = read::<u64>(&full, "/solver/factorizations").iter().sum();
-        let full_iterations: u64 = read::<u64>(&full, "/solver/iterations").iter().sum();
+        let iterations: u64 = read_counts(&modified, "/solver/iterations").iter().sum();
+        let full_factorizations: u64 = read_counts(&full, "/solver/factorizations").iter().sum();
+        let full_iterations: u64 = read_counts(&full, "/solver/iterations").iter().sum();
         eprintln!(
             "{integrator}: positions differ by {worst:.1e}; modified {factorizations} \
              factorisations / {iterations} iterations over {steps} steps, full \
@@ -79,18 +79,18 @@ fn the_free_chain_follows_full_newton_with_every_joint_kind() {
             "{integrator}: {factorizations} factorisations for {steps} steps"
         );
         for joint in ["revolute", "screw", "cam", "lobe"] {
-            let c = read::<f64>(&modified, &format!("/joints/{joint}/constraint_error"));
+            let c = read(&modified, &format!("/joints/{joint}/constraint_error"));
             assert!(c.iter().all(|&v| v <= 1e-12), "{integrator}, {joint}");
         }
         if integrator != "newmark" {
             let (dl, dh) = (
-                drift(&read::<f64>(&modified, "/momentum/linear"), 3),
-                drift(&read::<f64>(&modified, "/momentum/angular"), 3),
+                drift(&read(&modified, "/momentum/linear"), 3),
+                drift(&read(&modified, "/momentum/angular"), 3),
             );
             assert!(dl <= 1e-9 && dh <= 1e-9, "{integrator}: {dl:e} {dh:e}");
         }
         if integrator == "energy-momentum" {
-            let de = drift(&read::<f64>(&modified, "/energy/total"), 1);
+            let de = drift(&read(&modified, "/energy/total"), 1);
             assert!(de <= 1e-9, "energy drift {de:e}");
         }
     }
@@ -99,10 +99,10 @@ fn the_free_chain_follows_full_newton_with_every_joint_kind() {
 #[test]
 fn the_spinning_beam_keeps_its_energy_with_modified_newton() {
     let (file, _dir) = run("dynamics/spinning_beam.toml", "energy-momentum", "modified");
-    assert!((read::<f64>(&file, "/time").last().unwrap() - 20.0).abs() < 1e-9);
-    let de = drift(&read::<f64>(&file, "/energy/total"), 1);
+    assert!((read(&file, "/time").last().unwrap() - 20.0).abs() < 1e-9);
+    let de = drift(&read(&file, "/energy/total"), 1);
     assert!(de <= 1e-9, "energy drift {de:e}");
-    assert!(drift(&read::<f64>(&file, "/momentum/angular"), 3) <= 1e-9);
+    assert!(drift(&read(&file, "/momentum/angular"), 3) <= 1e-9);
 }
 
 #[test]
@@ -140,7 +140,7 @@ fn exact_and_full_newton_reach_the_same_energy_momentum_solution() {
     let (full, _d1) = run("dynamics/free_chain.toml", "energy-momentum", "full");
     let (exact, _d2) = run("dynamics/free_chain.toml", "energy-momentum", "exact");
     let worst = largest_position_difference(&full, &exact);
-    let iterations = |f: &Path| read::<u64>(f, "/solver/iterations").iter().sum::<u64>();
+    let iterations = |f: &Path| read_counts(f, "/solver/iterations").iter().sum::<u64>();
     eprintln!(
         "positions differ by {worst:.1e}; iterations full {} / exact {}",
         iterations(&full),
@@ -148,8 +148,8 @@ fn exact_and_full_newton_reach_the_same_energy_momentum_solution() {
     );
     assert!(worst <= SAME_SOLUTION, "{worst:e}");
     for file in [&full, &exact] {
-        let de = drift(&read::<f64>(file, "/energy/total"), 1);
+        let de = drift(&read(file, "/energy/total"), 1);
         assert!(de <= 1e-9, "energy drift {de:e}");
-        assert!(drift(&read::<f64>(file, "/momentum/angular"), 3) <= 1e-9);
+        assert!(drift(&read(file, "/momentum/angular"), 3) <= 1e-9);
     }
 }

@@ -16,6 +16,7 @@
 //!
 //! Every test runs every integrator of [`INTEGRATORS`].
 
+use crate::common::{read, reader};
 use flexmech::model::{parse_model, Analysis, Model};
 use flexmech::results::{run_model, RunError};
 use std::f64::consts::PI;
@@ -139,18 +140,11 @@ impl Run {
     }
 
     fn status(&self) -> String {
-        let f = hdf5::File::open(&self.file).unwrap();
-        let s: hdf5::types::VarLenUnicode = f.attr("status").unwrap().read_scalar().unwrap();
-        s.to_string()
+        reader(&self.file).status().unwrap()
     }
 
     fn series(&self, dataset: &str) -> Vec<f64> {
-        hdf5::File::open(&self.file)
-            .unwrap()
-            .dataset(dataset)
-            .unwrap()
-            .read_raw()
-            .unwrap()
+        read(&self.file, dataset)
     }
 
     fn rows(&self, dataset: &str) -> Vec<[f64; 3]> {

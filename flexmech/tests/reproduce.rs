@@ -13,6 +13,7 @@
 //!   fall when the step is halved while the discrete gradient's correction
 //!   falls by 4 (the consistency study on screw_free).
 
+use crate::common::{read, reader};
 use flexmech::cli::reproduce::{reproduce, ReproduceError, ReproduceOptions, INTEGRATORS};
 use std::path::Path;
 
@@ -130,12 +131,7 @@ fn screw_free_shows_the_papers_claims() {
     // The two conserving schemes agree (paper Figure 6): the post top's Y
     // displacement at the end differs by less than 5 % of its range.
     let y = |file: &Path| -> Vec<f64> {
-        let d: Vec<f64> = hdf5::File::open(file)
-            .unwrap()
-            .dataset("/nodes/post.end/displacement")
-            .unwrap()
-            .read_raw()
-            .unwrap();
+        let d = read(file, "/nodes/post.end/displacement");
         d.chunks(3).map(|r| r[1]).collect()
     };
     let (ym, ye) = (y(&mc.file), y(&em.file));
@@ -203,7 +199,7 @@ fn driven_examples_run_and_balance_their_energy() {
             assert_eq!(r.reduced_steps(), 0, "{}", r.model);
         }
         // Every run has its contract datasets.
-        let h = hdf5::File::open(&r.file).unwrap();
+        let h = reader(&r.file);
         for d in [
             "/time",
             "/energy/total",
@@ -211,7 +207,7 @@ fn driven_examples_run_and_balance_their_energy() {
             "/solver/beta",
             "/solver/dt",
         ] {
-            assert!(h.dataset(d).is_ok(), "{d}");
+            assert!(h.has(d), "{d}");
         }
     }
     let charts = dir.path().join("charts");

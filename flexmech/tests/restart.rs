@@ -2,6 +2,7 @@
 //! run, and a result file that does not belong to the model is refused with
 //! a message naming what differs.
 
+use crate::common::{read, string_attr};
 use flexmech::model::parse_model;
 use flexmech::results::{restart_model, run_model, RunError};
 use std::path::{Path, PathBuf};
@@ -19,15 +20,6 @@ fn text_of(p: &str) -> String {
 fn replaced(text: &str, from: &str, to: &str) -> String {
     assert!(text.contains(from), "{from}");
     text.replacen(from, to, 1)
-}
-
-fn read(file: &Path, dataset: &str) -> Vec<f64> {
-    hdf5::File::open(file)
-        .unwrap()
-        .dataset(dataset)
-        .unwrap()
-        .read_raw::<f64>()
-        .unwrap()
 }
 
 /// Runs `short` (to t₁), continues it with `long` (to t₂), runs `long` from
@@ -54,13 +46,7 @@ fn continued_vs_uninterrupted(short: &str, long: &str, datasets: &[&str]) -> f64
         "starts where the first run stopped"
     );
     assert_eq!(t_cont.last(), t_whole.last());
-    let root = hdf5::File::open(&continued).unwrap();
-    let from = root.attr("restarted_from").unwrap();
-    assert!(from
-        .read_scalar::<hdf5::types::VarLenUnicode>()
-        .unwrap()
-        .as_str()
-        .ends_with(".h5"));
+    assert!(string_attr(&continued, "restarted_from").ends_with(".h5"));
     let mut worst = 0.0_f64;
     for ds in datasets {
         let w = read(&whole, ds);

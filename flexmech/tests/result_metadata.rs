@@ -2,26 +2,13 @@
 //! was made, and the mesh (labels, elements, beams) needed to draw the
 //! mechanism without the model text; joint angles only where a joint has one.
 
+use crate::common::{read, read_counts, read_strings, string_attr};
 use flexmech::results::run_model;
 use flexmech::results::ResultReader;
-use hdf5::types::VarLenUnicode;
 use std::path::Path;
 
-fn strings(file: &hdf5::File, name: &str) -> Vec<String> {
-    file.dataset(name)
-        .unwrap()
-        .read_raw::<VarLenUnicode>()
-        .unwrap()
-        .iter()
-        .map(|s| s.as_str().to_owned())
-        .collect()
-}
-
-fn counts(file: &hdf5::File, name: &str) -> Vec<usize> {
-    file.dataset(name)
-        .unwrap()
-        .read_raw::<u64>()
-        .unwrap()
+fn counts(file: &Path, name: &str) -> Vec<usize> {
+    read_counts(file, name)
         .into_iter()
         .map(|n| n as usize)
         .collect()
@@ -36,17 +23,9 @@ fn the_file_is_enough_to_draw_the_mechanism() {
     let model = flexmech::model::parse_model(&text, &path).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let file = run_model(&model, dir.path()).unwrap().file;
-    let h5 = hdf5::File::open(&file).unwrap();
 
     // Provenance.
-    let attr = |name: &str| -> String {
-        h5.attr(name)
-            .unwrap()
-            .read_scalar::<VarLenUnicode>()
-            .unwrap()
-            .as_str()
-            .to_owned()
-    };
+    let attr = |name: &str| -> String { string_attr(&file, name) };
     let created = attr("created");
     assert_eq!(created.len(), 20, "{created}");
     assert!(
@@ -58,13 +37,9 @@ fn the_file_is_enough_to_draw_the_mechanism() {
     assert!(!attr("command_line").is_empty());
 
     // Labels in /configuration order: one per node, every beam's ends named.
-    let labels = strings(&h5, "/mesh/node_labels");
+    let labels = read_strings(&file, "/mesh/node_labels");
     let n = labels.len();
-    let x0 = h5
-        .dataset("/configuration/position")
-        .unwrap()
-        .read_raw::<f64>()
-        .unwrap();
+    let x0 = read(&file, "/configuration/position");
     assert_eq!(x0.len() % (3 * n), 0, "T×{n}×3");
     for beam in &model.beams {
         assert!(labels.contains(&format!("{}.start", beam.name)));
@@ -73,9 +48,9 @@ fn the_file_is_enough_to_draw_the_mechanism() {
 
     // Beams: their nodes in order; at t = 0 consecutive nodes of a straight
     // beam are its length over its node intervals apart.
-    let names = strings(&h5, "/mesh/beam_names");
-    let nodes = counts(&h5, "/mesh/beam_nodes");
-    let offsets = counts(&h5, "/mesh/beam_offsets");
+    let names = read_strings(&file, "/mesh/beam_names");
+    let nodes = counts(&file, "/mesh/beam_nodes");
+    let offsets = counts(&file, "/mesh/beam_offsets");
     assert_eq!(names.len(), model.beams.len());
     assert_eq!((offsets[0], *offsets.last().unwrap()), (0, nodes.len()));
     let at = |k: usize| nalgebra::Vector3::new(x0[3 * k], x0[3 * k + 1], x0[3 * k + 2]);
@@ -91,8 +66,8 @@ fn the_file_is_enough_to_draw_the_mechanism() {
     }
 
     // Elements: 2 or 3 nodes each, all of one beam, covering every node.
-    let element_nodes = counts(&h5, "/mesh/element_nodes");
-    let element_offsets = counts(&h5, "/mesh/element_offsets");
+    let element_nodes = counts(&file, "/mesh/element_nodes");
+    let element_offsets = counts(&file, "/mesh/element_offsets");
     let elements: usize = model.beams.iter().map(|b| b.elements).sum();
     assert_eq!(element_offsets.len(), elements + 1);
     let mut seen = vec![false; n];

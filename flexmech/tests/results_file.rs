@@ -1,6 +1,12 @@
 // The HDF5 result writer against the result-file contract of MODEL_FORMAT.md:
 // every dataset's shape and values, the root attributes, the rotation vector,
 // and that a failed, dropped or killed run still leaves a readable file.
+//
+// Unlike the other tests this file reads with the raw `hdf5` library, not
+// through `ResultReader`: its purpose is the on-disk HDF5 layout itself
+// (dtypes, shapes, group attributes, a killed process's file), checked
+// independently of the reader so that a mistake shared by the writer and the
+// reader cannot hide. It is why `hdf5` stays a dev-dependency of flexmech.
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};

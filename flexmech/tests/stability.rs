@@ -4,6 +4,7 @@
 //! `warnings` attribute) instead of completing silently on the unstable
 //! branch. Checked against a published buckling load and an analytic one.
 
+use crate::common::{read, read_integers, reader};
 use flexmech::model::{load_model, parse_model};
 use flexmech::results::run_model;
 use std::path::{Path, PathBuf};
@@ -14,24 +15,8 @@ fn data(path: &str) -> PathBuf {
         .join(path)
 }
 
-fn read<T: hdf5::H5Type>(file: &Path, dataset: &str) -> Vec<T> {
-    hdf5::File::open(file)
-        .unwrap()
-        .dataset(dataset)
-        .unwrap()
-        .read_raw()
-        .unwrap()
-}
-
 fn warnings_attr(file: &Path) -> String {
-    let f = hdf5::File::open(file).unwrap();
-    f.attr("warnings")
-        .map(|a| {
-            a.read_scalar::<hdf5::types::VarLenUnicode>()
-                .unwrap()
-                .to_string()
-        })
-        .unwrap_or_default()
+    reader(file).string_attr("warnings").unwrap_or_default()
 }
 
 /// The load at which the count first turns non-zero, bracketed by the last
@@ -54,11 +39,11 @@ fn the_argyris_frame_reports_lateral_buckling_at_the_published_load() {
     let dir = tempfile::tempdir().unwrap();
     let summary = run_model(&model, dir.path()).unwrap();
     let p_max = 1.1;
-    let loads: Vec<f64> = read::<f64>(&summary.file, "/time")
+    let loads: Vec<f64> = read(&summary.file, "/time")
         .iter()
         .map(|l| l * p_max)
         .collect();
-    let counts: Vec<i64> = read(&summary.file, "/solver/negative_pivots");
+    let counts: Vec<i64> = read_integers(&summary.file, "/solver/negative_pivots");
     assert_eq!(counts.len(), loads.len());
     let (stable, unstable, count) = bracket(&loads, &counts);
     const PUBLISHED: f64 = 1.088;
@@ -115,11 +100,11 @@ fn an_euler_column_turns_unstable_at_its_critical_load() {
     let dir = tempfile::tempdir().unwrap();
     let model = parse_model(&column(3.0, 60), Path::new("column.toml")).unwrap();
     let summary = run_model(&model, dir.path()).unwrap();
-    let loads: Vec<f64> = read::<f64>(&summary.file, "/time")
+    let loads: Vec<f64> = read(&summary.file, "/time")
         .iter()
         .map(|l| l * 3.0)
         .collect();
-    let counts: Vec<i64> = read(&summary.file, "/solver/negative_pivots");
+    let counts: Vec<i64> = read_integers(&summary.file, "/solver/negative_pivots");
     let (stable, unstable, count) = bracket(&loads, &counts);
     assert!(
         stable < p_cr * 1.005 && p_cr <= unstable,
@@ -130,7 +115,7 @@ fn an_euler_column_turns_unstable_at_its_critical_load() {
     // Below P_cr: stable all the way, no warning.
     let model = parse_model(&column(2.3, 10), Path::new("column.toml")).unwrap();
     let summary = run_model(&model, dir.path()).unwrap();
-    let counts: Vec<i64> = read(&summary.file, "/solver/negative_pivots");
+    let counts: Vec<i64> = read_integers(&summary.file, "/solver/negative_pivots");
     assert!(counts.iter().all(|&c| c == 0), "{counts:?}");
     assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
     assert_eq!(warnings_attr(&summary.file), "");
@@ -144,7 +129,7 @@ fn a_dead_end_moment_writes_the_count_without_a_stability_claim() {
     let model = load_model(&data("benchmarks/rollup_linear.toml")).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let summary = run_model(&model, dir.path()).unwrap();
-    let counts: Vec<i64> = read(&summary.file, "/solver/negative_pivots");
+    let counts: Vec<i64> = read_integers(&summary.file, "/solver/negative_pivots");
     assert_eq!(counts.len(), summary.written);
     assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
 }
@@ -158,6 +143,5 @@ fn dynamic_runs_have_no_stability_count() {
     }
     let dir = tempfile::tempdir().unwrap();
     let summary = run_model(&model, dir.path()).unwrap();
-    let f = hdf5::File::open(&summary.file).unwrap();
-    assert!(f.dataset("/solver/negative_pivots").is_err());
+    assert!(!reader(&summary.file).has("/solver/negative_pivots"));
 }

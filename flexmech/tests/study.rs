@@ -1,13 +1,13 @@
 //! `flexmech study`: parameter sweeps over a model file, run whole or in
 //! shards and merged, with their summary files and their errors.
 
+use crate::common::{read, read_counts, read_strings, reader, string_attr};
 use flexmech::joints::Screw;
 use flexmech::studies::merge::MergeError;
 use flexmech::studies::{
     load_study, merge_study, parse_study, run_study, select_shard, Shard, ShardError, SlurmArray,
     StudyError, StudyOptions, StudyReport, StudySpec,
 };
-use hdf5::types::VarLenUnicode;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -91,27 +91,6 @@ fn csv_rows(file: &Path) -> (Vec<String>, Vec<Vec<String>>) {
     (header, rows)
 }
 
-fn read_f64(file: &Path, dataset: &str) -> Vec<f64> {
-    hdf5::File::open(file)
-        .unwrap()
-        .dataset(dataset)
-        .unwrap()
-        .read_raw()
-        .unwrap()
-}
-
-fn read_strings(file: &Path, dataset: &str) -> Vec<String> {
-    hdf5::File::open(file)
-        .unwrap()
-        .dataset(dataset)
-        .unwrap()
-        .read_raw::<VarLenUnicode>()
-        .unwrap()
-        .iter()
-        .map(|s| s.as_str().to_owned())
-        .collect()
-}
-
 fn column(header: &[String], name: &str) -> usize {
     header.iter().position(|h| h == name).unwrap()
 }
@@ -152,13 +131,11 @@ fn runs_follow_grid_order_with_the_last_key_fastest() {
     // Each run's result file really holds its values.
     for r in &rows {
         let file = report.dir.join("runs").join(format!("{}.h5", r[0]));
-        let h5 = hdf5::File::open(&file).unwrap();
-        let integrator: VarLenUnicode = h5.attr("integrator").unwrap().read_scalar().unwrap();
-        assert_eq!(integrator.as_str(), r[2]);
-        let dt = read_f64(&file, "/solver/dt");
+        assert_eq!(string_attr(&file, "integrator"), r[2]);
+        let dt = read(&file, "/solver/dt");
         let want: f64 = r[1].parse().unwrap();
         assert!(dt[1..].iter().all(|&d| (d - want).abs() < 1e-12), "{dt:?}");
-        let t = read_f64(&file, "/time");
+        let t = read(&file, "/time");
         assert!((t.last().unwrap() - 0.4).abs() < 1e-12, "{t:?}");
     }
     assert_eq!(spec.grid.len(), 3);
@@ -174,21 +151,16 @@ fn figures_are_read_from_the_run_files() {
         assert_eq!(r[column(&header, "status")], "completed");
 
         // Newton iterations: the sum of the per-step counts.
-        let h5 = hdf5::File::open(&file).unwrap();
-        let its: Vec<u64> = h5
-            .dataset("/solver/iterations")
-            .unwrap()
-            .read_raw()
-            .unwrap();
+        let its = read_counts(&file, "/solver/iterations");
         assert_eq!(num("newton_iterations"), its.iter().sum::<u64>() as f64);
         assert!(num("newton_iterations") > 0.0);
 
         // Energy drift relative to the energy the run starts with or is
         // given by its drivers (the model starts in motion: E(0) > 0).
-        let e = read_f64(&file, "/energy/total");
-        let w = read_f64(&file, "/energy/driver_work");
-        let k = read_f64(&file, "/energy/kinetic");
-        let u = read_f64(&file, "/energy/strain");
+        let e = read(&file, "/energy/total");
+        let w = read(&file, "/energy/driver_work");
+        let k = read(&file, "/energy/kinetic");
+        let u = read(&file, "/energy/strain");
         let c: Vec<f64> = e.iter().zip(&w).map(|(e, w)| e - w).collect();
         let worst = c.iter().map(|v| (v - c[0]).abs()).fold(0.0, f64::max);
         let scale = w
@@ -208,7 +180,7 @@ fn figures_are_read_from_the_run_files() {
         // Largest displacement of the three tracked nodes.
         let mut largest = 0.0f64;
         for label in ["rod.start", "rod.end", "rod.5"] {
-            let d = read_f64(&file, &format!("/nodes/{label}/displacement"));
+            let d = read(&file, &format!("/nodes/{label}/displacement"));
             for p in d.chunks(3) {
                 largest = largest.max((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt());
             }
@@ -217,7 +189,7 @@ fn figures_are_read_from_the_run_files() {
         assert_eq!(num("max_displacement"), largest);
 
         assert!(num("failure_time").is_nan());
-        let wall: f64 = h5.attr("wall_time_s").unwrap().read_scalar().unwrap();
+        let wall = reader(&file).f64_attr("wall_time_s").unwrap();
         assert_eq!(num("wall_time"), wall);
     }
 }
@@ -226,21 +198,18 @@ fn figures_are_read_from_the_run_files() {
 fn summary_h5_has_one_dataset_per_column() {
     let (spec, report) = unsharded();
     let (header, rows) = csv_rows(&report.csv);
-    let h5 = hdf5::File::open(&report.h5).unwrap();
-    let study: VarLenUnicode = h5.attr("study").unwrap().read_scalar().unwrap();
-    assert_eq!(study.as_str(), spec.text);
-    let columns: Vec<VarLenUnicode> = h5.attr("columns").unwrap().read_raw().unwrap();
-    let columns: Vec<&str> = columns.iter().map(|c| c.as_str()).collect();
+    let h5 = reader(&report.h5);
+    assert_eq!(string_attr(&report.h5, "study"), spec.text);
+    let columns = h5.string_list_attr("columns").unwrap();
     assert_eq!(columns, header);
     for (j, name) in header.iter().enumerate() {
-        let ds = h5.dataset(name).unwrap();
-        assert_eq!(ds.shape(), [rows.len()], "{name}");
+        assert_eq!(h5.shape(name).unwrap(), [rows.len()], "{name}");
         if ["run", "solver.integrator", "status"].contains(&name.as_str()) {
             let got = read_strings(&report.h5, name);
             let want: Vec<&str> = rows.iter().map(|r| r[j].as_str()).collect();
             assert_eq!(got, want);
         } else {
-            let got = read_f64(&report.h5, name);
+            let got = read(&report.h5, name);
             for (g, r) in got.iter().zip(&rows) {
                 let want: f64 = r[j].parse().unwrap();
                 assert!(g.to_bits() == want.to_bits() || (g.is_nan() && want.is_nan()));
@@ -289,13 +258,7 @@ fn shards_then_merge_give_the_unsharded_summary() {
             ["run-0001", "run-0003"]
         };
         assert_eq!(ids, want);
-        let shard: VarLenUnicode = hdf5::File::open(&report.h5)
-            .unwrap()
-            .attr("shard")
-            .unwrap()
-            .read_scalar()
-            .unwrap();
-        assert_eq!(shard.as_str(), format!("{k}/2"));
+        assert_eq!(string_attr(&report.h5, "shard"), format!("{k}/2"));
     }
     assert!(!dir.join("summary.csv").exists());
 
@@ -423,16 +386,10 @@ figures = ["failure_time", "newton_iterations"]
     assert_eq!(rows[1][status], "completed");
     // The failed run's file is valid and ends at its last converged time.
     let run0 = report.dir.join("runs/run-0000.h5");
-    let t = read_f64(&run0, "/time");
+    let t = read(&run0, "/time");
     assert_eq!(rows[0][failure].parse::<f64>().unwrap(), *t.last().unwrap());
     assert!(rows[1][failure].parse::<f64>().unwrap().is_nan());
-    let st: VarLenUnicode = hdf5::File::open(&run0)
-        .unwrap()
-        .attr("status")
-        .unwrap()
-        .read_scalar()
-        .unwrap();
-    assert_eq!(st.as_str(), rows[0][status]);
+    assert_eq!(string_attr(&run0, "status"), rows[0][status]);
     // A chart for failure_time now exists: one run failed.
     assert!(report.dir.join("charts/failure_time.png").is_file());
 }

@@ -1,7 +1,9 @@
 //! Reading result files back: the other half of the contract the
 //! [`ResultWriter`](super::ResultWriter) writes (docs/MODEL_FORMAT.md). `plot`,
 //! studies and `reproduce` read through it, so a quantity derived from a
-//! result (the energy drift) has one definition.
+//! result (the energy drift) has one definition. It hands out arrays, strings
+//! and numbers — never HDF5 handles — so its callers need not name `hdf5`;
+//! a [table](super::table) (`summary.h5`) reads through it too.
 //!
 //! ```no_run
 //! use flexmech_results::ResultReader;
@@ -130,6 +132,17 @@ impl ResultReader {
         Ok(self.status()?.starts_with(layout::STATUS_FAILED_PREFIX))
     }
 
+    /// A root attribute holding a list of strings (a table's `columns`), if
+    /// present; a scalar string attribute is a list of one.
+    pub fn string_list_attr(&self, name: &str) -> Option<Vec<String>> {
+        let list = self
+            .file
+            .attr(name)
+            .and_then(|a| a.read_raw::<VarLenUnicode>())
+            .ok()?;
+        Some(list.iter().map(|s| s.as_str().to_owned()).collect())
+    }
+
     /// A numeric root attribute, if the file has it.
     pub fn f64_attr(&self, name: &str) -> Option<f64> {
         self.file
@@ -157,8 +170,9 @@ impl ResultReader {
     }
 
     /// The dataset at the absolute path `name`; if there is none, the error
-    /// lists the datasets below the nearest existing group.
-    pub fn dataset(&self, name: &str) -> Result<hdf5::Dataset, ReadError> {
+    /// lists the datasets below the nearest existing group. Private: the
+    /// reader hands out arrays, never HDF5 handles.
+    fn dataset(&self, name: &str) -> Result<hdf5::Dataset, ReadError> {
         let parts: Vec<&str> = name.split('/').filter(|p| !p.is_empty()).collect();
         let mut group = self
             .file
@@ -211,18 +225,29 @@ impl ResultReader {
         Ok(self.dataset(name)?.shape())
     }
 
+    /// Dataset `name` read as `T`, flattened in row-major order: the one
+    /// read behind [`values`](Self::values), [`counts`](Self::counts),
+    /// [`integers`](Self::integers) and [`strings`](Self::strings).
+    fn read_raw<T: hdf5::H5Type>(&self, name: &str) -> Result<Vec<T>, ReadError> {
+        self.dataset(name)?
+            .read_raw::<T>()
+            .map_err(self.hdf5(format!("reading {name}")))
+    }
+
     /// Dataset `name` as `f64`, flattened in row-major order.
     pub fn values(&self, name: &str) -> Result<Vec<f64>, ReadError> {
-        self.dataset(name)?
-            .read_raw::<f64>()
-            .map_err(self.hdf5(format!("reading {name}")))
+        self.read_raw(name)
     }
 
     /// Dataset `name` as unsigned counts (`/solver/iterations`, ...).
     pub fn counts(&self, name: &str) -> Result<Vec<u64>, ReadError> {
-        self.dataset(name)?
-            .read_raw::<u64>()
-            .map_err(self.hdf5(format!("reading {name}")))
+        self.read_raw(name)
+    }
+
+    /// Dataset `name` as signed integers (`/solver/negative_pivots`, where
+    /// −1 means undefined).
+    pub fn integers(&self, name: &str) -> Result<Vec<i64>, ReadError> {
+        self.read_raw(name)
     }
 
     /// A T×3 dataset as rows.
@@ -268,9 +293,7 @@ impl ResultReader {
     /// A dataset of strings (`/mesh/beam_names`, ...).
     pub fn strings(&self, name: &str) -> Result<Vec<String>, ReadError> {
         Ok(self
-            .dataset(name)?
-            .read_raw::<VarLenUnicode>()
-            .map_err(self.hdf5(format!("reading {name}")))?
+            .read_raw::<VarLenUnicode>(name)?
             .into_iter()
             .map(|s| s.as_str().to_owned())
             .collect())

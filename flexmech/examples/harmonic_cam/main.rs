@@ -91,7 +91,7 @@ mod tests {
     use super::*;
     use flexmech::cli::run_with;
     use flexmech::model::parse_model_with;
-    use flexmech::results::run_model;
+    use flexmech::results::{run_model, ResultReader};
     use nalgebra::Rotation3;
     use std::path::{Path, PathBuf};
     use std::process::ExitCode;
@@ -103,8 +103,7 @@ mod tests {
     }
 
     fn read(file: &Path, dataset: &str) -> Vec<f64> {
-        let f = hdf5::File::open(file).unwrap();
-        f.dataset(dataset).unwrap().read_raw::<f64>().unwrap()
+        ResultReader::open(file).unwrap().values(dataset).unwrap()
     }
 
     /// Both runs stop Newton at a residual of 1e-10 of the force scale, so

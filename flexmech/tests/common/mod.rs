@@ -1,7 +1,10 @@
 //! Helpers the integration tests share: model paths, result datasets and
+//! attributes (read through [`ResultReader`], not the HDF5 library) and
 //! the drift of a conserved series. (Each test crate uses a subset.)
 
 use std::path::{Path, PathBuf};
+
+use flexmech::results::ResultReader;
 
 /// A path under the repository's `data/`.
 pub fn data(rel: &str) -> PathBuf {
@@ -10,14 +13,44 @@ pub fn data(rel: &str) -> PathBuf {
         .join(rel)
 }
 
-/// A whole dataset of a result file, flattened.
-pub fn read<T: hdf5::H5Type>(file: &Path, dataset: &str) -> Vec<T> {
-    hdf5::File::open(file)
-        .unwrap()
-        .dataset(dataset)
-        .unwrap()
-        .read_raw()
-        .unwrap()
+/// A result file (or study summary) opened for reading.
+pub fn reader(file: &Path) -> ResultReader {
+    ResultReader::open(file).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A whole `f64` dataset of a result file, flattened.
+pub fn read(file: &Path, dataset: &str) -> Vec<f64> {
+    reader(file)
+        .values(dataset)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A whole `u64` dataset of a result file (`/solver/iterations`, ...).
+pub fn read_counts(file: &Path, dataset: &str) -> Vec<u64> {
+    reader(file)
+        .counts(dataset)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A whole `i64` dataset of a result file (`/solver/negative_pivots`).
+pub fn read_integers(file: &Path, dataset: &str) -> Vec<i64> {
+    reader(file)
+        .integers(dataset)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A whole string dataset of a result file or summary.
+pub fn read_strings(file: &Path, dataset: &str) -> Vec<String> {
+    reader(file)
+        .strings(dataset)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A string root attribute of a result file or summary (panics when absent).
+pub fn string_attr(file: &Path, name: &str) -> String {
+    reader(file)
+        .string_attr(name)
+        .unwrap_or_else(|| panic!("{}: no string attribute {name}", file.display()))
 }
 
 /// Largest change of a conserved series (rows of `width`) from its first
