@@ -14,6 +14,9 @@ pub use std::path::Path;
 #[cfg(feature = "plot")]
 pub use flexmech_plot::charts::{LineChart, Series};
 #[cfg(feature = "hdf5")]
-pub use flexmech_results::{restart_model, run_model, ResultReader, RunError, RunSummary};
+pub use flexmech_results::{
+    restart_model, run, run_model, FileSink, Memory, OnStep, ResultReader, RunError, RunSummary,
+    Sink,
+};
 #[cfg(feature = "studies")]
 pub use flexmech_studies::{Component, DatasetFigure, Figure, Reduce, Study, StudyReport};

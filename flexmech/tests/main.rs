@@ -38,6 +38,7 @@ mod resultants;
 mod results_file;
 mod rigid_bodies;
 mod rust_study;
+mod sinks;
 mod slider_crank;
 mod stability;
 mod study;

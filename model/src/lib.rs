@@ -22,6 +22,7 @@ pub mod build;
 mod check;
 pub mod error;
 pub mod expr;
+mod fluent;
 mod initial_check;
 mod labels;
 mod locate;
@@ -30,10 +31,12 @@ pub mod registry;
 pub mod time_function;
 pub mod types;
 mod validate;
+mod write;
 
 pub use build::{build, Built};
 pub use error::ModelError;
 pub use expr::{ExprError, Expression};
+pub use fluent::ModelBuilder;
 pub use registry::{JointKind, JointRegistry, RegistryError};
 pub use types::*;
 

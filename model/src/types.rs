@@ -304,7 +304,10 @@ pub struct Model {
     pub name: String,
     /// The file the model came from (for error messages).
     pub path: PathBuf,
-    /// The TOML text, stored verbatim in result files.
+    /// The TOML text, stored verbatim in result files; empty for a model
+    /// built in Rust, whose result files store [`Model::to_toml`] instead.
+    /// After changing a loaded model in Rust, set it to `model.to_toml()`
+    /// (or clear it) so that result files record what ran.
     pub source_text: String,
     /// Gravity acceleration (acts on ρA).
     pub gravity: [f64; 3],

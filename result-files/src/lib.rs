@@ -94,6 +94,7 @@ pub mod reader;
 pub mod restart;
 pub mod resultants;
 pub mod run;
+pub mod sink;
 pub mod table;
 mod writer;
 
@@ -102,5 +103,6 @@ pub use mesh::MeshMeta;
 pub use reader::{EnergyDrift, ReadError, ResultReader};
 pub use restart::{read_checkpoint, RestartError};
 pub use resultants::ResultantsMeta;
-pub use run::{restart_model, run_model, run_model_to, RunError, RunSummary};
+pub use run::{restart_model, run, run_model, run_model_to, RunError, RunSummary};
+pub use sink::{FileSink, Memory, OnStep, RunEnd, Sink, SinkError};
 pub use writer::{rotation_vector, ResultError, ResultWriter, RunMeta};

@@ -1,11 +1,12 @@
-//! Running one model: build it, solve it, stream every kept step into its
-//! HDF5 result file. A run that fails part-way still leaves a valid file with
-//! `status = "failed: …"` and every step computed before the failure.
+//! Running one model: build it, solve it, stream every kept step into a
+//! [`Sink`] — its HDF5 result file ([`run_model`], [`FileSink`]), memory or
+//! a closure ([`run`]). A run that fails part-way still leaves its sink
+//! every step computed before the failure and `status = "failed: …"`.
 
 use crate::checks::{Balance, Stability};
+use crate::sink::{FileSink, OutputDirError, RunEnd, Sink, SinkError};
 use crate::{
-    layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultWriter,
-    ResultantsMeta, RunMeta,
+    layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultantsMeta, RunMeta,
 };
 use flexmech_integrators::arc_length::{solve_arc_length, ArcLengthSettings};
 use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
@@ -35,6 +36,9 @@ pub enum RunError {
     /// Writing the result file failed.
     #[error(transparent)]
     Result(#[from] ResultError),
+    /// Another sink refused a step or the end.
+    #[error("the run's sink failed: {0}")]
+    Sink(SinkError),
     /// Two models of one `flexmech run` have the same `name`: the second
     /// would overwrite the first's result file, so it is refused.
     #[error(
@@ -135,9 +139,29 @@ impl std::fmt::Display for RunSummary {
 
 pub use crate::checks::ENERGY_BALANCE_WARNING;
 
-/// Keeps every `every`-th step and always the last one.
-struct Sink<'a> {
-    writer: ResultWriter,
+impl RunError {
+    /// A sink's error as a run error: a result file's and an output
+    /// directory's keep their own variants.
+    fn from_sink(e: SinkError) -> Self {
+        let e = match e.downcast::<ResultError>() {
+            Ok(r) => return Self::Result(*r),
+            Err(e) => e,
+        };
+        match e.downcast::<OutputDirError>() {
+            Ok(d) => Self::OutputDir {
+                dir: d.dir,
+                source: d.source,
+            },
+            Err(e) => Self::Sink(e),
+        }
+    }
+}
+
+/// Between the solver and the sink: keeps every `every`-th step and always
+/// the last one, and watches every converged step (energy balance,
+/// stability, figures of merit).
+struct Keeper<'a> {
+    sink: &'a mut dyn Sink,
     mech: &'a Mechanism,
     /// The energy balance, for dynamic runs.
     balance: Option<Balance>,
@@ -148,12 +172,13 @@ struct Sink<'a> {
     every: usize,
     count: usize,
     iterations: usize,
+    written: usize,
     pending: Option<StepRecord>,
-    error: Option<ResultError>,
+    error: Option<SinkError>,
 }
 
-impl Sink<'_> {
-    /// Takes a step's record; returns whether it was written now.
+impl Keeper<'_> {
+    /// Takes a step's record; returns whether it was handed to the sink now.
     fn push(&mut self, step: &StepRecord) -> bool {
         if let Some(b) = &mut self.balance {
             b.push(self.mech, step);
@@ -169,34 +194,53 @@ impl Sink<'_> {
         }
         if self.count.is_multiple_of(self.every) {
             self.pending = None;
-            if let Err(e) = self.writer.append(step) {
-                self.error = Some(e);
-            }
-            self.error.is_none()
+            self.give(step)
         } else {
             self.pending = Some(step.clone());
             false
         }
     }
 
-    /// Writes the last record if it is still pending; returns whether it did.
-    fn flush_last(&mut self) -> bool {
-        if let (Some(step), None) = (self.pending.take(), &self.error) {
-            if let Err(e) = self.writer.append(&step) {
-                self.error = Some(e);
+    /// Hands `step` to the sink; returns whether it took it.
+    fn give(&mut self, step: &StepRecord) -> bool {
+        match self.sink.step(step) {
+            Ok(()) => {
+                self.written += 1;
+                true
             }
-            return self.error.is_none();
+            Err(e) => {
+                self.error = Some(e);
+                false
+            }
         }
-        false
     }
 
-    /// Rewrites the file's restart state with the simulation's.
+    /// Hands the last record over if it is still pending; returns whether
+    /// it did.
+    fn flush_last(&mut self) -> bool {
+        match (self.pending.take(), &self.error) {
+            (Some(step), None) => self.give(&step),
+            _ => false,
+        }
+    }
+
+    /// Hands the simulation's restart state to the sink.
     fn checkpoint(&mut self, sim: &Simulation<'_>) {
         if self.error.is_none() {
-            if let Err(e) = self.writer.checkpoint(&sim.checkpoint()) {
+            if let Err(e) = self.sink.checkpoint(&sim.checkpoint()) {
                 self.error = Some(e);
             }
         }
+    }
+
+    /// The warnings of a completed run's checks.
+    fn warnings(&self) -> Vec<String> {
+        self.balance
+            .as_ref()
+            .and_then(Balance::warning)
+            .into_iter()
+            .chain(self.stability.as_ref().and_then(Stability::warning))
+            .collect()
     }
 }
 
@@ -235,9 +279,32 @@ pub fn run_model(model: &Model, out_dir: &Path) -> Result<RunSummary, RunError> 
 }
 
 /// Runs `model` and writes its results to `file` (parent directories are
-/// created).
+/// created); with `[output] vtk = true`, its ParaView series beside it.
 pub fn run_model_to(model: &Model, file: &Path) -> Result<RunSummary, RunError> {
-    run(model, file, None)
+    with_vtk(model, run_with(model, &mut FileSink::new(file), None))
+}
+
+/// Runs `model` into `sink` ([`crate::Memory`], [`crate::OnStep`],
+/// [`FileSink`] or a sink of your own). [`RunSummary::file`] is the sink's
+/// file, if it writes one.
+pub fn run(model: &Model, sink: &mut dyn Sink) -> Result<RunSummary, RunError> {
+    run_with(model, sink, None)
+}
+
+/// After a completed run into a file: the ParaView series the model asks
+/// for (`[output] vtk = true`), written next to it.
+fn with_vtk(model: &Model, summary: Result<RunSummary, RunError>) -> Result<RunSummary, RunError> {
+    let mut summary = summary?;
+    if model.output.vtk {
+        let dir = summary
+            .file
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."))
+            .to_path_buf();
+        summary.vtk = Some(crate::export::export_vtk(&summary.file, &dir, None)?);
+    }
+    Ok(summary)
 }
 
 /// Relative distance between a node's initial position in the model and in
@@ -305,34 +372,26 @@ pub fn restart_model(model: &Model, result: &Path, out_dir: &Path) -> Result<Run
             [here[i].x, here[i].y, here[i].z]
         )));
     }
-    run(model, &file, Some((&checkpoint, result)))
+    let mut sink = FileSink::new(&file).restarted_from(result, checkpoint.time);
+    with_vtk(model, run_with(model, &mut sink, Some(&checkpoint)))
 }
 
-fn run(
-    model: &Model,
-    file: &Path,
-    restart_from: Option<(&Checkpoint, &Path)>,
-) -> Result<RunSummary, RunError> {
-    let restart = restart_from.map(|(c, _)| c);
-    let built: Built = build(model)?;
-    let out_dir = file
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(out_dir).map_err(|source| RunError::OutputDir {
-        dir: out_dir.to_path_buf(),
-        source,
-    })?;
-    let file = file.to_path_buf();
+/// What a run of `model` is, for its sink: labels, nodes, joints, mesh.
+fn run_meta(model: &Model, built: &Built) -> RunMeta {
     let mech = &built.mechanism;
-    let mesh = mesh_meta(model, &built);
+    let mesh = mesh_meta(model, built);
     let supports = mech
         .supported_nodes()
         .into_iter()
         .map(|n| mesh.node_labels[n].clone())
         .collect();
-    let meta = RunMeta {
-        model_text: model.source_text.clone(),
+    RunMeta {
+        // A model built in Rust has no text: the model writer's.
+        model_text: if model.source_text.is_empty() {
+            model.to_toml()
+        } else {
+            model.source_text.clone()
+        },
         integrator: match model.solver.analysis {
             Analysis::Static { .. } | Analysis::ArcLength { .. } => "static".to_string(),
             Analysis::Dynamic { integrator, .. } => integrator.name().to_string(),
@@ -369,11 +428,19 @@ fn run(
                 .map(|(b, e)| (b.name.clone(), e.clone()))
                 .collect(),
         }),
-    };
-    let mut writer = ResultWriter::create(&file, &meta)?;
-    if let Some((c, from)) = restart_from {
-        writer.restarted_from(from, c.time)?;
     }
+}
+
+/// Builds `model`, hands its description to `sink`, solves it (from
+/// `restart` when given) handing over the kept steps, and ends the sink.
+fn run_with(
+    model: &Model,
+    sink: &mut dyn Sink,
+    restart: Option<&Checkpoint>,
+) -> Result<RunSummary, RunError> {
+    let built: Built = build(model)?;
+    let meta = run_meta(model, &built);
+    sink.begin(&meta).map_err(RunError::from_sink)?;
     let dynamic = matches!(model.solver.analysis, Analysis::Dynamic { .. });
     let dissipative = matches!(
         model.solver.analysis,
@@ -382,9 +449,9 @@ fn run(
             ..
         }
     );
-    let mut sink = Sink {
-        writer,
-        mech,
+    let mut keeper = Keeper {
+        sink,
+        mech: &built.mechanism,
         balance: dynamic.then(|| Balance::new(dissipative)),
         stability: (!dynamic).then(|| Stability::new(conservative(model))),
         merit: Merit::new(
@@ -396,22 +463,40 @@ fn run(
         every: model.output.every.max(1),
         count: 0,
         iterations: 0,
+        written: 0,
         pending: None,
         error: None,
     };
     let start = Instant::now();
-    let mut setup = 0.0;
-    let outcome = match model.solver.analysis {
+    let (outcome, setup) = solve(model, &built, restart, &mut keeper, start);
+    let wall = start.elapsed().as_secs_f64();
+    keeper.flush_last();
+    end(model, &built, keeper, outcome, wall, setup)
+}
+
+/// Solves `model` with its analysis, handing every converged step to
+/// `keeper`; returns the outcome and the set-up time of a dynamic run.
+fn solve(
+    model: &Model,
+    built: &Built,
+    restart: Option<&Checkpoint>,
+    keeper: &mut Keeper<'_>,
+    start: Instant,
+) -> (Result<(), SolveError>, f64) {
+    let mech = &built.mechanism;
+    let newton = static_newton(model);
+    let max_halvings = model.solver.max_halvings;
+    match model.solver.analysis {
         Analysis::Static { load_steps } => {
             let settings = StaticSettings {
                 load_steps,
-                newton: static_newton(model),
-                max_halvings: model.solver.max_halvings,
+                newton,
+                max_halvings,
             };
-            solve_static(mech, &settings, |s| {
-                sink.push(s);
-            })
-            .map(|_| ())
+            let outcome = solve_static(mech, &settings, |s| {
+                keeper.push(s);
+            });
+            (outcome.map(|_| ()), 0.0)
         }
         Analysis::ArcLength {
             load_steps,
@@ -420,110 +505,132 @@ fn run(
         } => {
             let settings = ArcLengthSettings {
                 load_steps,
-                newton: static_newton(model),
-                max_halvings: model.solver.max_halvings,
+                newton,
+                max_halvings,
                 max_steps,
                 branch_switch,
             };
-            solve_arc_length(mech, &settings, |s| {
-                sink.push(s);
-            })
-            .map(|_| ())
+            let outcome = solve_arc_length(mech, &settings, |s| {
+                keeper.push(s);
+            });
+            (outcome.map(|_| ()), 0.0)
         }
         Analysis::Dynamic {
             integrator,
             dt,
             t_end,
-        } => {
-            let settings = DynamicSettings {
-                dt,
-                t_end,
-                newton: NewtonSettings {
-                    tolerance: model.solver.tolerance,
-                    max_iterations: model.solver.max_iterations,
-                    modified: model.solver.modified_newton,
-                    exact_tangent: model.solver.exact_tangent,
-                },
-                max_halvings: model.solver.max_halvings,
-                mass: model.solver.mass,
-            };
-            let sim = match restart {
-                Some(c) => Simulation::resume(mech, integrator, &settings, c),
-                None => Simulation::new(mech, integrator, &settings, &built.motion),
-            };
-            sim.and_then(|mut sim| {
-                if sink.push(&sim.record()) {
-                    sink.checkpoint(&sim);
+        } => solve_dynamic(
+            model,
+            built,
+            restart,
+            keeper,
+            start,
+            (integrator, dt, t_end),
+        ),
+    }
+}
+
+/// The time steps of a dynamic run, each kept one followed by its restart
+/// state; returns the outcome and the set-up time (before the first step).
+fn solve_dynamic(
+    model: &Model,
+    built: &Built,
+    restart: Option<&Checkpoint>,
+    keeper: &mut Keeper<'_>,
+    start: Instant,
+    (integrator, dt, t_end): (IntegratorKind, f64, f64),
+) -> (Result<(), SolveError>, f64) {
+    let mech = &built.mechanism;
+    let settings = DynamicSettings {
+        dt,
+        t_end,
+        newton: NewtonSettings {
+            tolerance: model.solver.tolerance,
+            max_iterations: model.solver.max_iterations,
+            modified: model.solver.modified_newton,
+            exact_tangent: model.solver.exact_tangent,
+        },
+        max_halvings: model.solver.max_halvings,
+        mass: model.solver.mass,
+    };
+    let sim = match restart {
+        Some(c) => Simulation::resume(mech, integrator, &settings, c),
+        None => Simulation::new(mech, integrator, &settings, &built.motion),
+    };
+    let mut sim = match sim {
+        Ok(sim) => sim,
+        Err(e) => return (Err(e), 0.0),
+    };
+    if keeper.push(&sim.record()) {
+        keeper.checkpoint(&sim);
+    }
+    let setup = start.elapsed().as_secs_f64();
+    let outcome = loop {
+        match sim.step() {
+            Ok(Some(record)) => {
+                if keeper.push(&record) {
+                    keeper.checkpoint(&sim);
                 }
-                setup = start.elapsed().as_secs_f64();
-                let outcome = loop {
-                    match sim.step() {
-                        Ok(Some(record)) => {
-                            if sink.push(&record) {
-                                sink.checkpoint(&sim);
-                            }
-                        }
-                        Ok(None) => break Ok(()),
-                        Err(e) => break Err(e),
-                    }
-                };
-                // The last converged state, also after a failure.
-                if sink.flush_last() {
-                    sink.checkpoint(&sim);
-                }
-                outcome
-            })
+            }
+            Ok(None) => break Ok(()),
+            Err(e) => break Err(e),
         }
     };
-    let wall = start.elapsed().as_secs_f64();
-    sink.flush_last();
-    if sink.error.is_none() {
-        if let Err(e) = sink.writer.figures(&sink.merit) {
-            sink.error = Some(e);
-        }
+    // The last converged state, also after a failure.
+    if keeper.flush_last() {
+        keeper.checkpoint(&sim);
     }
-    if let Some(e) = sink.error.take() {
-        // The file is as valid as HDF5 left it; report the write failure.
-        let _ = sink
-            .writer
-            .finish(&layout::failed_status(&e.to_string()), wall);
-        return Err(e.into());
+    (outcome, setup)
+}
+
+/// Ends the run in its sink: a sink's own failure first, then the solve's
+/// outcome (its errors named in the model's words).
+fn end(
+    model: &Model,
+    built: &Built,
+    keeper: Keeper<'_>,
+    outcome: Result<(), SolveError>,
+    wall: f64,
+    setup: f64,
+) -> Result<RunSummary, RunError> {
+    let warnings = keeper.warnings();
+    let Keeper {
+        sink,
+        merit,
+        error,
+        count,
+        iterations,
+        written,
+        ..
+    } = keeper;
+    if let Some(e) = error {
+        // The sink's record is as complete as it could be made; report it.
+        let status = layout::failed_status(&e.to_string());
+        let _ = sink.finish(&RunEnd::new(status, wall, &merit));
+        return Err(RunError::from_sink(e));
     }
-    let written = sink.writer.steps_written();
+    let file = sink.file().map(Path::to_path_buf).unwrap_or_default();
     match outcome {
         Ok(()) => {
-            let warnings: Vec<String> = sink
-                .balance
-                .as_ref()
-                .and_then(Balance::warning)
-                .into_iter()
-                .chain(sink.stability.as_ref().and_then(Stability::warning))
-                .collect();
-            if !warnings.is_empty() {
-                sink.writer.warn(&warnings.join("; "))?;
-            }
-            let file = sink.writer.finish(layout::STATUS_COMPLETED, wall)?;
-            let vtk = if model.output.vtk {
-                Some(crate::export::export_vtk(&file, out_dir, None)?)
-            } else {
-                None
-            };
+            let mut end = RunEnd::new(layout::STATUS_COMPLETED.into(), wall, &merit);
+            end.warnings = warnings;
+            sink.finish(&end).map_err(RunError::from_sink)?;
             Ok(RunSummary {
                 file,
-                vtk,
-                steps: sink.count,
+                vtk: None,
+                steps: count,
                 written,
-                iterations: sink.iterations,
+                iterations,
                 wall_time_s: wall,
                 setup_time_s: setup,
-                warnings,
+                warnings: end.warnings,
             })
         }
         Err(mut error) => {
-            name_the_beam(model, &built, &mut error);
-            let file = sink
-                .writer
-                .finish(&layout::failed_status(&error.to_string()), wall)?;
+            name_the_beam(model, built, &mut error);
+            let status = layout::failed_status(&error.to_string());
+            sink.finish(&RunEnd::new(status, wall, &merit))
+                .map_err(RunError::from_sink)?;
             Err(RunError::Solve {
                 model: model.name.clone(),
                 path: model.path.clone(),

@@ -54,12 +54,17 @@ impl StudySpec {
 impl Study {
     /// A study named `name` over `base`: grid keys are the model key paths
     /// of study files (`joint.cam.b`, `section.rod.EI[0]`, `solver.dt`), set
-    /// in the model text `base` was read from ([`Model::source_text`]).
+    /// in the model text `base` was read from ([`Model::source_text`]), or,
+    /// for a model built in Rust (no text), in [`Model::to_toml`].
     pub fn over(name: &str, base: &Model) -> Self {
         Self {
             name: name.to_owned(),
             model_file: base.path.clone(),
-            model_text: base.source_text.clone(),
+            model_text: if base.source_text.is_empty() {
+                base.to_toml()
+            } else {
+                base.source_text.clone()
+            },
             grid: Vec::new(),
             figures: Vec::new(),
             joints: JointRegistry::builtin(),
@@ -93,8 +98,7 @@ impl Study {
         self
     }
 
-    /// The checked study: every check of a study file applies, and the base
-    /// model must have come from text (a file or [`flexmech_model::parse_model`]).
+    /// The checked study: every check of a study file applies.
     pub fn spec(&self) -> Result<StudySpec, SpecError> {
         let figures = if self.figures.is_empty() {
             Figure::ALL.to_vec()

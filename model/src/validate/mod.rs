@@ -22,7 +22,7 @@ mod solver;
 type Res<T> = Result<T, ModelError>;
 
 /// DOF names in index order.
-const DOFS: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];
+pub(crate) const DOFS: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];
 const DOF_LIST: &str = "\"ux\", \"uy\", \"uz\", \"rx\", \"ry\", \"rz\"";
 /// |sin| or |cos| below which two directions count as parallel / perpendicular.
 const ANGLE_TOL: f64 = 1e-8;

@@ -1,0 +1,59 @@
+//! A run's sink: memory, a closure or the result file see the same run —
+//! the same kept steps, bit for bit, and the same status.
+
+use flexmech::prelude::*;
+
+use crate::common::data;
+
+#[test]
+fn memory_closure_and_file_sinks_see_the_same_steps() {
+    let text = std::fs::read_to_string(data("paper/cam.toml"))
+        .unwrap()
+        .replace("t_end = 3.0", "t_end = 0.2");
+    let model = parse_model(&text, &data("paper/cam.toml")).unwrap();
+    let mut memory = Memory::default();
+    let summary = run(&model, &mut memory).unwrap();
+    assert_eq!(memory.status(), "completed");
+    assert_eq!(summary.file, Path::new(""));
+    assert_eq!(memory.records.len(), summary.written);
+    assert!(memory.checkpoint.is_some(), "a dynamic run's restart state");
+
+    let mut times = Vec::new();
+    run(
+        &model,
+        &mut OnStep(|r: &flexmech::integrators::StepRecord| times.push(r.time)),
+    )
+    .unwrap();
+    assert_eq!(times, memory.time());
+
+    let out = tempfile::tempdir().unwrap();
+    let file = run_model(&model, out.path()).unwrap().file;
+    let reader = ResultReader::open(&file).unwrap();
+    assert_eq!(reader.time().unwrap(), memory.time());
+    for (label, _) in &memory.meta.tracked {
+        let stored = reader.rows3(&format!("/nodes/{label}/position")).unwrap();
+        assert_eq!(stored, memory.positions(label).unwrap(), "{label}");
+    }
+}
+
+#[test]
+fn a_failed_run_leaves_its_steps_and_status_in_memory() {
+    // A load far past the arm's strength in one step: Newton fails, the
+    // memory holds the initial state and the failure.
+    let text = std::fs::read_to_string(data("paper/screw_driven.toml"))
+        .unwrap()
+        .replace("max_halvings = 8", "max_halvings = 0")
+        .replace("max_iterations = 30", "max_iterations = 1");
+    let model = parse_model(&text, &data("paper/screw_driven.toml")).unwrap();
+    let mut memory = Memory::default();
+    match run(&model, &mut memory) {
+        Err(RunError::Solve { file, .. }) => assert_eq!(file, Path::new("")),
+        other => panic!("expected a failed solve, got {other:?}"),
+    }
+    assert!(
+        memory.status().starts_with("failed: "),
+        "{}",
+        memory.status()
+    );
+    assert!(!memory.records.is_empty());
+}
