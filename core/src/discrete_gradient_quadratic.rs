@@ -119,6 +119,21 @@ fn corrected<T: Scalar>(op: Matrix3<T>, exact: Vector3<T>, d: &Vector3<T>, eps: 
     op + (exact - op * d) * (d / (d.norm_squared() + eps * eps)).transpose()
 }
 
+/// Coordinates of the end nodes at both ends of the step, `[k][i]` for node
+/// `i` at `n` (`k = 0`) and `n+1` (`k = 1`); zero at the frame node.
+type Coordinates<T> = [[Vector3<T>; 3]; 2];
+
+/// The step's frame of a 3-node element: the frame node's triads `Λ_r` at
+/// `n` and `n+1` and their mean `Λ̄_r`, the nodes' Cayley increments `θᵢ`
+/// (`Rᵢ,ₙ₊₁ = cay(θᵢ) Rᵢ,ₙ`), and the regularisation `ε` of the rank-one
+/// corrections.
+struct StepFrame<T: Scalar> {
+    lam_r: [Matrix3<T>; 2],
+    lam_bar: Matrix3<T>,
+    theta: [Vector3<T>; 3],
+    eps: T,
+}
+
 impl BeamElement<3> {
     /// The energy-consistent internal force between the poses at `n` and
     /// `n+1`, ordered `(f₀, m₀, f₁, m₁, f₂, m₂)`; see the module docs. The
@@ -140,21 +155,31 @@ impl BeamElement<3> {
                 .map(|t| t.norm_squared())
                 .fold(T::zero(), |a, b| a + b))
             * cst::<T>(RIGID_STEP);
-        // Objective coordinates at both ends: aᵢ, ψᵢ (ψ_r = 0, a_r = 0).
-        let rel = |k: usize, i: usize| -> (Vector3<T>, Vector3<T>) {
-            let (x, l) = (if k == 0 { &start.0 } else { &end.0 }, &ends[k]);
-            (
-                lam_r[k].transpose() * (x[i] - x[FRAME]),
-                log(&(lam_r[k].transpose() * l[i])),
-            )
+        let (a, psi) = objective_coordinates(start, end, &ends, &lam_r);
+        let (g_a, g_psi) = self.coordinate_forces(start, end, &a, &psi, eps);
+        let frame = StepFrame {
+            lam_r,
+            lam_bar,
+            theta,
+            eps,
         };
-        let mut a = [[Vector3::zeros(); 3]; 2];
-        let mut psi = [[Vector3::zeros(); 3]; 2];
-        for k in 0..2 {
-            for i in ENDS {
-                (a[k][i], psi[k][i]) = rel(k, i);
-            }
-        }
+        nodal_forces(start, end, &frame, &psi, &g_a, &g_psi)
+    }
+
+    /// The forces `(g_a, g_ψ)` conjugate to the increments of the objective
+    /// coordinates `a`, `psi` of the step (`Σ g_aᵢ·Δaᵢ + g_ψᵢ·Δψᵢ = ΔΠ`),
+    /// summed over the Gauss points with the step means `N̄`, `M̄`, `Q̄`, `H̄`
+    /// and the exact operators `K`, `D` (regularised by `eps`) of the module
+    /// docs.
+    fn coordinate_forces<T: Scalar>(
+        &self,
+        start: &Pose3<T>,
+        end: &Pose3<T>,
+        a: &Coordinates<T>,
+        psi: &Coordinates<T>,
+        eps: T,
+    ) -> ([Vector3<T>; 3], [Vector3<T>; 3]) {
+        let half = cst::<T>(0.5);
         // Forces conjugate to the coordinates' increments: Σ g_aᵢ·Δaᵢ + g_ψᵢ·Δψᵢ = ΔΠ.
         let mut g_a = [Vector3::zeros(); 3];
         let mut g_psi = [Vector3::zeros(); 3];
@@ -205,29 +230,79 @@ impl BeamElement<3> {
                 g_psi[i] += on_k * cst::<T>(d[i] * ds) + on_pg * cst::<T>(v[i]);
             }
         }
-        // Nodal forces: Δaᵢ = Λ̄_rᵀ(Δdᵢ + d̄ᵢ × θ_r), Δψᵢ = Tᵢ(θᵢ − θ_r).
-        let mut out = SVector::<T, 18>::zeros();
-        let mut add = |node: usize, row: usize, v: Vector3<T>| {
-            let mut r = out.fixed_rows_mut::<3>(6 * node + row);
-            r += v;
-        };
-        for i in ENDS {
-            let f = lam_bar * g_a[i];
-            let dbar = (end.0[i] - end.0[FRAME] + start.0[i] - start.0[FRAME]) * half;
-            add(i, 0, f);
-            add(FRAME, 0, -f);
-            add(FRAME, 3, f.cross(&dbar));
-            let pair = [theta[FRAME], theta[i]];
-            let (_, tf) = secant_operators(&lam_r[0], &psi[0][i], &psi[1][i], &pair);
-            let (_, tb) = secant_operators(&lam_r[1], &psi[1][i], &psi[0][i], &pair.map(|t| -t));
-            let dtheta = theta[i] - theta[FRAME];
-            let t = corrected((tf + tb) * half, psi[1][i] - psi[0][i], &dtheta, eps);
-            let m = t.transpose() * g_psi[i];
-            add(i, 3, m);
-            add(FRAME, 3, -m);
-        }
-        out
+        (g_a, g_psi)
     }
+}
+
+/// The objective coordinates `(a, ψ)` at both ends of the step:
+/// `aᵢ = Λ_rᵀ(xᵢ − x_r)`, `ψᵢ = log(Λ_rᵀΛᵢ)` of the end nodes, from the
+/// nodes' triads `ends` and the frame node's `lam_r` (`a_r = 0`, `ψ_r = 0`).
+fn objective_coordinates<T: Scalar>(
+    start: &Pose3<T>,
+    end: &Pose3<T>,
+    ends: &[[Matrix3<T>; 3]; 2],
+    lam_r: &[Matrix3<T>; 2],
+) -> (Coordinates<T>, Coordinates<T>) {
+    // Objective coordinates at both ends: aᵢ, ψᵢ (ψ_r = 0, a_r = 0).
+    let rel = |k: usize, i: usize| -> (Vector3<T>, Vector3<T>) {
+        let (x, l) = (if k == 0 { &start.0 } else { &end.0 }, &ends[k]);
+        (
+            lam_r[k].transpose() * (x[i] - x[FRAME]),
+            log(&(lam_r[k].transpose() * l[i])),
+        )
+    };
+    let mut a = [[Vector3::zeros(); 3]; 2];
+    let mut psi = [[Vector3::zeros(); 3]; 2];
+    for k in 0..2 {
+        for i in ENDS {
+            (a[k][i], psi[k][i]) = rel(k, i);
+        }
+    }
+    (a, psi)
+}
+
+/// The nodal forces, ordered `(f₀, m₀, f₁, m₁, f₂, m₂)`, conjugate to the
+/// nodal increments through `Δaᵢ = Λ̄_rᵀ(Δdᵢ + d̄ᵢ × θ_r)` and
+/// `Δψᵢ = Tᵢ(θᵢ − θ_r)` (`Tᵢ` the mean of the 2-node element's secant
+/// operators both ways, corrected to map `θᵢ − θ_r` to `Δψᵢ` exactly), from
+/// the coordinates' forces `g_a`, `g_psi`.
+fn nodal_forces<T: Scalar>(
+    start: &Pose3<T>,
+    end: &Pose3<T>,
+    frame: &StepFrame<T>,
+    psi: &Coordinates<T>,
+    g_a: &[Vector3<T>; 3],
+    g_psi: &[Vector3<T>; 3],
+) -> SVector<T, 18> {
+    let half = cst::<T>(0.5);
+    let StepFrame {
+        lam_r,
+        lam_bar,
+        theta,
+        eps,
+    } = frame;
+    // Nodal forces: Δaᵢ = Λ̄_rᵀ(Δdᵢ + d̄ᵢ × θ_r), Δψᵢ = Tᵢ(θᵢ − θ_r).
+    let mut out = SVector::<T, 18>::zeros();
+    let mut add = |node: usize, row: usize, v: Vector3<T>| {
+        let mut r = out.fixed_rows_mut::<3>(6 * node + row);
+        r += v;
+    };
+    for i in ENDS {
+        let f = lam_bar * g_a[i];
+        let dbar = (end.0[i] - end.0[FRAME] + start.0[i] - start.0[FRAME]) * half;
+        add(i, 0, f);
+        add(FRAME, 0, -f);
+        add(FRAME, 3, f.cross(&dbar));
+        let pair = [theta[FRAME], theta[i]];
+        let (_, tf) = secant_operators(&lam_r[0], &psi[0][i], &psi[1][i], &pair);
+        let (_, tb) = secant_operators(&lam_r[1], &psi[1][i], &psi[0][i], &pair.map(|t| -t));
+        let dtheta = theta[i] - theta[FRAME];
+        let t = corrected((tf + tb) * half, psi[1][i] - psi[0][i], &dtheta, *eps);
+        let m = t.transpose() * g_psi[i];
+        add(i, 3, m);
+        add(FRAME, 3, -m);
+    }
+    out
 }
 
 #[cfg(test)]

@@ -23,17 +23,15 @@
 //! Loads must be proportional — `f(λ) = λ f_ref`: dead loads and gravity
 //! ramped with `λ` — and nothing driven or following: those are refused.
 
-use crate::assembly::Assembler;
-use crate::constraints::{initial_state, Topology};
 use crate::error::{NewtonFailure, SolveError};
 use crate::linsolve::SparseLu;
-use crate::measure::static_record;
 use crate::mechanism::Mechanism;
 use crate::newton::{NewtonReport, NewtonSettings, NewtonSystem};
 use crate::record::StepRecord;
-use crate::rotation_guard::{as_step_failure, RotationGuard};
-use crate::stability::InertiaCount;
-use crate::statics::{StaticOutcome, StaticTerms};
+use crate::rotation_guard::RotationGuard;
+use crate::statics::{
+    begin_step, converged_record, static_system, step_rejected, StaticOutcome, StaticTerms,
+};
 use crate::system::ReducedSystem;
 
 /// Settings of an arc-length analysis.
@@ -72,55 +70,27 @@ pub fn solve_arc_length(
     mut on_step: impl FnMut(&StepRecord),
 ) -> Result<StaticOutcome, SolveError> {
     refuse_unless_proportional(mech, settings)?;
-    let mut state = initial_state(mech);
-    let topo = Topology::new(mech, &state)?;
-    topo.impose(mech, &mut state, 0.0);
-    let n = topo.dofs.n_eq;
+    let (mut sys, mut lu, mut inertia) = static_system(mech)?;
+    let n = sys.topo.dofs.n_eq;
     let nodes = mech.mesh.node_count();
-    let asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
-    let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
-    let mut inertia = InertiaCount::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
-    let mut sys = ReducedSystem::new(mech, topo, asm, state, StaticTerms);
     let mut f_ref = vec![0.0; 6 * nodes];
     mech.external_forces(1.0, &mut f_ref);
     let mut guard = RotationGuard::new(mech, &sys.end);
     let mut work = Work::new(n);
     let (mut lambda, mut steps) = (0.0f64, 0usize);
-    // The arc length from the first load-controlled predictor.
-    set_load(&mut sys, &f_ref, 0.0);
-    sys.evaluate(&mut work.r);
-    factor_and_solve_f(&mut sys, &mut lu, &f_ref, &mut work)?;
-    let first = 1.0 / settings.load_steps.max(1) as f64;
-    let mut arc = first * norm(&work.qf);
+    let mut arc = first_arc(&mut sys, &mut lu, &f_ref, &mut work, settings)?;
     // The arc grows back after halvings, never beyond the first one: the
     // path keeps the resolution load_steps asked for.
     let nominal = arc;
-    if !(arc > 0.0 && arc.is_finite()) {
-        return Err(SolveError::InvalidMechanism(
-            "arc-length: the loads do nothing (f_ref = 0); give the model a load".into(),
-        ));
-    }
     let mut previous: Option<Vec<f64>> = None;
     let mut halvings = 0;
-    // The stability count of the last step, and the critical mode to leave
-    // along (once) after a bifurcation.
-    let mut last_count = Some(0);
-    let mut switch: Option<Vec<f64>> = None;
-    let mut switched = false;
+    let mut branch = BranchSwitch::default();
     while lambda < 1.0 {
         if steps >= settings.max_steps {
-            return Err(SolveError::InvalidMechanism(format!(
-                "arc-length: {steps} steps taken (the model's budget) and the load factor \
-                 is {lambda:.6}, short of 1; raise load_steps (shorter first step) or \
-                 max_arc_steps"
-            )));
+            return Err(out_of_budget(steps, lambda));
         }
-        sys.start.clone_from(&sys.end);
-        sys.floor = mech.round_off_floor_at(&sys.end.config.x);
-        let direction = if switched { None } else { switch.take() };
-        if direction.is_some() {
-            switched = true;
-        }
+        begin_step(&mut sys);
+        let direction = branch.direction();
         let leaving = direction.is_some();
         match arc_step(
             &mut sys,
@@ -134,8 +104,7 @@ pub fn solve_arc_length(
         ) {
             Ok((lambda_new, report)) => {
                 if let Err(objection) = guard.accept(mech, &sys.end, lambda_new) {
-                    sys.end.clone_from(&sys.start);
-                    let reason = as_step_failure(objection)?;
+                    let reason = step_rejected(&mut sys, objection)?;
                     halve(&mut arc, &mut halvings, settings, lambda, reason)?;
                     continue;
                 }
@@ -143,20 +112,12 @@ pub fn solve_arc_length(
                 let (lambda_rec, report) = if crosses {
                     // The path passes λ = 1 in this step: solve that point
                     // by load control from the step's start.
-                    sys.end.clone_from(&sys.start);
-                    set_load(&mut sys, &f_ref, 1.0);
-                    let report = crate::newton::solve(
-                        &mut sys,
-                        &mut lu,
-                        &settings.newton,
-                        &mut work.r,
-                        &mut work.dq,
-                    )
-                    .map_err(|reason| SolveError::NoConvergence {
-                        time: 1.0,
-                        halvings,
-                        reason,
-                    })?;
+                    let report = solve_at_one(&mut sys, &mut lu, &f_ref, &mut work, settings)
+                        .map_err(|reason| SolveError::NoConvergence {
+                            time: 1.0,
+                            halvings,
+                            reason,
+                        })?;
                     (1.0, report)
                 } else {
                     (lambda_new, report)
@@ -166,22 +127,20 @@ pub fn solve_arc_length(
                 lambda = lambda_rec;
                 steps += 1;
                 set_load(&mut sys, &f_ref, lambda);
-                let fext = sys.fext.clone();
-                let mut step = static_record(mech, &sys.end, &fext, lambda, dl, Some(&report));
-                sys.update_tangent(&mut work.r);
-                step.negative_pivots = inertia.negative_eigenvalues(&sys.asm.values);
-                sys.record_reactions(&mut step);
+                let step = converged_record(
+                    &mut sys,
+                    &mut inertia,
+                    &mut work.r,
+                    (lambda, dl),
+                    &report,
+                    None,
+                );
                 on_step(&step);
-                let grew = match (last_count, step.negative_pivots) {
-                    (Some(a), Some(b)) => b > a,
-                    _ => false,
-                };
-                last_count = step.negative_pivots;
-                if settings.branch_switch && grew && !switched && !leaving && lambda < 1.0 {
-                    switch = critical_mode(&mut sys, &mut lu, &f_ref, &mut work);
+                let grew = branch.count(step.negative_pivots);
+                if settings.branch_switch && grew && !branch.switched && !leaving && lambda < 1.0 {
+                    branch.switch = critical_mode(&mut sys, &mut lu, &f_ref, &mut work);
                 }
-                let taken = report.iterations.max(1) as f64;
-                arc = (arc * (DESIRED_ITERATIONS / taken).sqrt().clamp(0.5, 2.0)).min(nominal);
+                arc = adapted_arc(arc, nominal, report.iterations);
                 previous = Some(increment);
                 halvings = 0;
             }
@@ -191,11 +150,110 @@ pub fn solve_arc_length(
             }
         }
     }
-    Ok(StaticOutcome {
-        config: sys.end.config.clone(),
-        state: sys.end,
-        steps,
-    })
+    Ok(StaticOutcome::reached(sys, steps))
+}
+
+/// The arc length `Δl` of the path, from the first load-controlled
+/// predictor: `‖K⁻¹ f_ref‖ / load_steps` at the initial state (its tangent
+/// evaluated with λ = 0). An error when the loads do nothing.
+fn first_arc(
+    sys: &mut ReducedSystem<'_, StaticTerms>,
+    lu: &mut SparseLu,
+    f_ref: &[f64],
+    work: &mut Work,
+    settings: &ArcLengthSettings,
+) -> Result<f64, SolveError> {
+    // The arc length from the first load-controlled predictor.
+    set_load(sys, f_ref, 0.0);
+    sys.evaluate(&mut work.r);
+    factor_and_solve_f(sys, lu, f_ref, work)?;
+    let first = 1.0 / settings.load_steps.max(1) as f64;
+    let arc = first * norm(&work.qf);
+    if !(arc > 0.0 && arc.is_finite()) {
+        return Err(SolveError::InvalidMechanism(
+            "arc-length: the loads do nothing (f_ref = 0); give the model a load".into(),
+        ));
+    }
+    Ok(arc)
+}
+
+/// The error of a path that used its step budget short of λ = 1.
+fn out_of_budget(steps: usize, lambda: f64) -> SolveError {
+    SolveError::InvalidMechanism(format!(
+        "arc-length: {steps} steps taken (the model's budget) and the load factor \
+         is {lambda:.6}, short of 1; raise load_steps (shorter first step) or \
+         max_arc_steps"
+    ))
+}
+
+/// Solves the path's point at λ = 1 by load control from the step's start,
+/// for a step that passed it; Newton's report.
+fn solve_at_one(
+    sys: &mut ReducedSystem<'_, StaticTerms>,
+    lu: &mut SparseLu,
+    f_ref: &[f64],
+    work: &mut Work,
+    settings: &ArcLengthSettings,
+) -> Result<NewtonReport, NewtonFailure> {
+    sys.end.clone_from(&sys.start);
+    set_load(sys, f_ref, 1.0);
+    crate::newton::solve(sys, lu, &settings.newton, &mut work.r, &mut work.dq)
+}
+
+/// The arc length of the next step after one that took `iterations`:
+/// scaled by `√(desired/taken)`, between ½ and 2, never beyond `nominal`.
+fn adapted_arc(arc: f64, nominal: f64, iterations: usize) -> f64 {
+    let taken = iterations.max(1) as f64;
+    (arc * (DESIRED_ITERATIONS / taken).sqrt().clamp(0.5, 2.0)).min(nominal)
+}
+
+/// Branch switching: the stability count of the last step, and the
+/// critical mode to leave the path along (once) after a bifurcation.
+struct BranchSwitch {
+    /// Negative eigenvalues of the last converged step's tangent.
+    last_count: Option<usize>,
+    /// The critical mode found at a bifurcation, not yet left along.
+    switch: Option<Vec<f64>>,
+    /// Whether the path has left along a critical mode.
+    switched: bool,
+}
+
+impl Default for BranchSwitch {
+    /// The count of the unloaded state (none negative), no mode.
+    fn default() -> Self {
+        Self {
+            last_count: Some(0),
+            switch: None,
+            switched: false,
+        }
+    }
+}
+
+impl BranchSwitch {
+    /// The direction the next step leaves along: the critical mode, taken
+    /// once (the path switches branches at most once).
+    fn direction(&mut self) -> Option<Vec<f64>> {
+        let direction = if self.switched {
+            None
+        } else {
+            self.switch.take()
+        };
+        if direction.is_some() {
+            self.switched = true;
+        }
+        direction
+    }
+
+    /// Takes a converged step's count of negative eigenvalues; whether it
+    /// grew since the last step (both known).
+    fn count(&mut self, negative_pivots: Option<usize>) -> bool {
+        let grew = match (self.last_count, negative_pivots) {
+            (Some(a), Some(b)) => b > a,
+            _ => false,
+        };
+        self.last_count = negative_pivots;
+        grew
+    }
 }
 
 /// Scratch of the iterations: residual, Newton increment, the two
@@ -264,34 +322,7 @@ fn arc_step(
     previous: Option<&[f64]>,
     leave_along: Option<&[f64]>,
 ) -> Result<(f64, NewtonReport), NewtonFailure> {
-    let linear = |e: String| NewtonFailure::LinearSolve(e);
-    // Predictor: the tangent direction, signed to continue the path — or,
-    // leaving the fundamental path at a bifurcation, the critical mode at
-    // the same load.
-    set_load(sys, f_ref, lambda);
-    sys.evaluate(&mut work.r);
-    factor_and_solve_f(sys, lu, f_ref, work).map_err(|e| linear(e.to_string()))?;
-    let mut dl = 0.0;
-    match leave_along {
-        Some(mode) => {
-            let scale = arc / norm(mode);
-            for (a, m) in work.acc.iter_mut().zip(mode) {
-                *a = scale * m;
-            }
-        }
-        None => {
-            let sign = match previous {
-                Some(p) if dot(&work.qf, p) < 0.0 => -1.0,
-                _ => 1.0,
-            };
-            dl = sign * arc / norm(&work.qf);
-            for (a, f) in work.acc.iter_mut().zip(&work.qf) {
-                *a = dl * f;
-            }
-        }
-    }
-    work.dq.copy_from_slice(&work.acc);
-    sys.apply(&work.dq);
+    let mut dl = predict(sys, lu, f_ref, work, (lambda, arc), previous, leave_along)?;
     let mut history = Vec::new();
     for it in 1..=settings.newton.max_iterations {
         set_load(sys, f_ref, lambda + dl);
@@ -313,52 +344,113 @@ fn arc_step(
                 },
             ));
         }
-        factor_and_solve_f(sys, lu, f_ref, work).map_err(|e| linear(e.to_string()))?;
-        // K q_r = −r into work.dq.
-        for (d, r) in work.dq.iter_mut().zip(&work.r) {
-            *d = -r;
-        }
-        lu.solve(&mut work.dq).map_err(linear)?;
-        // ‖acc + q_r + δλ q_f‖² = arc²: a δλ² + b δλ + c = 0.
-        let base: Vec<f64> = work.acc.iter().zip(&work.dq).map(|(a, d)| a + d).collect();
-        let (a, b, c) = (
-            dot(&work.qf, &work.qf),
-            2.0 * dot(&work.qf, &base),
-            dot(&base, &base) - arc * arc,
-        );
-        let disc = b * b - 4.0 * a * c;
-        if disc < 0.0 {
-            return Err(NewtonFailure::Rejected(
-                "arc-length: the constraint has no real root (complex roots); the arc is \
-                 shortened"
-                    .into(),
-            ));
-        }
-        let roots = [
-            (-b + disc.sqrt()) / (2.0 * a),
-            (-b - disc.sqrt()) / (2.0 * a),
-        ];
-        // The root whose increment turns least from the step's so far.
-        let turn = |x: f64| {
-            let new: Vec<f64> = base.iter().zip(&work.qf).map(|(q, f)| q + x * f).collect();
-            dot(&new, &work.acc) / (norm(&new) * norm(&work.acc)).max(f64::MIN_POSITIVE)
-        };
-        let dlam = if turn(roots[0]) >= turn(roots[1]) {
-            roots[0]
-        } else {
-            roots[1]
-        };
-        for ((d, f), a) in work.dq.iter_mut().zip(&work.qf).zip(work.acc.iter_mut()) {
-            *d += dlam * f;
-            *a += *d;
-        }
-        sys.apply(&work.dq);
-        dl += dlam;
+        dl += correct(sys, lu, f_ref, work, arc)?;
     }
     Err(NewtonFailure::MaxIterations {
         iterations: settings.newton.max_iterations,
         residual: history.last().copied().unwrap_or(f64::NAN),
     })
+}
+
+/// The predictor of a step from `sys.start` at `lambda`: the tangent
+/// direction `δλ q_f` of length `arc`, signed to continue the path along
+/// `previous` — or, leaving the fundamental path at a bifurcation, the
+/// critical mode `leave_along` at the same load. Applies it, keeps it as the
+/// step's accumulated increment `work.acc` and returns its `δλ`.
+fn predict(
+    sys: &mut ReducedSystem<'_, StaticTerms>,
+    lu: &mut SparseLu,
+    f_ref: &[f64],
+    work: &mut Work,
+    (lambda, arc): (f64, f64),
+    previous: Option<&[f64]>,
+    leave_along: Option<&[f64]>,
+) -> Result<f64, NewtonFailure> {
+    // Predictor: the tangent direction, signed to continue the path — or,
+    // leaving the fundamental path at a bifurcation, the critical mode at
+    // the same load.
+    set_load(sys, f_ref, lambda);
+    sys.evaluate(&mut work.r);
+    factor_and_solve_f(sys, lu, f_ref, work)
+        .map_err(|e| NewtonFailure::LinearSolve(e.to_string()))?;
+    let mut dl = 0.0;
+    match leave_along {
+        Some(mode) => {
+            let scale = arc / norm(mode);
+            for (a, m) in work.acc.iter_mut().zip(mode) {
+                *a = scale * m;
+            }
+        }
+        None => {
+            let sign = match previous {
+                Some(p) if dot(&work.qf, p) < 0.0 => -1.0,
+                _ => 1.0,
+            };
+            dl = sign * arc / norm(&work.qf);
+            for (a, f) in work.acc.iter_mut().zip(&work.qf) {
+                *a = dl * f;
+            }
+        }
+    }
+    work.dq.copy_from_slice(&work.acc);
+    sys.apply(&work.dq);
+    Ok(dl)
+}
+
+/// One corrector iteration on the cylinder of radius `arc` (the residual
+/// of the iterate in `work.r`): solves `K q_f = f_ref` and `K q_r = −r` with
+/// one factorisation, takes the increment `q_r + δλ q_f` with `δλ` the root
+/// of `‖acc + q_r + δλ q_f‖² = arc²` whose new increment turns least from
+/// the step's so far, applies it, adds it to `work.acc` and returns `δλ`.
+fn correct(
+    sys: &mut ReducedSystem<'_, StaticTerms>,
+    lu: &mut SparseLu,
+    f_ref: &[f64],
+    work: &mut Work,
+    arc: f64,
+) -> Result<f64, NewtonFailure> {
+    factor_and_solve_f(sys, lu, f_ref, work)
+        .map_err(|e| NewtonFailure::LinearSolve(e.to_string()))?;
+    // K q_r = −r into work.dq.
+    for (d, r) in work.dq.iter_mut().zip(&work.r) {
+        *d = -r;
+    }
+    lu.solve(&mut work.dq).map_err(NewtonFailure::LinearSolve)?;
+    // ‖acc + q_r + δλ q_f‖² = arc²: a δλ² + b δλ + c = 0.
+    let base: Vec<f64> = work.acc.iter().zip(&work.dq).map(|(a, d)| a + d).collect();
+    let (a, b, c) = (
+        dot(&work.qf, &work.qf),
+        2.0 * dot(&work.qf, &base),
+        dot(&base, &base) - arc * arc,
+    );
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        return Err(NewtonFailure::Rejected(
+            "arc-length: the constraint has no real root (complex roots); the arc is \
+             shortened"
+                .into(),
+        ));
+    }
+    let roots = [
+        (-b + disc.sqrt()) / (2.0 * a),
+        (-b - disc.sqrt()) / (2.0 * a),
+    ];
+    // The root whose increment turns least from the step's so far.
+    let turn = |x: f64| {
+        let new: Vec<f64> = base.iter().zip(&work.qf).map(|(q, f)| q + x * f).collect();
+        dot(&new, &work.acc) / (norm(&new) * norm(&work.acc)).max(f64::MIN_POSITIVE)
+    };
+    let dlam = if turn(roots[0]) >= turn(roots[1]) {
+        roots[0]
+    } else {
+        roots[1]
+    };
+    for ((d, f), a) in work.dq.iter_mut().zip(&work.qf).zip(work.acc.iter_mut()) {
+        *d += dlam * f;
+        *a += *d;
+    }
+    sys.apply(&work.dq);
+    Ok(dlam)
 }
 
 /// The critical mode at the converged state (its tangent in the solver's

@@ -38,6 +38,10 @@ struct Slots {
     direct: Option<Vec<(usize, usize, usize)>>,
 }
 
+/// An element's `(element dof, local index)` pairs, or `None` where a joint
+/// touches it (see [`direct_pairs`]).
+type DirectPairs = Option<Vec<(usize, usize)>>;
+
 /// The `(element dof, local index)` pairs of an element whose nodes are all
 /// independent (see [`Slots::direct`]; the local index is into the sorted
 /// equation list `eqs`), or `None`.
@@ -50,6 +54,118 @@ fn direct_pairs(el: &Element, dofs: &DofMap, eqs: &[usize]) -> Option<Vec<(usize
         }
     }
     (pairs.len() == eqs.len()).then_some(pairs)
+}
+
+/// Every element's slots (its sorted, unique equations; positions still to
+/// be found), its direct pairs ([`direct_pairs`]) and its buffers, with its
+/// equation pairs added to the pattern's columns `cols`.
+fn element_slots(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    cols: &mut [Vec<usize>],
+) -> (Vec<Slots>, Vec<DirectPairs>, Vec<Work>) {
+    let mut slots = Vec::with_capacity(mesh.elements.len());
+    let mut direct = Vec::with_capacity(mesh.elements.len());
+    let mut work = Vec::with_capacity(mesh.elements.len());
+    for el in &mesh.elements {
+        let mut eqs: Vec<usize> = el
+            .nodes()
+            .iter()
+            .flat_map(|&nd| dofs.nodes[nd].eqs.iter().copied())
+            .collect();
+        eqs.sort_unstable();
+        eqs.dedup();
+        for &j in &eqs {
+            cols[j].extend(eqs.iter().copied());
+        }
+        work.push(Work::new(el.dofs(), eqs.len()));
+        direct.push(direct_pairs(el, dofs, &eqs));
+        slots.push(Slots {
+            eqs,
+            pos: Vec::new(),
+            direct: None,
+        });
+    }
+    (slots, direct, work)
+}
+
+/// The slots of the extra dense blocks over the equation lists `blocks`
+/// (positions still to be found), with their pairs added to `cols`.
+fn block_slots(blocks: &[Vec<usize>], cols: &mut [Vec<usize>]) -> Vec<Slots> {
+    let mut extra: Vec<Slots> = Vec::with_capacity(blocks.len());
+    for eqs in blocks {
+        for &j in eqs {
+            cols[j].extend(eqs.iter().copied());
+        }
+        extra.push(Slots {
+            eqs: eqs.clone(),
+            pos: Vec::new(),
+            direct: None,
+        });
+    }
+    extra
+}
+
+/// The compressed columns `(col_ptr, row_idx)` of the pattern whose
+/// column `j` holds the rows `cols[j]` (sorted and made unique in place).
+fn compressed_columns(cols: &mut [Vec<usize>]) -> (Vec<usize>, Vec<usize>) {
+    let mut col_ptr = Vec::with_capacity(cols.len() + 1);
+    let mut row_idx = Vec::new();
+    col_ptr.push(0);
+    for c in cols {
+        c.sort_unstable();
+        c.dedup();
+        row_idx.extend(c.iter().copied());
+        col_ptr.push(row_idx.len());
+    }
+    (col_ptr, row_idx)
+}
+
+/// The positions in the CSC value array of the pattern `(col_ptr, row_idx)`
+/// of every pair `(eqs[i], eqs[j])`, column-major `j·m + i` ([`Slots::pos`]).
+fn value_positions(eqs: &[usize], col_ptr: &[usize], row_idx: &[usize]) -> Vec<usize> {
+    let m = eqs.len();
+    let mut pos = Vec::with_capacity(m * m);
+    for &cj in eqs {
+        let rows = &row_idx[col_ptr[cj]..col_ptr[cj + 1]];
+        for &ri in eqs {
+            let p = rows
+                .binary_search(&ri)
+                .expect("pattern contains every element pair");
+            pos.push(col_ptr[cj] + p);
+        }
+    }
+    pos
+}
+
+/// The runs of [`Slots::direct`] for an element of `d` unknowns whose nodes
+/// are all independent, from its direct `pairs` and positions `s.pos`.
+fn direct_runs(pairs: &[(usize, usize)], d: usize, s: &Slots) -> Vec<(usize, usize, usize)> {
+    let m = s.eqs.len();
+    let mut runs: Vec<(usize, usize, usize)> = Vec::new();
+    for &(ec, lc) in pairs {
+        for &(er, lr) in pairs {
+            let (e, p) = (ec * d + er, s.pos[lc * m + lr]);
+            match runs.last_mut() {
+                Some((e0, p0, len)) if *e0 + *len == e && *p0 + *len == p => *len += 1,
+                _ => runs.push((e, p, 1)),
+            }
+        }
+    }
+    runs
+}
+
+/// One scratch buffer per element kind (number of unknowns) of `mesh`, for
+/// the one-thread path ([`scratch_for`]).
+fn kind_scratch(mesh: &Mesh) -> Vec<Work> {
+    let mut scratch: Vec<Work> = Vec::new();
+    for el in &mesh.elements {
+        let d = el.dofs();
+        if scratch.iter().all(|w| w.r.len() != d) {
+            scratch.push(Work::new(d, 0));
+        }
+    }
+    scratch
 }
 
 struct Work {
@@ -113,92 +229,25 @@ impl Assembler {
         for (e, c) in cols.iter_mut().enumerate() {
             c.push(e);
         }
-        let mut slots = Vec::with_capacity(mesh.elements.len());
-        let mut direct = Vec::with_capacity(mesh.elements.len());
-        let mut work = Vec::with_capacity(mesh.elements.len());
-        for el in &mesh.elements {
-            let mut eqs: Vec<usize> = el
-                .nodes()
-                .iter()
-                .flat_map(|&nd| dofs.nodes[nd].eqs.iter().copied())
-                .collect();
-            eqs.sort_unstable();
-            eqs.dedup();
-            for &j in &eqs {
-                cols[j].extend(eqs.iter().copied());
-            }
-            work.push(Work::new(el.dofs(), eqs.len()));
-            direct.push(direct_pairs(el, dofs, &eqs));
-            slots.push(Slots {
-                eqs,
-                pos: Vec::new(),
-                direct: None,
-            });
-        }
-        let mut extra: Vec<Slots> = Vec::with_capacity(blocks.len());
-        for eqs in blocks {
-            for &j in eqs {
-                cols[j].extend(eqs.iter().copied());
-            }
-            extra.push(Slots {
-                eqs: eqs.clone(),
-                pos: Vec::new(),
-                direct: None,
-            });
-        }
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut row_idx = Vec::new();
-        col_ptr.push(0);
-        for c in &mut cols {
-            c.sort_unstable();
-            c.dedup();
-            row_idx.extend(c.iter().copied());
-            col_ptr.push(row_idx.len());
-        }
+        let (mut slots, direct, work) = element_slots(mesh, dofs, &mut cols);
+        let mut extra = block_slots(blocks, &mut cols);
+        let (col_ptr, row_idx) = compressed_columns(&mut cols);
         for s in slots.iter_mut().chain(extra.iter_mut()) {
-            let m = s.eqs.len();
-            s.pos = Vec::with_capacity(m * m);
-            for &cj in &s.eqs {
-                let rows = &row_idx[col_ptr[cj]..col_ptr[cj + 1]];
-                for &ri in &s.eqs {
-                    let p = rows
-                        .binary_search(&ri)
-                        .expect("pattern contains every element pair");
-                    s.pos.push(col_ptr[cj] + p);
-                }
-            }
+            s.pos = value_positions(&s.eqs, &col_ptr, &row_idx);
         }
         for ((s, el), pairs) in slots.iter_mut().zip(&mesh.elements).zip(&direct) {
-            let (Some(pairs), d, m) = (pairs, el.dofs(), s.eqs.len()) else {
-                continue;
-            };
-            let mut runs: Vec<(usize, usize, usize)> = Vec::new();
-            for &(ec, lc) in pairs {
-                for &(er, lr) in pairs {
-                    let (e, p) = (ec * d + er, s.pos[lc * m + lr]);
-                    match runs.last_mut() {
-                        Some((e0, p0, len)) if *e0 + *len == e && *p0 + *len == p => *len += 1,
-                        _ => runs.push((e, p, 1)),
-                    }
-                }
+            if let Some(pairs) = pairs {
+                s.direct = Some(direct_runs(pairs, el.dofs(), s));
             }
-            s.direct = Some(runs);
         }
         let nnz = row_idx.len();
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        let mut scratch: Vec<Work> = Vec::new();
-        for el in &mesh.elements {
-            let d = el.dofs();
-            if scratch.iter().all(|w| w.r.len() != d) {
-                scratch.push(Work::new(d, 0));
-            }
-        }
         Self {
             pattern,
             slots,
             blocks: extra,
             work,
-            scratch,
+            scratch: kind_scratch(mesh),
             split: None,
             chunk_scratch: Vec::new(),
             tangent_cost: LoopCost::default(),

@@ -13,7 +13,7 @@ use crate::error::{NewtonFailure, SolveError};
 use crate::linsolve::SparseLu;
 use crate::measure::{follower_work, static_record};
 use crate::mechanism::Mechanism;
-use crate::newton::{self, NewtonSettings, NewtonSystem};
+use crate::newton::{self, NewtonReport, NewtonSettings, NewtonSystem};
 use crate::record::StepRecord;
 use crate::rotation_guard::{as_step_failure, RotationGuard};
 use crate::stability::InertiaCount;
@@ -69,14 +69,8 @@ pub fn solve_static(
             "load_steps must be at least 1".into(),
         ));
     }
-    let mut state = initial_state(mech);
-    let topo = Topology::new(mech, &state)?;
-    topo.impose(mech, &mut state, 0.0);
-    let n = topo.dofs.n_eq;
-    let asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
-    let mut lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
-    let mut inertia = InertiaCount::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
-    let mut prob = ReducedSystem::new(mech, topo, asm, state, StaticTerms);
+    let (mut prob, mut lu, mut inertia) = static_system(mech)?;
+    let n = prob.topo.dofs.n_eq;
     let (mut r, mut dq) = (vec![0.0; n], vec![0.0; n]);
     let nominal = 1.0 / settings.load_steps as f64;
     let mut control = StepControl::with(nominal, settings.max_halvings, GROW_AFTER);
@@ -93,17 +87,8 @@ pub fn solve_static(
     // The state before the last converged step and that step's size.
     let mut previous: Option<(MechanismState, f64)> = None;
     while lambda < 1.0 - TOLERANCES.end_of_run {
-        // Never step over a planned level k/load_steps: results are reported
-        // at the load factors the user asked for; halvings only add levels.
-        let next_planned = ((lambda / nominal + TOLERANCES.level_snap).floor() + 1.0) * nominal;
-        let target = (lambda + control.step()).min(next_planned);
-        let target = if target > 1.0 - TOLERANCES.end_of_run {
-            1.0
-        } else {
-            target
-        };
-        prob.start.clone_from(&prob.end);
-        prob.floor = mech.round_off_floor_at(&prob.end.config.x);
+        let target = next_level(lambda, nominal, control.step());
+        begin_step(&mut prob);
         if let (true, Some((before, before_step))) = (driven, &previous) {
             prob.topo
                 .extrapolate(mech, &mut prob.end, before, (target - lambda) / before_step);
@@ -114,8 +99,7 @@ pub fn solve_static(
         match newton::solve(&mut prob, &mut lu, &settings.newton, &mut r, &mut dq) {
             Ok(report) => {
                 if let Err(objection) = guard.accept(mech, &prob.end, target) {
-                    prob.end.clone_from(&prob.start);
-                    control.failed(target, as_step_failure(objection)?)?;
+                    control.failed(target, step_rejected(&mut prob, objection)?)?;
                     continue;
                 }
                 let dt = target - lambda;
@@ -127,28 +111,20 @@ pub fn solve_static(
                 );
                 lambda = target;
                 steps += 1;
-                let mut step =
-                    static_record(mech, &prob.end, &prob.fext, lambda, dt, Some(&report));
-                // Follower loads have no potential: minus their work along
-                // the load path stands for it.
-                step.energy.potential -= follower;
-                step.energy.total -= follower;
-                // The stability count is of the converged iterate's tangent.
-                prob.update_tangent(&mut r);
-                step.negative_pivots = inertia.negative_eigenvalues(&prob.asm.values);
-                prob.record_reactions(&mut step);
+                let step = converged_record(
+                    &mut prob,
+                    &mut inertia,
+                    &mut r,
+                    (lambda, dt),
+                    &report,
+                    Some(follower),
+                );
                 on_step(&step);
                 control.succeeded();
             }
             Err(reason) => {
                 prob.end.clone_from(&prob.start);
-                if let NewtonFailure::LinearSolve(msg) = &reason {
-                    if lambda == 0.0 && control.level() == 0 {
-                        // A singular tangent at the undeformed state will not be
-                        // cured by a smaller load: the mechanism is under-supported.
-                        return Err(SolveError::Singular(msg.clone()));
-                    }
-                }
+                refuse_if_unsupported(&reason, lambda, control.level())?;
                 // Halve, never below nominal/2^max_halvings (the level is
                 // kept across successes, so the load path cannot creep on
                 // with ever smaller steps).
@@ -156,9 +132,112 @@ pub fn solve_static(
             }
         }
     }
-    Ok(StaticOutcome {
-        config: prob.end.config.clone(),
-        state: prob.end,
-        steps,
-    })
+    Ok(StaticOutcome::reached(prob, steps))
+}
+
+/// The load factor the step from `lambda` aims at, with the step control's
+/// size `step`: at most the next planned level `k·nominal`, and exactly 1
+/// within `end_of_run` of the end.
+fn next_level(lambda: f64, nominal: f64, step: f64) -> f64 {
+    // Never step over a planned level k/load_steps: results are reported
+    // at the load factors the user asked for; halvings only add levels.
+    let next_planned = ((lambda / nominal + TOLERANCES.level_snap).floor() + 1.0) * nominal;
+    let target = (lambda + step).min(next_planned);
+    if target > 1.0 - TOLERANCES.end_of_run {
+        1.0
+    } else {
+        target
+    }
+}
+
+/// The error that ends the run when the first step from the undeformed
+/// state, at full size, failed on a singular tangent; any other failure is
+/// left to the step control.
+fn refuse_if_unsupported(
+    reason: &NewtonFailure,
+    lambda: f64,
+    level: usize,
+) -> Result<(), SolveError> {
+    if let NewtonFailure::LinearSolve(msg) = reason {
+        if lambda == 0.0 && level == 0 {
+            // A singular tangent at the undeformed state will not be
+            // cured by a smaller load: the mechanism is under-supported.
+            return Err(SolveError::Singular(msg.clone()));
+        }
+    }
+    Ok(())
+}
+
+impl StaticOutcome {
+    /// The outcome at the last converged state of `sys`, after `steps` steps.
+    pub(crate) fn reached(sys: ReducedSystem<'_, StaticTerms>, steps: usize) -> Self {
+        Self {
+            config: sys.end.config.clone(),
+            state: sys.end,
+            steps,
+        }
+    }
+}
+
+/// The static system of `mech` at its initial state (the joints' driven
+/// coordinates imposed at λ = 0), with the sparse LU of its tangent and the
+/// stability count, both over the tangent's pattern. Shared by load control
+/// ([`solve_static`]) and arc-length control
+/// ([`crate::arc_length::solve_arc_length`]).
+pub(crate) fn static_system(
+    mech: &Mechanism,
+) -> Result<(ReducedSystem<'_, StaticTerms>, SparseLu, InertiaCount), SolveError> {
+    let mut state = initial_state(mech);
+    let topo = Topology::new(mech, &state)?;
+    topo.impose(mech, &mut state, 0.0);
+    let asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
+    let lu = SparseLu::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
+    let inertia = InertiaCount::new(asm.pattern().clone()).map_err(SolveError::Singular)?;
+    let sys = ReducedSystem::new(mech, topo, asm, state, StaticTerms);
+    Ok((sys, lu, inertia))
+}
+
+/// Starts a step from the last converged state: the step's start is the
+/// current end, and the round-off floor of the residual is that state's.
+pub(crate) fn begin_step(sys: &mut ReducedSystem<'_, StaticTerms>) {
+    sys.start.clone_from(&sys.end);
+    sys.floor = sys.mech.round_off_floor_at(&sys.end.config.x);
+}
+
+/// Undoes a step the rotation guard objected to (back to the step's start)
+/// and returns the objection as a step failure when smaller steps cure it,
+/// or else the error that ends the run.
+pub(crate) fn step_rejected(
+    sys: &mut ReducedSystem<'_, StaticTerms>,
+    objection: SolveError,
+) -> Result<NewtonFailure, SolveError> {
+    sys.end.clone_from(&sys.start);
+    as_step_failure(objection)
+}
+
+/// The record of a converged static step to the load factor `lambda` (step
+/// `dl`; the loads set at `lambda`): its energies, the stability count of the
+/// converged iterate's tangent and the reactions. `follower`, the follower
+/// loads' work along the load path, is taken off the potential and total
+/// energies where given. `scratch` is a residual-sized buffer.
+pub(crate) fn converged_record(
+    sys: &mut ReducedSystem<'_, StaticTerms>,
+    inertia: &mut InertiaCount,
+    scratch: &mut [f64],
+    (lambda, dl): (f64, f64),
+    report: &NewtonReport,
+    follower: Option<f64>,
+) -> StepRecord {
+    let mut step = static_record(sys.mech, &sys.end, &sys.fext, lambda, dl, Some(report));
+    if let Some(follower) = follower {
+        // Follower loads have no potential: minus their work along
+        // the load path stands for it.
+        step.energy.potential -= follower;
+        step.energy.total -= follower;
+    }
+    // The stability count is of the converged iterate's tangent.
+    sys.update_tangent(scratch);
+    step.negative_pivots = inertia.negative_eigenvalues(&sys.asm.values);
+    sys.record_reactions(&mut step);
+    step
 }

@@ -63,6 +63,40 @@ fn energy_terms(el: &Element, start: &Configuration, end: &Configuration) -> Ene
     }
 }
 
+/// Scratch of the bordered iterations: the residual `r`, the border
+/// `b = ∂(Ñᵀg)/∂β`, the reduced gradients `∇E`, `∇C` of the energy terms, and
+/// the two solutions `y₁ = −K⁻¹r`, `y₂ = K⁻¹b` of one factorisation.
+struct BorderedWork {
+    r: Vec<f64>,
+    b: Vec<f64>,
+    ge: Vec<f64>,
+    gc: Vec<f64>,
+    y1: Vec<f64>,
+    y2: Vec<f64>,
+}
+
+impl BorderedWork {
+    /// Buffers for `n_eq` reduced unknowns.
+    fn new(n_eq: usize) -> Self {
+        Self {
+            r: vec![0.0; n_eq],
+            b: vec![0.0; n_eq],
+            ge: vec![0.0; n_eq],
+            gc: vec![0.0; n_eq],
+            y1: vec![0.0; n_eq],
+            y2: vec![0.0; n_eq],
+        }
+    }
+}
+
+/// The energy equation's sums over the elements: `E = Σ e`, `C = Σ c` (the
+/// residual is `E + βC`) and its scale `Σ |e| + |c|`.
+struct EnergySums {
+    e_tot: f64,
+    c_tot: f64,
+    e_scale: f64,
+}
+
 /// Newton on `(q, β)` with the bordered tangent. Returns the report and β
 /// (NaN when the correction had no effect on the energy).
 pub(super) fn solve_step<T: Bordered>(
@@ -70,68 +104,23 @@ pub(super) fn solve_step<T: Bordered>(
     lu: &mut SparseLu,
     settings: &NewtonSettings,
 ) -> Result<(NewtonReport, f64), NewtonFailure> {
-    let n_eq = sys.topo.dofs.n_eq;
-    let nodes = sys.end.config.x.len();
-    let (mut r, mut b, mut ge, mut gc) = (
-        vec![0.0; n_eq],
-        vec![0.0; n_eq],
-        vec![0.0; n_eq],
-        vec![0.0; n_eq],
-    );
-    let (mut y1, mut y2) = (vec![0.0; n_eq], vec![0.0; n_eq]);
+    let mut work = BorderedWork::new(sys.topo.dofs.n_eq);
     let mut history = Vec::with_capacity(settings.max_iterations + 1);
     let mut beta = 0.0;
     let mut determined = true;
     let mut previous_norm = f64::INFINITY;
     for it in 0..=settings.max_iterations {
         sys.terms.set_beta(beta);
-        let scale = sys.evaluate(&mut r);
-        // Energy equation and its border, element by element (in order: deterministic).
-        let (mut e_tot, mut c_tot, mut e_scale) = (0.0, 0.0, 0.0);
-        let mut nodal = [
-            vec![0.0; 6 * nodes],
-            vec![0.0; 6 * nodes],
-            vec![0.0; 6 * nodes],
-        ];
-        // Element terms in parallel, summed in element order (deterministic).
-        let (start, end) = (&sys.start.config, &sys.end.config);
-        let elements = &sys.mech.mesh.elements;
-        let terms: Vec<EnergyTerms> = if sequential(elements.len()) {
-            elements
-                .iter()
-                .map(|el| energy_terms(el, start, end))
-                .collect()
-        } else {
-            elements
-                .par_iter()
-                .map(|el| energy_terms(el, start, end))
-                .collect()
-        };
-        for (el, t) in sys.mech.mesh.elements.iter().zip(&terms) {
-            e_tot += t.e;
-            c_tot += t.c;
-            e_scale += t.e.abs() + t.c.abs();
-            for (a, &nd) in el.nodes().iter().enumerate() {
-                for d in 0..6 {
-                    nodal[0][6 * nd + d] += t.qd[6 * a + d];
-                    nodal[1][6 * nd + d] += t.de[6 * a + d];
-                    nodal[2][6 * nd + d] += t.dc[6 * a + d];
-                }
-            }
-        }
-        // b = ∂(Ñᵀg)/∂β is a residual (through Ñ); the gradients of the
-        // energy terms are derivatives (through the end-point maps).
-        sys.reduce(&nodal[0], &mut b);
-        sys.topo.dofs.reduce(&nodal[1], &mut ge);
-        sys.topo.dofs.reduce(&nodal[2], &mut gc);
-        let energy = e_tot + beta * c_tot;
-        let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let scale = sys.evaluate(&mut work.r);
+        let sums = energy_equation(sys, &mut work);
+        let energy = sums.e_tot + beta * sums.c_tot;
+        let norm = work.r.iter().map(|v| v * v).sum::<f64>().sqrt();
         let res_g = if norm == 0.0 {
             0.0
         } else {
             norm / scale.max(f64::MIN_POSITIVE)
         };
-        let res_e = energy.abs() / e_scale.max(f64::MIN_POSITIVE);
+        let res_e = energy.abs() / sums.e_scale.max(f64::MIN_POSITIVE);
         let res = if determined { res_g.max(res_e) } else { res_g };
         history.push(res);
         if !res.is_finite() {
@@ -140,18 +129,11 @@ pub(super) fn solve_step<T: Bordered>(
         let g_ok = res_g <= settings.tolerance || at_floor(norm, &mut previous_norm, sys.floor());
         // The energy residual's own round-off floor: forces rounded at the
         // system's force floor, times the size of the step's increments.
-        let increments: f64 = (0..nodes)
-            .map(|i| {
-                let (s0, s1) = (&sys.start.config, &sys.end.config);
-                let u = s1.x[i] - s0.x[i];
-                let th = cayley_inverse(&(s1.rot[i] * s0.rot[i].transpose()));
-                u.norm_squared() + th.norm_squared()
-            })
-            .sum::<f64>()
-            .sqrt();
+        let increments = step_increments(sys);
         let e_ok = !determined
             || res_e <= settings.tolerance
-            || energy.abs() <= TOLERANCES.energy_round_off * e_scale + sys.floor() * increments;
+            || energy.abs()
+                <= TOLERANCES.energy_round_off * sums.e_scale + sys.floor() * increments;
         if g_ok && e_ok {
             check_regular(sys, lu, it > 0, true)?;
             let beta_out = if determined { beta } else { f64::NAN };
@@ -171,37 +153,137 @@ pub(super) fn solve_step<T: Bordered>(
         if it == settings.max_iterations {
             break;
         }
-        lu.factor(sys.tangent_values())
-            .map_err(NewtonFailure::LinearSolve)?;
-        for (y, v) in y1.iter_mut().zip(&r) {
-            *y = -v;
-        }
-        lu.solve(&mut y1).map_err(NewtonFailure::LinearSolve)?;
-        y2.copy_from_slice(&b);
-        lu.solve(&mut y2).map_err(NewtonFailure::LinearSolve)?;
-        // Border: c = ∂e/∂q = ∇E + β∇C, d = ∂e/∂β = C.
-        let c: Vec<f64> = ge.iter().zip(&gc).map(|(a, g)| a + beta * g).collect();
-        let cy1: f64 = c.iter().zip(&y1).map(|(a, b)| a * b).sum();
-        let cy2: f64 = c.iter().zip(&y2).map(|(a, b)| a * b).sum();
-        let pivot = c_tot - cy2;
-        let size = c_tot.abs()
-            + c.iter().map(|v| v * v).sum::<f64>().sqrt()
-                * y2.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let dbeta = if pivot.abs() > TOLERANCES.border_pivot * size && pivot.is_finite() {
-            determined = true;
-            (-energy - cy1) / pivot
-        } else {
-            // β has no lever on the energy in this step: solve without it.
-            determined = false;
-            beta = 0.0;
-            0.0
+        solve_both(sys, lu, &mut work)?;
+        let dbeta = match beta_increment(&work, sums.c_tot, energy, beta) {
+            Some(dbeta) => {
+                determined = true;
+                dbeta
+            }
+            None => {
+                // β has no lever on the energy in this step: solve without it.
+                determined = false;
+                beta = 0.0;
+                0.0
+            }
         };
         beta += dbeta;
-        let dq: Vec<f64> = y1.iter().zip(&y2).map(|(a, b)| a - b * dbeta).collect();
+        let dq: Vec<f64> = work
+            .y1
+            .iter()
+            .zip(&work.y2)
+            .map(|(a, b)| a - b * dbeta)
+            .collect();
         sys.apply(&dq);
     }
     Err(NewtonFailure::MaxIterations {
         iterations: settings.max_iterations,
         residual: *history.last().unwrap_or(&f64::NAN),
     })
+}
+
+/// The energy equation and its border at the iterate: every element's
+/// [`EnergyTerms`] (in parallel), summed in element order (deterministic)
+/// into the returned sums and the nodal vectors, which are reduced into
+/// `work.b` (a residual, through `Ñ`), `work.ge` and `work.gc` (derivatives,
+/// through the end-point maps).
+fn energy_equation<T: Bordered>(sys: &ReducedSystem<'_, T>, work: &mut BorderedWork) -> EnergySums {
+    let nodes = sys.end.config.x.len();
+    // Energy equation and its border, element by element (in order: deterministic).
+    let (mut e_tot, mut c_tot, mut e_scale) = (0.0, 0.0, 0.0);
+    let mut nodal = [
+        vec![0.0; 6 * nodes],
+        vec![0.0; 6 * nodes],
+        vec![0.0; 6 * nodes],
+    ];
+    // Element terms in parallel, summed in element order (deterministic).
+    let (start, end) = (&sys.start.config, &sys.end.config);
+    let elements = &sys.mech.mesh.elements;
+    let terms: Vec<EnergyTerms> = if sequential(elements.len()) {
+        elements
+            .iter()
+            .map(|el| energy_terms(el, start, end))
+            .collect()
+    } else {
+        elements
+            .par_iter()
+            .map(|el| energy_terms(el, start, end))
+            .collect()
+    };
+    for (el, t) in sys.mech.mesh.elements.iter().zip(&terms) {
+        e_tot += t.e;
+        c_tot += t.c;
+        e_scale += t.e.abs() + t.c.abs();
+        for (a, &nd) in el.nodes().iter().enumerate() {
+            for d in 0..6 {
+                nodal[0][6 * nd + d] += t.qd[6 * a + d];
+                nodal[1][6 * nd + d] += t.de[6 * a + d];
+                nodal[2][6 * nd + d] += t.dc[6 * a + d];
+            }
+        }
+    }
+    // b = ∂(Ñᵀg)/∂β is a residual (through Ñ); the gradients of the
+    // energy terms are derivatives (through the end-point maps).
+    sys.reduce(&nodal[0], &mut work.b);
+    sys.topo.dofs.reduce(&nodal[1], &mut work.ge);
+    sys.topo.dofs.reduce(&nodal[2], &mut work.gc);
+    EnergySums {
+        e_tot,
+        c_tot,
+        e_scale,
+    }
+}
+
+/// The size of the step's increments, `(Σᵢ |uᵢ|² + |θᵢ|²)^½` with
+/// `uᵢ = xᵢ,ₙ₊₁ − xᵢ,ₙ` and `Rᵢ,ₙ₊₁ = cay(θᵢ) Rᵢ,ₙ`.
+fn step_increments<T: Bordered>(sys: &ReducedSystem<'_, T>) -> f64 {
+    let nodes = sys.end.config.x.len();
+    (0..nodes)
+        .map(|i| {
+            let (s0, s1) = (&sys.start.config, &sys.end.config);
+            let u = s1.x[i] - s0.x[i];
+            let th = cayley_inverse(&(s1.rot[i] * s0.rot[i].transpose()));
+            u.norm_squared() + th.norm_squared()
+        })
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// Factorises the tangent `K` and solves, with that one factorisation,
+/// `K y₁ = −r` and `K y₂ = b` into `work.y1`, `work.y2`.
+fn solve_both<T: Bordered>(
+    sys: &ReducedSystem<'_, T>,
+    lu: &mut SparseLu,
+    work: &mut BorderedWork,
+) -> Result<(), NewtonFailure> {
+    lu.factor(sys.tangent_values())
+        .map_err(NewtonFailure::LinearSolve)?;
+    for (y, v) in work.y1.iter_mut().zip(&work.r) {
+        *y = -v;
+    }
+    lu.solve(&mut work.y1).map_err(NewtonFailure::LinearSolve)?;
+    work.y2.copy_from_slice(&work.b);
+    lu.solve(&mut work.y2).map_err(NewtonFailure::LinearSolve)
+}
+
+/// The increment of β from the bordered system's last row, with the border
+/// `c = ∂e/∂q = ∇E + β∇C`, `d = ∂e/∂β = C`:
+/// `δβ = (−e − c·y₁)/(d − c·y₂)` — or `None` when the pivot `d − c·y₂` is
+/// negligible against `|d| + |c||y₂|` (or not finite): β has no lever on
+/// the energy in this step.
+fn beta_increment(work: &BorderedWork, c_tot: f64, energy: f64, beta: f64) -> Option<f64> {
+    // Border: c = ∂e/∂q = ∇E + β∇C, d = ∂e/∂β = C.
+    let c: Vec<f64> = work
+        .ge
+        .iter()
+        .zip(&work.gc)
+        .map(|(a, g)| a + beta * g)
+        .collect();
+    let cy1: f64 = c.iter().zip(&work.y1).map(|(a, b)| a * b).sum();
+    let cy2: f64 = c.iter().zip(&work.y2).map(|(a, b)| a * b).sum();
+    let pivot = c_tot - cy2;
+    let size = c_tot.abs()
+        + c.iter().map(|v| v * v).sum::<f64>().sqrt()
+            * work.y2.iter().map(|v| v * v).sum::<f64>().sqrt();
+    (pivot.abs() > TOLERANCES.border_pivot * size && pivot.is_finite())
+        .then(|| (-energy - cy1) / pivot)
 }
