@@ -33,7 +33,8 @@ pub enum SolveError {
     ElementRotation {
         /// Index of the element in the mesh.
         element: usize,
-        /// ` of beam "name"` where known, else empty.
+        /// ` (element k of beam "name", which has m)` where the mechanism
+        /// names its beams ([`crate::mechanism::Names`]), else empty.
         beam: String,
         /// Time (statics: load factor) of the rejected step.
         time: f64,

@@ -45,8 +45,8 @@ pub struct FreeMotion {
     pub nodes: Vec<usize>,
     /// How many nodes it moves in all.
     pub moving: usize,
-    /// Labels of `nodes` in the model's terms, filled by a caller that knows
-    /// them (empty: `node <n>`).
+    /// Labels of `nodes` in the model's terms ([`Mechanism::names`];
+    /// `node <n>` for an unnamed node).
     pub labels: Vec<String>,
     /// Names of the joints whose released coordinates it moves.
     pub joints: Vec<String>,
@@ -86,6 +86,16 @@ impl FreeMotion {
         motion.moving = nodes.len();
         nodes.sort_by(|&a, &b| sizes[b].total_cmp(&sizes[a]).then(a.cmp(&b)));
         nodes.truncate(NAMED);
+        if !mech.names.nodes.is_empty() {
+            motion.labels = nodes
+                .iter()
+                .map(|&n| {
+                    mech.names
+                        .node(n)
+                        .map_or_else(|| format!("node {n}"), str::to_owned)
+                })
+                .collect();
+        }
         motion.nodes = nodes;
         let released = |eqs: &Vec<Option<usize>>| {
             eqs.iter()

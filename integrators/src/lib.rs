@@ -30,7 +30,7 @@ pub mod tolerances;
 pub use constraints::{MechanismState, Topology};
 pub use error::{NewtonFailure, SolveError};
 pub use mechanism::{
-    FollowerLoad, JointInstance, LoadField, Mechanism, NodalLoad, PrescribedDof, RigidBody,
+    FollowerLoad, JointInstance, LoadField, Mechanism, Names, NodalLoad, PrescribedDof, RigidBody,
     Schedule,
 };
 pub use newton::NewtonSettings;

@@ -156,6 +156,52 @@ pub struct RigidBody {
     pub inertia: Matrix3<f64>,
 }
 
+/// What the model calls the mechanism's parts, so that a solver's error is
+/// born in the model's words. Empty for a mechanism built without names
+/// (nodes and elements are then numbered).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Names {
+    /// Every node's label (`arm.3`, `ground.pin`, `body.mass`); an empty
+    /// or missing entry: unnamed.
+    pub nodes: Vec<String>,
+    /// Every beam: its name and its elements' range in the mesh.
+    pub beams: Vec<(String, std::ops::Range<usize>)>,
+    /// Per prescribed DOF ([`Mechanism::prescribed`]), its entry in the
+    /// model's `[[prescribed]]` list (missing: the DOF's own index).
+    pub prescribed: Vec<usize>,
+}
+
+impl Names {
+    /// Node `n`'s label, if it has one.
+    pub fn node(&self, n: usize) -> Option<&str> {
+        self.nodes
+            .get(n)
+            .map(String::as_str)
+            .filter(|l| !l.is_empty())
+    }
+
+    /// Element `e` in its beam's words, ` (element k of beam "arm", which
+    /// has m)`, or empty.
+    pub fn element(&self, e: usize) -> String {
+        self.beams
+            .iter()
+            .find(|(_, r)| r.contains(&e))
+            .map(|(name, r)| {
+                format!(
+                    " (element {} of beam \"{name}\", which has {})",
+                    e - r.start,
+                    r.len()
+                )
+            })
+            .unwrap_or_default()
+    }
+
+    /// The model's `[[prescribed]]` entry of prescribed DOF `index`.
+    pub fn prescribed_entry(&self, index: usize) -> usize {
+        self.prescribed.get(index).copied().unwrap_or(index)
+    }
+}
+
 /// Everything a solver needs about the mechanism.
 #[derive(Debug, Clone)]
 pub struct Mechanism {
@@ -183,6 +229,8 @@ pub struct Mechanism {
     /// `C(ε + η ε̇)`; missing entries and 0: undamped). Newmark and
     /// generalized-α take it (FORMULATION §4.7).
     pub damping: Vec<f64>,
+    /// What the model calls its nodes, beams and prescribed DOFs.
+    pub names: Names,
 }
 
 impl Mechanism {
@@ -201,6 +249,7 @@ impl Mechanism {
             prescribed: Vec::new(),
             bodies: Vec::new(),
             damping: Vec::new(),
+            names: Names::default(),
         }
     }
 

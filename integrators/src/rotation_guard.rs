@@ -72,7 +72,7 @@ impl RotationGuard {
             let change = (now - before).abs();
             if p.dof >= 3 && change > Element::ROTATION_STEP_LIMIT {
                 return Err(SolveError::PrescribedRotationStep {
-                    index,
+                    index: mech.names.prescribed_entry(index),
                     time,
                     change,
                 });
@@ -85,7 +85,7 @@ impl RotationGuard {
                 if angle > Element::ROTATION_LIMIT || change > Element::ROTATION_STEP_LIMIT {
                     return Err(SolveError::ElementRotation {
                         element,
-                        beam: String::new(),
+                        beam: mech.names.element(element),
                         time,
                         angle,
                         change,

@@ -8,7 +8,7 @@ use flexmech_integrators::builder::{
     Beam, BeamDef, BuildError, Dof, JointDef, JointId, MechanismBuilder, NodeId,
 };
 use flexmech_integrators::dynamics::Motion;
-use flexmech_integrators::{Mechanism, Schedule};
+use flexmech_integrators::{Mechanism, Names, Schedule};
 use nalgebra::{Matrix3, Vector3};
 
 /// A mechanism with the numbering that relates it back to the model file.
@@ -175,8 +175,45 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         body_nodes,
     };
     built.motion = initial_motion(model, &built);
+    built.mechanism.names = names(model, &built);
     crate::initial_check::check(model, &built.mechanism, &built.beam_nodes, &built.motion)?;
     Ok(built)
+}
+
+/// The model's names of the built mechanism's parts: every node's label
+/// (beam nodes `arm.3`, ground nodes `ground.<joint>`, offset bodies'
+/// centres `body.<name>`), the beams' element ranges, and the
+/// `[[prescribed]]` entry of every prescribed nodal DOF (the mechanism
+/// numbers only those, not the driven joints).
+fn names(model: &Model, built: &Built) -> Names {
+    let mut nodes = vec![String::new(); built.mechanism.mesh.node_count()];
+    for (b, beam) in built.beam_nodes.iter().enumerate() {
+        for (k, &n) in beam.iter().enumerate() {
+            nodes[n] = model.node_label(NodeRef { beam: b, node: k });
+        }
+    }
+    for &(j, n) in &built.ground_nodes {
+        nodes[n] = format!("ground.{}", model.joints[j].name);
+    }
+    for &(b, n) in &built.body_nodes {
+        nodes[n] = format!("body.{}", model.rigid_bodies[b].name);
+    }
+    Names {
+        nodes,
+        beams: model
+            .beams
+            .iter()
+            .zip(&built.beam_elements)
+            .map(|(b, r)| (b.name.clone(), r.clone()))
+            .collect(),
+        prescribed: model
+            .prescribed
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| matches!(p, PrescribedSpec::NodeDof { .. }))
+            .map(|(i, _)| i)
+            .collect(),
+    }
 }
 
 /// Meshes the beams of `model` in `b`, with their sections' structural

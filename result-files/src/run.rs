@@ -471,7 +471,7 @@ fn run_with(
     let (outcome, setup) = solve(model, &built, restart, &mut keeper, start);
     let wall = start.elapsed().as_secs_f64();
     keeper.flush_last();
-    end(model, &built, keeper, outcome, wall, setup)
+    end(model, keeper, outcome, wall, setup)
 }
 
 /// Solves `model` with its analysis, handing every converged step to
@@ -584,10 +584,10 @@ fn solve_dynamic(
 }
 
 /// Ends the run in its sink: a sink's own failure first, then the solve's
-/// outcome (its errors named in the model's words).
+/// outcome (its errors are born in the model's words: the mechanism
+/// carries its names).
 fn end(
     model: &Model,
-    built: &Built,
     keeper: Keeper<'_>,
     outcome: Result<(), SolveError>,
     wall: f64,
@@ -626,8 +626,7 @@ fn end(
                 warnings: end.warnings,
             })
         }
-        Err(mut error) => {
-            name_the_beam(model, built, &mut error);
+        Err(error) => {
             let status = layout::failed_status(&error.to_string());
             sink.finish(&RunEnd::new(status, wall, &merit))
                 .map_err(RunError::from_sink)?;
@@ -658,18 +657,6 @@ fn command_line() -> String {
 /// Labels, elements and beams of the built mechanism, for `/mesh`.
 fn mesh_meta(model: &Model, built: &Built) -> MeshMeta {
     let mesh = &built.mechanism.mesh;
-    let mut node_labels = vec![String::new(); mesh.node_count()];
-    for (b, nodes) in built.beam_nodes.iter().enumerate() {
-        for (k, &n) in nodes.iter().enumerate() {
-            node_labels[n] = model.node_label(flexmech_model::NodeRef { beam: b, node: k });
-        }
-    }
-    for &(j, n) in &built.ground_nodes {
-        node_labels[n] = format!("ground.{}", model.joints[j].name);
-    }
-    for &(b, n) in &built.body_nodes {
-        node_labels[n] = format!("body.{}", model.rigid_bodies[b].name);
-    }
     let mut node_directors = vec![[[0.0; 3]; 3]; mesh.node_count()];
     for e in &mesh.elements {
         for (&n, l0) in e.nodes().iter().zip(e.initial_triads()) {
@@ -677,7 +664,7 @@ fn mesh_meta(model: &Model, built: &Built) -> MeshMeta {
         }
     }
     MeshMeta {
-        node_labels,
+        node_labels: built.mechanism.names.nodes.clone(),
         node_directors,
         elements: mesh.elements.iter().map(|e| e.nodes().to_vec()).collect(),
         beams: model
@@ -686,59 +673,5 @@ fn mesh_meta(model: &Model, built: &Built) -> MeshMeta {
             .zip(&built.beam_nodes)
             .map(|(b, nodes)| (b.name.clone(), nodes.clone()))
             .collect(),
-    }
-}
-
-/// Names the model's own entries in an error: the beam (and the element
-/// within it) of an element — elements are numbered beam after beam, in the
-/// model's order — and the `[[prescribed]]` entry of a prescribed nodal DOF
-/// (the mechanism numbers only the nodal ones), and the nodes of a free
-/// motion.
-fn name_the_beam(model: &Model, built: &Built, error: &mut SolveError) {
-    if let SolveError::Unrestrained { motion, .. } = error {
-        motion.labels = motion
-            .nodes
-            .iter()
-            .map(|&n| {
-                built
-                    .beam_nodes
-                    .iter()
-                    .enumerate()
-                    .find_map(|(b, nodes)| {
-                        nodes
-                            .iter()
-                            .position(|&m| m == n)
-                            .map(|k| model.node_label(flexmech_model::NodeRef { beam: b, node: k }))
-                    })
-                    .unwrap_or_else(|| format!("node {n}"))
-            })
-            .collect();
-    }
-    if let SolveError::PrescribedRotationStep { index, .. } = error {
-        if let Some(i) = model
-            .prescribed
-            .iter()
-            .enumerate()
-            .filter(|(_, p)| matches!(p, flexmech_model::PrescribedSpec::NodeDof { .. }))
-            .nth(*index)
-            .map(|(i, _)| i)
-        {
-            *index = i;
-        }
-    }
-    if let SolveError::ElementRotation { element, beam, .. } = error {
-        let mut first = 0;
-        for b in &model.beams {
-            if *element < first + b.elements {
-                *beam = format!(
-                    " (element {} of beam \"{}\", which has {})",
-                    *element - first,
-                    b.name,
-                    b.elements
-                );
-                return;
-            }
-            first += b.elements;
-        }
     }
 }
