@@ -11,8 +11,9 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use super::font::{self, text_width};
 use super::line::{
     px, Corner, Figure, Layout, AXIS_WIDTH, HEIGHT, LEGEND_COLUMN_GAP, LEGEND_FONT, LEGEND_GAP,
-    LEGEND_INSET, LEGEND_PAD, LEGEND_ROW, LEGEND_SAMPLE, LINE_WIDTH, MARGIN, MARKER_RADIUS,
+    LEGEND_INSET, LEGEND_PAD, LEGEND_ROW, LEGEND_SAMPLE, LINE_WIDTH, MARGIN,
 };
+use super::marks::draw_mark;
 use super::strokes::{dashed, pixels};
 
 impl Figure {
@@ -169,8 +170,8 @@ impl Figure {
                 ))?;
             }
             if curve.mark_every > 0 {
-                let c = (px(x0 + 0.5 * LEGEND_SAMPLE * s), px(y));
-                root.draw(&Circle::new(c, px(MARKER_RADIUS * s), curve.color.filled()))?;
+                let c = (x0 + 0.5 * LEGEND_SAMPLE * s, y);
+                draw_mark(root, c, curve.marker, curve.color, s)?;
             }
             root.draw(&Text::new(
                 curve.label.clone(),

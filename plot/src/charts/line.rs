@@ -16,10 +16,12 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::chart::{LineChart, AUTO_MARKERS};
+use super::chart::{LineChart, Series};
 use super::clip::clip_polyline;
 use super::font::{self, text_width};
+use super::marks::draw_mark;
 use super::strokes::{dashed, pixels};
+use super::style::Marker;
 use super::ticks::{Axis, TickRange};
 
 /// Width of the PNG (and of the SVG's canvas) in pixels.
@@ -135,23 +137,14 @@ impl LineChart {
     /// created. Nothing is written when the data are unusable.
     pub fn render(&self, stem: &Path) -> Result<(PathBuf, PathBuf), ChartError> {
         let png = with_suffix(stem, ".png");
-        let svg = with_suffix(stem, ".svg");
         let figure = Figure::prepare(self, &png)?;
-        if !font::ensure_registered() {
-            return Err(ChartError::Font { path: png });
-        }
-        if let Some(dir) = stem.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|source| ChartError::Io {
-                path: dir.to_path_buf(),
-                source,
-            })?;
-        }
-        write_png(&figure, &png)?;
-        write_svg(&figure, &svg)?;
         let csv = with_suffix(stem, ".csv");
-        super::pgfplots::write(self, &csv, &with_suffix(stem, ".tex"))
-            .map_err(|source| ChartError::Io { path: csv, source })?;
-        Ok((png, svg))
+        render_files(&figure, stem, |tex| {
+            super::pgfplots::write(self, &csv, tex).map_err(|source| ChartError::Io {
+                path: csv.clone(),
+                source,
+            })
+        })
     }
 
     /// [`Self::render`], then the PDF of the chart's PGFPlots copy
@@ -165,24 +158,76 @@ impl LineChart {
     }
 }
 
+/// What [`render_files`] draws: a canvas of some multiple of the chart size.
+pub(super) trait Canvas {
+    /// The output size in pixels.
+    fn size(&self) -> (u32, u32);
+
+    /// Draws on `root`, a canvas [`Self::size`] times `scale`.
+    fn paint<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        scale: f64,
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>;
+}
+
+impl Canvas for Figure {
+    fn size(&self) -> (u32, u32) {
+        (WIDTH, HEIGHT)
+    }
+
+    fn paint<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        scale: f64,
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+        self.draw(root, scale)
+    }
+}
+
+/// Writes `<stem>.png` and `<stem>.svg` of `canvas`, then the editable
+/// copies by `copies` (given the `.tex` path); returns the PNG and SVG.
+pub(super) fn render_files<C: Canvas>(
+    canvas: &C,
+    stem: &Path,
+    copies: impl FnOnce(&Path) -> Result<(), ChartError>,
+) -> Result<(PathBuf, PathBuf), ChartError> {
+    let png = with_suffix(stem, ".png");
+    let svg = with_suffix(stem, ".svg");
+    if !font::ensure_registered() {
+        return Err(ChartError::Font { path: png });
+    }
+    if let Some(dir) = stem.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|source| ChartError::Io {
+            path: dir.to_path_buf(),
+            source,
+        })?;
+    }
+    write_png(canvas, &png)?;
+    write_svg(canvas, &svg)?;
+    copies(&with_suffix(stem, ".tex"))?;
+    Ok((png, svg))
+}
+
 /// Plotters' bitmap backend does not anti-alias lines: the PNG is drawn at
 /// this multiple of its size and averaged down.
 const SUPERSAMPLE: u32 = 2;
 
-fn write_png(figure: &Figure, png: &Path) -> Result<(), ChartError> {
-    let (w, h) = (WIDTH * SUPERSAMPLE, HEIGHT * SUPERSAMPLE);
-    let mut big = vec![0u8; (w * h * 3) as usize];
+fn write_png<C: Canvas>(canvas: &C, png: &Path) -> Result<(), ChartError> {
+    let (width, height) = canvas.size();
+    let (w, h) = (width * SUPERSAMPLE, height * SUPERSAMPLE);
+    let mut big = vec![0u8; (w as usize) * (h as usize) * 3];
     {
         let root = BitMapBackend::with_buffer(&mut big, (w, h)).into_drawing_area();
-        figure
-            .draw(&root, f64::from(SUPERSAMPLE))
+        canvas
+            .paint(&root, f64::from(SUPERSAMPLE))
             .and_then(|()| root.present())
             .map_err(|e| draw_error(png, e))?;
     }
     let small = downsample(&big, w as usize, SUPERSAMPLE as usize);
-    let mut backend = BitMapBackend::new(png, (WIDTH, HEIGHT));
+    let mut backend = BitMapBackend::new(png, (width, height));
     backend
-        .blit_bitmap((0, 0), (WIDTH, HEIGHT), &small)
+        .blit_bitmap((0, 0), (width, height), &small)
         .and_then(|()| backend.present())
         .map_err(|e| ChartError::Draw {
             path: png.to_path_buf(),
@@ -213,12 +258,12 @@ fn downsample(rgb: &[u8], width: usize, factor: usize) -> Vec<u8> {
     out
 }
 
-fn write_svg(figure: &Figure, svg: &Path) -> Result<(), ChartError> {
+fn write_svg<C: Canvas>(canvas: &C, svg: &Path) -> Result<(), ChartError> {
     let mut text = String::new();
     {
-        let root = SVGBackend::with_string(&mut text, (WIDTH, HEIGHT)).into_drawing_area();
-        figure
-            .draw(&root, 1.0)
+        let root = SVGBackend::with_string(&mut text, canvas.size()).into_drawing_area();
+        canvas
+            .paint(&root, 1.0)
             .and_then(|()| root.present())
             .map_err(|e| draw_error(svg, e))?;
     }
@@ -239,7 +284,7 @@ fn write_svg(figure: &Figure, svg: &Path) -> Result<(), ChartError> {
     })
 }
 
-fn with_suffix(stem: &Path, suffix: &str) -> PathBuf {
+pub(super) fn with_suffix(stem: &Path, suffix: &str) -> PathBuf {
     let mut name = OsString::from(stem.as_os_str());
     name.push(suffix);
     PathBuf::from(name)
@@ -290,33 +335,8 @@ pub(super) enum Corner {
     Outside,
 }
 
-/// Okabe–Ito colours (distinguishable with colour-vision deficiencies).
-const PALETTE: [RGBColor; 6] = [
-    RGBColor(0, 114, 178),   // blue
-    RGBColor(213, 94, 0),    // vermilion
-    RGBColor(0, 158, 115),   // bluish green
-    RGBColor(204, 121, 167), // reddish purple
-    RGBColor(230, 159, 0),   // orange
-    RGBColor(86, 180, 233),  // sky blue
-];
-
-/// Dash patterns in pixels (on, off, on, off, …); empty = solid.
-const DASHES: [&[f64]; 6] = [
-    &[],
-    &[24.0, 12.0],
-    &[4.0, 10.0],
-    &[26.0, 10.0, 4.0, 10.0],
-    &[44.0, 14.0],
-    &[22.0, 8.0, 4.0, 8.0, 4.0, 8.0],
-];
-
 const MARKER_COLOR: RGBColor = RGBColor(60, 60, 60);
 const MARKER_DASH: &[f64] = &[14.0, 9.0];
-
-fn series_style(index: usize) -> (RGBColor, &'static [f64]) {
-    let n = PALETTE.len();
-    (PALETTE[index % n], DASHES[(index + index / n) % n])
-}
 
 pub(super) fn px(v: f64) -> i32 {
     v.round() as i32
@@ -334,6 +354,8 @@ pub(super) struct Curve {
     pub(super) runs: Vec<Vec<(f64, f64)>>,
     /// Marker on every k-th drawn point (0: none).
     pub(super) mark_every: usize,
+    /// Its shape ([`Marker::None`] when `mark_every` is 0).
+    pub(super) marker: Marker,
 }
 
 /// Pixel geometry of the figure at one drawing scale (1 for the SVG, the
@@ -372,67 +394,52 @@ pub(super) struct Figure {
     pub(super) legend_columns: usize,
 }
 
+/// The plot frame in pixels of the drawing area: plotters' own mapping of
+/// the axes' ends, and the plotting area's pixel ranges.
+struct Frame {
+    x0: i32,
+    y0: i32,
+    x1: i32,
+    y1: i32,
+    area: (std::ops::Range<i32>, std::ops::Range<i32>),
+}
+
+impl Frame {
+    /// The exact pixel position of a plotted point.
+    fn to_px(&self, lay: &Layout, (x, y): (f64, f64)) -> (f64, f64) {
+        let (x0, y0) = (f64::from(self.x0), f64::from(self.y0));
+        (
+            x0 + (x - lay.x.lo) / (lay.x.hi - lay.x.lo) * f64::from(self.x1 - self.x0),
+            y0 + (y - lay.y.lo) / (lay.y.hi - lay.y.lo) * f64::from(self.y1 - self.y0),
+        )
+    }
+
+    /// Left, top, right, bottom, the rectangle curves are clipped to.
+    fn rect(&self) -> (f64, f64, f64, f64) {
+        (
+            f64::from(self.x0),
+            f64::from(self.y1),
+            f64::from(self.x1),
+            f64::from(self.y0),
+        )
+    }
+}
+
 impl Figure {
-    fn prepare(chart: &LineChart, png: &Path) -> Result<Self, ChartError> {
+    pub(super) fn prepare(chart: &LineChart, png: &Path) -> Result<Self, ChartError> {
+        // Legend widths are measured with the embedded face: register it
+        // first, so the legend's place never depends on what was drawn before.
+        font::ensure_registered();
         let path = || png.to_path_buf();
         if chart.series.is_empty() {
             return Err(ChartError::NoSeries { path: path() });
         }
-        let mut curves = Vec::with_capacity(chart.series.len());
-        for (i, s) in chart.series.iter().enumerate() {
-            let label = || s.label.clone();
-            if s.x.len() != s.y.len() {
-                return Err(ChartError::LengthMismatch {
-                    path: path(),
-                    label: label(),
-                    x_len: s.x.len(),
-                    y_len: s.y.len(),
-                });
-            }
-            if s.x.is_empty() {
-                return Err(ChartError::EmptySeries {
-                    path: path(),
-                    label: label(),
-                });
-            }
-            let finite = |x: f64, y: f64| x.is_finite() && y.is_finite();
-            if !s.x.iter().zip(&s.y).any(|(&x, &y)| finite(x, y)) {
-                return Err(ChartError::NoFinitePoints {
-                    path: path(),
-                    label: label(),
-                });
-            }
-            let mut runs = Vec::new();
-            let mut run = Vec::new();
-            for (&x, &y) in s.x.iter().zip(&s.y) {
-                if finite(x, y) && (!chart.log_y || y > 0.0) {
-                    run.push((x, if chart.log_y { y.log10() } else { y }));
-                } else if !run.is_empty() {
-                    runs.push(std::mem::take(&mut run));
-                }
-            }
-            if !run.is_empty() {
-                runs.push(run);
-            }
-            if runs.is_empty() {
-                return Err(ChartError::NoPositivePoints {
-                    path: path(),
-                    label: label(),
-                });
-            }
-            let (color, dash) = series_style(i);
-            let points: usize = runs.iter().map(Vec::len).sum();
-            curves.push(Curve {
-                label: s.label.clone(),
-                color,
-                dash,
-                runs,
-                mark_every: match s.mark_every {
-                    0 if points <= AUTO_MARKERS => 1,
-                    k => k,
-                },
-            });
-        }
+        let curves = chart
+            .series
+            .iter()
+            .enumerate()
+            .map(|(i, s)| Curve::of(s, i, chart.log_y, png))
+            .collect::<Result<Vec<_>, _>>()?;
         for (x, label) in &chart.markers {
             if !x.is_finite() {
                 return Err(ChartError::BadMarker {
@@ -444,17 +451,7 @@ impl Figure {
         }
 
         let points = || curves.iter().flat_map(|c| c.runs.iter().flatten());
-        let (x_lo, x_hi) = min_max(points().map(|p| p.0));
-        let (mut x_lo, mut x_hi) = widen_if_flat(x_lo, x_hi);
-        // A marker at (or beyond) an end of the data: a little room so its
-        // line is not hidden by the frame.
-        let span = x_hi - x_lo;
-        if chart.markers.iter().any(|m| m.0 <= x_lo) {
-            x_lo = chart.markers.iter().fold(x_lo, |lo, m| lo.min(m.0)) - 0.02 * span;
-        }
-        if chart.markers.iter().any(|m| m.0 >= x_hi) {
-            x_hi = chart.markers.iter().fold(x_hi, |hi, m| hi.max(m.0)) + 0.02 * span;
-        }
+        let x_range = x_range(min_max(points().map(|p| p.0)), &chart.markers);
         let (d_lo, d_hi) = min_max(points().map(|p| p.1));
         let y_range = if chart.log_y {
             (d_lo, d_hi)
@@ -471,7 +468,7 @@ impl Figure {
             log_y: chart.log_y,
             curves,
             markers: chart.markers.clone(),
-            x_range: (x_lo, x_hi),
+            x_range,
             y_range,
             legend: None,
             legend_columns: 1,
@@ -484,8 +481,9 @@ impl Figure {
         Layout::compute(self, scale)
     }
 
-    /// Draws the figure on a canvas `scale` times the output size.
-    fn draw<DB: DrawingBackend>(
+    /// Draws the figure on a canvas `scale` times the output size (a whole
+    /// drawing area of [`WIDTH`] × [`HEIGHT`] times `scale`).
+    pub(super) fn draw<DB: DrawingBackend>(
         &self,
         root: &DrawingArea<DB, Shift>,
         scale: f64,
@@ -493,6 +491,53 @@ impl Figure {
         let lay = self.layout(scale);
         let s = scale;
         root.fill(&WHITE)?;
+        let frame = self.draw_mesh(root, &lay)?;
+
+        // Markers under the curves.
+        let marker_style = MARKER_COLOR.stroke_width(px(1.5 * AXIS_WIDTH * s) as u32);
+        let marker_dash: Vec<f64> = MARKER_DASH.iter().map(|d| d * s).collect();
+        for (x, _) in &self.markers {
+            let line = [
+                frame.to_px(&lay, (*x, lay.y.lo)),
+                frame.to_px(&lay, (*x, lay.y.hi)),
+            ];
+            for piece in dashed(&line, &marker_dash) {
+                root.draw(&PathElement::new(pixels(&piece), marker_style))?;
+            }
+        }
+        for curve in &self.curves {
+            curve.draw(root, &lay, &frame)?;
+        }
+
+        // Frame around the plot.
+        let (xr, yr) = &frame.area;
+        root.draw(&Rectangle::new(
+            [(xr.start, yr.start), (xr.end - 1, yr.end - 1)],
+            BLACK.stroke_width(px(AXIS_WIDTH * s) as u32),
+        ))?;
+
+        self.draw_notes(root, &lay, (frame.x0, frame.y1, frame.x1))?;
+        if !self.title.is_empty() {
+            root.draw(&Text::new(
+                self.title.clone(),
+                (px(f64::from(WIDTH) * s / 2.0), px(MARGIN * s)),
+                font::text(TITLE_FONT * s).pos(Pos::new(HPos::Center, VPos::Top)),
+            ))?;
+        }
+        if let Some(corner) = self.legend {
+            self.draw_legend(root, &lay, corner)?;
+        }
+        Ok(())
+    }
+
+    /// Axes, tick labels, grid and axis labels (plotters'); returns where
+    /// the plot frame is, in pixels of `root`.
+    fn draw_mesh<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        lay: &Layout,
+    ) -> Result<Frame, DrawingAreaErrorKind<DB::ErrorType>> {
+        let s = lay.scale;
         let mut chart = ChartBuilder::on(root)
             .margin_top(px(lay.top))
             .margin_bottom(px(lay.bottom_margin))
@@ -519,88 +564,19 @@ impl Figure {
             .y_labels(lay.y.ticks.len().max(1))
             .max_light_lines(10)
             .draw()?;
-
-        // Exact pixel mapping of the plot, taken from plotters' own.
-        let (px0, py0) = chart.backend_coord(&(lay.x.lo, lay.y.lo));
-        let (px1, py1) = chart.backend_coord(&(lay.x.hi, lay.y.hi));
-        let to_px = |(x, y): (f64, f64)| {
-            (
-                f64::from(px0) + (x - lay.x.lo) / (lay.x.hi - lay.x.lo) * f64::from(px1 - px0),
-                f64::from(py0) + (y - lay.y.lo) / (lay.y.hi - lay.y.lo) * f64::from(py1 - py0),
-            )
-        };
-        let scaled = |pattern: &[f64]| -> Vec<f64> { pattern.iter().map(|d| d * s).collect() };
-
-        // Markers under the curves.
-        let marker_style = MARKER_COLOR.stroke_width(px(1.5 * AXIS_WIDTH * s) as u32);
-        for (x, _) in &self.markers {
-            let line = [to_px((*x, lay.y.lo)), to_px((*x, lay.y.hi))];
-            for piece in dashed(&line, &scaled(MARKER_DASH)) {
-                root.draw(&PathElement::new(pixels(&piece), marker_style))?;
-            }
-        }
-
-        // Curves clipped to the plot frame.
-        let frame = (
-            f64::from(px0),
-            f64::from(py1),
-            f64::from(px1),
-            f64::from(py0),
-        );
-        let line_width = px(LINE_WIDTH * s);
-        let mark =
-            |c: (f64, f64)| c.0 >= frame.0 && c.0 <= frame.2 && c.1 >= frame.1 && c.1 <= frame.3;
-        for curve in &self.curves {
-            let style = curve.color.stroke_width(line_width as u32);
-            let dash = scaled(curve.dash);
-            let mut index = 0usize;
-            for run in &curve.runs {
-                let pts: Vec<(f64, f64)> = run.iter().map(|&p| to_px(p)).collect();
-                for inside in clip_polyline(&pts, frame) {
-                    if inside.len() == 1 {
-                        let c = pixels(&inside)[0];
-                        root.draw(&Circle::new(c, line_width, curve.color.filled()))?;
-                        continue;
-                    }
-                    for piece in dashed(&inside, &dash) {
-                        root.draw(&PathElement::new(pixels(&piece), style))?;
-                    }
-                }
-                if curve.mark_every > 0 {
-                    for &p in &pts {
-                        if index.is_multiple_of(curve.mark_every) && mark(p) {
-                            let c = (px(p.0), px(p.1));
-                            root.draw(&Circle::new(
-                                c,
-                                px(MARKER_RADIUS * s),
-                                curve.color.filled(),
-                            ))?;
-                        }
-                        index += 1;
-                    }
-                }
-            }
-        }
-
-        // Frame around the plot.
+        // Plotters maps to the backend's pixels; `root` may be one panel of
+        // a larger canvas, whose own pixels start at its base.
+        let (bx, by) = root.get_base_pixel();
+        let (x0, y0) = chart.backend_coord(&(lay.x.lo, lay.y.lo));
+        let (x1, y1) = chart.backend_coord(&(lay.x.hi, lay.y.hi));
         let (xr, yr) = chart.plotting_area().get_pixel_range();
-        root.draw(&Rectangle::new(
-            [(xr.start, yr.start), (xr.end - 1, yr.end - 1)],
-            BLACK.stroke_width(px(AXIS_WIDTH * s) as u32),
-        ))?;
-
-        self.draw_notes(root, &lay, (px0, py1, px1))?;
-        if !self.title.is_empty() {
-            root.draw(&Text::new(
-                self.title.clone(),
-                (px(f64::from(WIDTH) * s / 2.0), px(MARGIN * s)),
-                font::text(TITLE_FONT * s).pos(Pos::new(HPos::Center, VPos::Top)),
-            ))?;
-        }
-        if let Some(corner) = self.legend {
-            self.draw_legend(root, &lay, corner)?;
-        }
-        Ok(())
+        Ok(Frame {
+            x0: x0 - bx,
+            y0: y0 - by,
+            x1: x1 - bx,
+            y1: y1 - by,
+            area: (xr.start - bx..xr.end - bx, yr.start - by..yr.end - by),
+        })
     }
 
     /// Marker labels and the axes' common factors, outside the plot.
@@ -641,6 +617,103 @@ impl Figure {
                 (px(start), row_y(row)),
                 note.pos(Pos::new(HPos::Left, VPos::Bottom)),
             ))?;
+        }
+        Ok(())
+    }
+}
+
+impl Curve {
+    /// The `index`-th series of a chart, checked and cut into runs of
+    /// drawable points (log10 of `y` on a logarithmic axis).
+    fn of(s: &Series, index: usize, log_y: bool, png: &Path) -> Result<Self, ChartError> {
+        let path = || png.to_path_buf();
+        let label = || s.label.clone();
+        if s.x.len() != s.y.len() {
+            return Err(ChartError::LengthMismatch {
+                path: path(),
+                label: label(),
+                x_len: s.x.len(),
+                y_len: s.y.len(),
+            });
+        }
+        if s.x.is_empty() {
+            return Err(ChartError::EmptySeries {
+                path: path(),
+                label: label(),
+            });
+        }
+        let finite = |x: f64, y: f64| x.is_finite() && y.is_finite();
+        if !s.x.iter().zip(&s.y).any(|(&x, &y)| finite(x, y)) {
+            return Err(ChartError::NoFinitePoints {
+                path: path(),
+                label: label(),
+            });
+        }
+        let mut runs = Vec::new();
+        let mut run = Vec::new();
+        for (&x, &y) in s.x.iter().zip(&s.y) {
+            if finite(x, y) && (!log_y || y > 0.0) {
+                run.push((x, if log_y { y.log10() } else { y }));
+            } else if !run.is_empty() {
+                runs.push(std::mem::take(&mut run));
+            }
+        }
+        if !run.is_empty() {
+            runs.push(run);
+        }
+        if runs.is_empty() {
+            return Err(ChartError::NoPositivePoints {
+                path: path(),
+                label: label(),
+            });
+        }
+        let points: usize = runs.iter().map(Vec::len).sum();
+        let (color, style, marker, mark_every) = s.resolved_style(index, points);
+        Ok(Self {
+            label: s.label.clone(),
+            color: color.plotters(),
+            dash: style.pixels(),
+            runs,
+            mark_every,
+            marker,
+        })
+    }
+
+    /// The curve clipped to the plot frame, then its markers.
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        lay: &Layout,
+        frame: &Frame,
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+        let s = lay.scale;
+        let rect = frame.rect();
+        let line_width = px(LINE_WIDTH * s);
+        let style = self.color.stroke_width(line_width as u32);
+        let dash: Vec<f64> = self.dash.iter().map(|d| d * s).collect();
+        let inside =
+            |c: (f64, f64)| c.0 >= rect.0 && c.0 <= rect.2 && c.1 >= rect.1 && c.1 <= rect.3;
+        let mut index = 0usize;
+        for run in &self.runs {
+            let pts: Vec<(f64, f64)> = run.iter().map(|&p| frame.to_px(lay, p)).collect();
+            for piece in clip_polyline(&pts, rect) {
+                if piece.len() == 1 {
+                    let c = pixels(&piece)[0];
+                    root.draw(&Circle::new(c, line_width, self.color.filled()))?;
+                    continue;
+                }
+                for dash in dashed(&piece, &dash) {
+                    root.draw(&PathElement::new(pixels(&dash), style))?;
+                }
+            }
+            if self.mark_every > 0 {
+                for &p in &pts {
+                    if index.is_multiple_of(self.mark_every) && inside(p) {
+                        draw_mark(root, p, self.marker, self.color, s)?;
+                    }
+                    index += 1;
+                }
+            }
         }
         Ok(())
     }
@@ -738,6 +811,20 @@ impl Layout {
             b - (y - self.y.lo) / (self.y.hi - self.y.lo) * (b - t),
         )
     }
+}
+
+/// The plotted x range: the data's, with a little room for a marker line at
+/// (or beyond) an end of the data, so that the frame does not hide it.
+fn x_range((lo, hi): (f64, f64), markers: &[(f64, String)]) -> (f64, f64) {
+    let (mut x_lo, mut x_hi) = widen_if_flat(lo, hi);
+    let span = x_hi - x_lo;
+    if markers.iter().any(|m| m.0 <= x_lo) {
+        x_lo = markers.iter().fold(x_lo, |lo, m| lo.min(m.0)) - 0.02 * span;
+    }
+    if markers.iter().any(|m| m.0 >= x_hi) {
+        x_hi = markers.iter().fold(x_hi, |hi, m| hi.max(m.0)) + 0.02 * span;
+    }
+    (x_lo, x_hi)
 }
 
 fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {

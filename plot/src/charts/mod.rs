@@ -7,17 +7,28 @@
 //! Text uses only the DejaVu Sans face embedded through [`font`], never a
 //! system font. [`plot_datasets`] is the `flexmech plot` command: charts of
 //! HDF5 result datasets over `/time`.
+//!
+//! A [`Series`] may set its own [`Color`], [`Dash`] and [`Marker`]; unset,
+//! it keeps the automatic cycle ([`auto_style`]). [`Panels`] lays several
+//! charts out in a row or a grid, as one PNG, SVG and PGFPlots copy.
 
 mod chart;
 mod clip;
 pub mod font;
 mod legend;
 mod line;
+mod marks;
+mod panels;
 pub mod pgfplots;
 mod plot;
 mod strokes;
+mod style;
+#[cfg(test)]
+mod tests;
 mod ticks;
 
 pub use chart::{LineChart, Series, AUTO_MARKERS};
 pub use line::{ChartError, HEIGHT, WIDTH};
+pub use panels::Panels;
 pub use plot::{plot_datasets, plot_with, unit_of, PlotError, PlotOptions};
+pub use style::{auto_style, Color, Dash, Marker};

@@ -10,29 +10,20 @@
 //! `geometry` only) to one page holding the figure; the `tikzpicture` inside
 //! is what a paper copies. Labels are the chart's, with Greek letters, sub-
 //! and superscripts and the minus sign written as LaTeX math.
+//!
+//! The copy agrees with the PNG and SVG ([`super::line`]) on what a reader
+//! compares: the title, axis labels and legend entries (a curve without a
+//! label has none in either), the legend's corner (`legend pos`) or its
+//! place below the plot with as many columns, the axis limits, and each
+//! curve's colour, dash pattern and markers (solid, as in the PNG). A
+//! [`super::Panels`] figure is one `groupplot` with an axis per chart.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::chart::{LineChart, Series, AUTO_MARKERS};
-
-/// The curves' colours (Okabe–Ito, as the PNG) and dash patterns.
-const COLORS: [(&str, &str); 6] = [
-    ("fmblue", "0,114,178"),
-    ("fmvermilion", "213,94,0"),
-    ("fmgreen", "0,158,115"),
-    ("fmpurple", "204,121,167"),
-    ("fmorange", "230,159,0"),
-    ("fmsky", "86,180,233"),
-];
-const DASHES: [&str; 6] = [
-    "solid",
-    "dashed",
-    "dotted",
-    "dashdotted",
-    "densely dashed",
-    "loosely dotted",
-];
+use super::chart::{LineChart, Series};
+use super::line::{Corner, Figure};
+use super::style::{Color, PGF_COLOR_NAMES};
 
 fn number(v: f64) -> String {
     if v.is_finite() {
@@ -44,26 +35,35 @@ fn number(v: f64) -> String {
 
 /// The chart's data, two columns per curve.
 pub fn csv(chart: &LineChart) -> String {
+    csv_of(&[("", chart)])
+}
+
+/// The data of several charts in one table: two columns per curve, named
+/// `<prefix>x<i>`, `<prefix>y<i>`, each chart's after the other's.
+pub(super) fn csv_of(charts: &[(&str, &LineChart)]) -> String {
     let mut out = String::new();
-    let header: Vec<String> = (0..chart.series.len())
-        .flat_map(|i| [format!("x{i}"), format!("y{i}")])
+    let header: Vec<String> = charts
+        .iter()
+        .flat_map(|(prefix, chart)| {
+            (0..chart.series.len())
+                .flat_map(move |i| [format!("{prefix}x{i}"), format!("{prefix}y{i}")])
+        })
         .collect();
     out.push_str(&header.join(","));
     out.push('\n');
-    let rows = chart
-        .series
+    let rows = charts
         .iter()
-        .map(|s| s.x.len().min(s.y.len()))
+        .flat_map(|(_, c)| c.series.iter().map(|s| s.x.len().min(s.y.len())))
         .max()
         .unwrap_or(0);
     for r in 0..rows {
-        let cells: Vec<String> = chart
-            .series
+        let cells: Vec<String> = charts
             .iter()
-            .flat_map(|s: &Series| {
+            .flat_map(|(_, chart)| chart.series.iter().map(move |s| (chart.log_y, s)))
+            .flat_map(|(log_y, s): (bool, &Series)| {
                 if r < s.x.len().min(s.y.len()) {
                     // A logarithmic axis leaves non-positive values out, as the PNG does.
-                    let y = if chart.log_y && s.y[r] <= 0.0 {
+                    let y = if log_y && s.y[r] <= 0.0 {
                         f64::NAN
                     } else {
                         s.y[r]
@@ -182,23 +182,104 @@ pub fn latex(text: &str) -> String {
 }
 
 /// The PGFPlots document drawing `chart` from the CSV file `csv_name`
-/// (relative to the `.tex` file).
+/// (relative to the `.tex` file). Title, axis labels, legend entries, the
+/// legend's corner and columns, the axis limits and each curve's colour,
+/// pattern and markers are those of the chart's PNG and SVG.
 pub fn tex(chart: &LineChart, csv_name: &str) -> String {
+    let figure = Figure::prepare(chart, Path::new(csv_name)).ok();
+    let mut body = String::from("\\begin{axis}[\n");
+    body.push_str(&axis_options(chart, figure.as_ref()));
+    body.push_str("]\n");
+    body.push_str(&axis_body(chart, csv_name, ""));
+    body.push_str("\\end{axis}\n");
+    let below = figure.as_ref().map_or(0, legend_rows_below);
+    document((15.0, 11.0 + 0.6 * below as f64), false, &body)
+}
+
+/// Rows of a legend put below the plot (0 for one inside it).
+pub(super) fn legend_rows_below(figure: &Figure) -> usize {
+    if figure.legend == Some(Corner::Outside) {
+        figure.legend_lines().div_ceil(figure.legend_columns.max(1))
+    } else {
+        0
+    }
+}
+
+/// A whole `.tex` document: page size in cm, whether it needs the
+/// `groupplots` library, and the `tikzpicture`'s body.
+pub(super) fn document((width, height): (f64, f64), groups: bool, body: &str) -> String {
     let mut t = String::from(
         "% Made by flexmech: the chart's data are in the CSV file next to this one.\n\
          % Compile with pdflatex; copy the tikzpicture into a paper to restyle it.\n\
-         \\documentclass{article}\n\
-         \\usepackage[paperwidth=15cm,paperheight=11cm,margin=0.3cm]{geometry}\n\
-         \\usepackage{pgfplots}\n\
-         \\pgfplotsset{compat=1.16}\n\\pagestyle{empty}\n",
+         \\documentclass{article}\n",
     );
-    for (name, rgb) in COLORS {
-        let _ = writeln!(t, "\\definecolor{{{name}}}{{RGB}}{{{rgb}}}");
+    let _ = writeln!(
+        t,
+        "\\usepackage[paperwidth={width}cm,paperheight={height}cm,margin=0.3cm]{{geometry}}"
+    );
+    t.push_str("\\usepackage{pgfplots}\n");
+    if groups {
+        t.push_str("\\usepgfplotslibrary{groupplots}\n");
     }
-    t.push_str("\\begin{document}\n\\begin{tikzpicture}\n\\begin{axis}[\n");
-    t.push_str("  width=13.5cm, height=8.5cm, grid=major, grid style={gray!25},\n");
-    t.push_str("  unbounded coords=jump, legend cell align=left, legend columns=2,\n");
-    t.push_str("  legend style={font=\\small, draw=gray!60, at={(0.5,-0.2)}, anchor=north},\n");
+    t.push_str("\\pgfplotsset{compat=1.16}\n\\pagestyle{empty}\n");
+    for (name, c) in PGF_COLOR_NAMES.iter().zip(Color::PALETTE) {
+        let _ = writeln!(
+            t,
+            "\\definecolor{{{name}}}{{RGB}}{{{},{},{}}}",
+            c.r, c.g, c.b
+        );
+    }
+    t.push_str("\\begin{document}\n\\begin{tikzpicture}\n");
+    t.push_str(body);
+    t.push_str("\\end{tikzpicture}\n\\end{document}\n");
+    t
+}
+
+/// The options of one chart's axis (one per line, inside `[…]`): the
+/// look, the PNG's limits and legend place (when the chart can be drawn),
+/// labels and title.
+pub(super) fn axis_options(chart: &LineChart, figure: Option<&Figure>) -> String {
+    let mut t = String::from("  width=13.5cm, height=8.5cm, grid=major, grid style={gray!25},\n");
+    let columns = figure.map_or(1, |f| f.legend_columns.max(1));
+    let _ = writeln!(
+        t,
+        "  unbounded coords=jump, legend cell align=left, legend columns={columns},"
+    );
+    let place = match figure.and_then(|f| f.legend.map(|c| (f, c))) {
+        Some((f, Corner::Outside)) => {
+            // As far below the plot, in its heights, as the PNG's legend.
+            let lay = f.layout(1.0);
+            let (_, top, _, bottom) = lay.plot;
+            let (_, legend_top, _, _) = f.legend_box(&lay, Corner::Outside);
+            format!(
+                "at={{(0,{:.3})}}, anchor=north west",
+                -(legend_top - bottom) / (bottom - top)
+            )
+        }
+        Some((_, corner)) => format!("legend pos={}", pgf_corner(corner)),
+        None => "legend pos=north east".to_owned(),
+    };
+    if place.starts_with("legend pos") {
+        let _ = writeln!(t, "  {place},");
+        t.push_str("  legend style={font=\\small, draw=gray!60, fill=white},\n");
+    } else {
+        let _ = writeln!(
+            t,
+            "  legend style={{font=\\small, draw=gray!60, fill=white, {place}}},"
+        );
+    }
+    if let Some(f) = figure {
+        let lay = f.layout(1.0);
+        let y = |v: f64| number(if f.log_y { 10f64.powf(v) } else { v });
+        let _ = writeln!(
+            t,
+            "  xmin={}, xmax={}, ymin={}, ymax={},",
+            number(lay.x.lo),
+            number(lay.x.hi),
+            y(lay.y.lo),
+            y(lay.y.hi)
+        );
+    }
     let _ = writeln!(t, "  xlabel={{{}}},", latex(&chart.x_label));
     let _ = writeln!(t, "  ylabel={{{}}},", latex(&chart.y_label));
     if !chart.title.is_empty() {
@@ -210,27 +291,50 @@ pub fn tex(chart: &LineChart, csv_name: &str) -> String {
     if !chart.markers.is_empty() {
         t.push_str("  clip=false,\n");
     }
-    t.push_str("]\n");
+    t
+}
+
+/// The PGFPlots legend position of a corner inside the plot.
+fn pgf_corner(corner: Corner) -> &'static str {
+    match corner {
+        Corner::UpperRight | Corner::Outside => "north east",
+        Corner::UpperLeft => "north west",
+        Corner::LowerRight => "south east",
+        Corner::LowerLeft => "south west",
+    }
+}
+
+/// The `\addplot`s of one chart (columns `<prefix>x<i>`, `<prefix>y<i>`
+/// of `csv_name`), their legend entries and the marker lines. A curve
+/// without a label is left out of the legend (`forget plot`), as in the PNG.
+pub(super) fn axis_body(chart: &LineChart, csv_name: &str, prefix: &str) -> String {
+    let mut t = String::new();
     for (i, s) in chart.series.iter().enumerate() {
-        let (color, _) = COLORS[i % COLORS.len()];
         let points =
             s.x.iter()
                 .zip(&s.y)
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .filter(|&(x, &y)| x.is_finite() && y.is_finite() && (!chart.log_y || y > 0.0))
                 .count();
-        let marks = match s.mark_every {
-            0 if points <= AUTO_MARKERS => "mark=*, mark size=1.5pt".to_owned(),
-            0 => "no markers".to_owned(),
-            k => format!("mark=*, mark size=1.5pt, mark repeat={k}"),
+        let (color, dash, marker, every) = s.resolved_style(i, points);
+        let marks = match (marker.pgf(), every) {
+            (None, _) | (_, 0) => "no markers".to_owned(),
+            (Some(m), 1) => format!("mark={m}, mark size=1.5pt, mark options={{solid}}"),
+            (Some(m), k) => {
+                format!("mark={m}, mark size=1.5pt, mark options={{solid}}, mark repeat={k}")
+            }
+        };
+        let forget = if s.label.is_empty() {
+            ", forget plot"
+        } else {
+            ""
         };
         let _ = writeln!(
             t,
-            "\\addplot[{color}, {}, thick, {marks}] table[x=x{i}, y=y{i}, col sep=comma] {{{csv_name}}};",
-            DASHES[i % DASHES.len()]
+            "\\addplot[{}, {}, thick, {marks}{forget}] table[x={prefix}x{i}, y={prefix}y{i}, col sep=comma] {{{csv_name}}};",
+            color.pgf(),
+            dash.pgf()
         );
-        if s.label.is_empty() {
-            t.push_str("\\addlegendentry{}\n");
-        } else {
+        if !s.label.is_empty() {
             let _ = writeln!(t, "\\addlegendentry{{{}}}", latex(&s.label));
         }
     }
@@ -243,7 +347,6 @@ pub fn tex(chart: &LineChart, csv_name: &str) -> String {
             latex(label)
         );
     }
-    t.push_str("\\end{axis}\n\\end{tikzpicture}\n\\end{document}\n");
     t
 }
 
