@@ -230,10 +230,11 @@ fn iterate<S: NewtonSystem>(
         }
         let floored = at_floor(norm, &mut previous_norm, sys.floor());
         if res <= settings.tolerance || floored {
+            let residual = reported_residual(res, norm, scale, sys.floor());
             return Ok(NewtonReport {
                 iterations: it,
                 factorizations,
-                residual: res,
+                residual,
                 history,
             });
         }
@@ -293,6 +294,25 @@ fn iterate<S: NewtonSystem>(
         iterations: settings.max_iterations,
         residual: *history.last().unwrap_or(&f64::NAN),
     })
+}
+
+/// A force scale at most this many round-off floors is itself round-off:
+/// the loads vanish (a zero load, or only drivers moving the mechanism
+/// rigidly) and the forces that cancel in the residual are noise.
+const DEGENERATE_SCALE: f64 = 1e3;
+
+/// The residual an accepted iterate reports (`/solver/residual`): its
+/// scaled residual `res = ‖r‖/scale`, except where the scale degenerates
+/// (below [`DEGENERATE_SCALE`] round-off floors), where `res` is round-off
+/// over round-off (≈ 1) and says nothing; there the norm is measured
+/// against the structure's own force scale, the one the round-off floor
+/// `4 ε ‖force scales‖` is made of. Newton's decisions never use it.
+fn reported_residual(res: f64, norm: f64, scale: f64, floor: f64) -> f64 {
+    if floor > 0.0 && scale <= DEGENERATE_SCALE * floor {
+        norm * 4.0 * f64::EPSILON / floor
+    } else {
+        res
+    }
 }
 
 /// Refuses a converged iterate whose tangent is singular (its solution is
