@@ -219,6 +219,87 @@ fn create_group(
         .ctx(path, || format!("writing the description of {name}"))
 }
 
+/// Creates the scalar attribute `name` of `loc` holding `value`.
+fn scalar_attr<T: H5Type>(loc: &Location, name: &str, value: T) -> hdf5::Result<()> {
+    loc.new_attr::<T>()
+        .shape(())
+        .create(name)
+        .and_then(|a| a.as_writer().write_scalar(&value))
+}
+
+/// The file being created, for making its groups and datasets (errors name
+/// `path`).
+#[derive(Clone, Copy)]
+struct Creator<'a> {
+    file: &'a File,
+    path: &'a Path,
+}
+
+impl Creator<'_> {
+    /// A group with its description (see [`create_group`]).
+    fn group(self, name: &str, description: &str) -> Result<(), ResultError> {
+        create_group(self.file, self.path, name, description)
+    }
+
+    /// A group with its description and the `u64` scalar attributes
+    /// `attrs` (`(name, value)`, e.g. a node or joint index).
+    fn indexed_group(
+        self,
+        group: &str,
+        description: &str,
+        attrs: &[(&str, usize)],
+    ) -> Result<(), ResultError> {
+        self.group(group, description)?;
+        let g = self
+            .file
+            .group(group)
+            .ctx(self.path, || format!("opening group {group}"))?;
+        for &(attr, value) in attrs {
+            scalar_attr(&g, attr, value as u64)
+                .ctx(self.path, || format!("writing {group} attribute {attr}"))?;
+        }
+        Ok(())
+    }
+
+    /// A `T` or `T×n` series of `T`s ([`Series::time_series`]).
+    fn series<T: H5Type>(
+        self,
+        name: &str,
+        tail: &[usize],
+        description: &str,
+    ) -> Result<Series, ResultError> {
+        Series::time_series::<T>(self.file, self.path, name, tail, description)
+    }
+
+    /// A `T` or `T×n` series of `f64`s.
+    fn f64s(self, name: &str, tail: &[usize], description: &str) -> Result<Series, ResultError> {
+        self.series::<f64>(name, tail, description)
+    }
+
+    /// A `T × count × width` series of `f64`s, chunked by rows of at most
+    /// [`CONFIG_CHUNK_BYTES`].
+    fn block(
+        self,
+        name: &str,
+        count: usize,
+        width: usize,
+        description: &str,
+    ) -> Result<Series, ResultError> {
+        let count_chunk = count.clamp(1, CONFIG_CHUNK_NODES);
+        let rows = (CONFIG_CHUNK_BYTES / (count_chunk * width * 8)).clamp(1, CONFIG_CHUNK_ROWS);
+        let chunk = [rows, count_chunk, width];
+        Series::create::<f64>(
+            self.file,
+            self.path,
+            name,
+            0,
+            &[count, width],
+            &chunk,
+            description,
+        )
+    }
+}
+
 /// One extendable dataset: rows along the first (unlimited) dimension, fixed
 /// trailing dimensions.
 struct Series {
@@ -336,33 +417,75 @@ impl Series {
     }
 }
 
-struct NodeSets {
-    index: usize,
-    position: Series,
-    displacement: Series,
-    rotation: Series,
+/// A 1-D series and the value of a record that goes into it.
+type Column<'a, T> = (&'a Series, fn(&StepRecord) -> T);
+
+/// Extends each 1-D series of `columns` by one value per record: the
+/// value its function takes from the record.
+fn push_columns<T: H5Type>(
+    t0: usize,
+    recs: &[StepRecord],
+    path: &Path,
+    columns: &[Column<'_, T>],
+) -> Result<(), ResultError> {
+    for &(series, value) in columns {
+        let values: Vec<T> = recs.iter().map(value).collect();
+        series.push_scalars(t0, &values, path)?;
+    }
+    Ok(())
 }
 
-struct JointSets {
-    /// Absent for a joint without a released angle.
-    angle: Option<Series>,
-    reaction_force: Series,
-    reaction_moment: Series,
-    released_translation: Series,
-    constraint_error: Series,
+/// Extends a force and a moment series by the rows of `reactions`
+/// (`(force, moment)` each).
+fn push_reactions(
+    [force, moment]: [&Series; 2],
+    t0: usize,
+    reactions: impl Iterator<Item = [f64; 6]>,
+    path: &Path,
+) -> Result<(), ResultError> {
+    let (f, m) = force_moment(reactions);
+    force.push_rows(t0, &f, path)?;
+    moment.push_rows(t0, &m, path)
 }
 
-/// Every dataset handle of the file, kept open for the whole run.
-struct Datasets {
-    time: Series,
+/// `/energy/*`.
+struct EnergySets {
     kinetic: Series,
     strain: Series,
     potential: Series,
     total: Series,
     driver_work: Series,
     dissipated: Series,
-    momentum_linear: Series,
-    momentum_angular: Series,
+}
+
+impl EnergySets {
+    /// Creates the energy datasets (the group exists).
+    fn create(c: Creator<'_>) -> Result<Self, ResultError> {
+        Ok(Self {
+            kinetic: c.f64s(names::ENERGY_KINETIC, &[], "kinetic energy")?,
+            strain: c.f64s(names::ENERGY_STRAIN, &[], "strain energy")?,
+            potential: c.f64s(
+                names::ENERGY_POTENTIAL,
+                &[],
+                "potential of gravity and dead external loads",
+            )?,
+            total: c.f64s(names::ENERGY_TOTAL, &[], "kinetic + strain + potential")?,
+            driver_work: c.f64s(
+                names::ENERGY_DRIVER_WORK,
+                &[],
+                "work done by driven joint coordinates and prescribed DOFs since t = 0",
+            )?,
+            dissipated: c.f64s(
+                names::ENERGY_DISSIPATED,
+                &[],
+                "energy dissipated by structural damping since t = 0 (in potential and total)",
+            )?,
+        })
+    }
+}
+
+/// `/solver/*`.
+struct SolverSets {
     iterations: Series,
     factorizations: Series,
     dt: Series,
@@ -372,41 +495,502 @@ struct Datasets {
     negative_pivots: Option<Series>,
     newton_residuals: Series,
     newton_offsets: Series,
+}
+
+impl SolverSets {
+    /// Creates the solver datasets (the group exists), `negative_pivots`
+    /// for `statics` only, and writes the first Newton offset (0).
+    fn create(c: Creator<'_>, statics: bool) -> Result<Self, ResultError> {
+        let sets = Self {
+            iterations: c.series::<u64>(
+                names::SOLVER_ITERATIONS,
+                &[],
+                "Newton iterations of the step",
+            )?,
+            factorizations: c.series::<u64>(
+                names::SOLVER_FACTORIZATIONS,
+                &[],
+                "tangent factorisations of the step",
+            )?,
+            dt: c.f64s(
+                names::SOLVER_DT,
+                &[],
+                "step size actually used (after halvings)",
+            )?,
+            residual: c.f64s(names::SOLVER_RESIDUAL, &[], "final scaled residual norm")?,
+            beta: c.f64s(
+                names::SOLVER_BETA,
+                &[],
+                "energy-momentum beta of the step (NaN for other integrators)",
+            )?,
+            negative_pivots: statics
+                .then(|| {
+                    c.series::<i64>(
+                        names::SOLVER_NEGATIVE_PIVOTS,
+                        &[],
+                        "number of negative eigenvalues of the converged reduced tangent (negative \
+                         pivots of its LDLT factorisation); > 0: the equilibrium is unstable; -1: \
+                         undefined (a zero pivot)",
+                    )
+                })
+                .transpose()?,
+            newton_residuals: Series::create::<f64>(
+                c.file,
+                c.path,
+                names::SOLVER_NEWTON_RESIDUALS,
+                0,
+                &[],
+                &[NEWTON_CHUNK],
+                "scaled residual after each Newton iteration (first: before the first solve), \
+                 all steps concatenated; see newton_offsets",
+            )?,
+            newton_offsets: Series::create::<u64>(
+                c.file,
+                c.path,
+                names::SOLVER_NEWTON_OFFSETS,
+                1,
+                &[],
+                &[NEWTON_CHUNK],
+                "T+1 offsets: step k's residuals are newton_residuals[offsets[k]..offsets[k+1]]",
+            )?,
+        };
+        sets.newton_offsets.write_values(0, &[0_u64], c.path)?;
+        Ok(sets)
+    }
+
+    /// Writes the step statistics of `recs` from row `t0`.
+    fn write(&self, t0: usize, recs: &[StepRecord], path: &Path) -> Result<(), ResultError> {
+        push_columns::<u64>(
+            t0,
+            recs,
+            path,
+            &[
+                (&self.iterations, |r| r.iterations as u64),
+                (&self.factorizations, |r| r.factorizations as u64),
+            ],
+        )?;
+        push_columns::<f64>(
+            t0,
+            recs,
+            path,
+            &[
+                (&self.dt, |r| r.dt),
+                (&self.residual, |r| r.residual),
+                (&self.beta, |r| r.beta),
+            ],
+        )?;
+        if let Some(set) = &self.negative_pivots {
+            push_columns::<i64>(
+                t0,
+                recs,
+                path,
+                &[(set, |r| r.negative_pivots.map_or(-1, |n| n as i64))],
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Appends the Newton residual histories of `recs` (steps `t0..`) after
+    /// the `newton_len` residuals in the file, and their offsets.
+    fn write_newton(
+        &self,
+        t0: usize,
+        newton_len: usize,
+        recs: &[StepRecord],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        let history: Vec<f64> = recs
+            .iter()
+            .flat_map(|r| r.residual_history.iter().copied())
+            .collect();
+        let mut end = newton_len;
+        let offsets: Vec<u64> = recs
+            .iter()
+            .map(|r| {
+                end += r.residual_history.len();
+                end as u64
+            })
+            .collect();
+        self.newton_residuals.set_rows(end, path)?;
+        self.newton_residuals
+            .write_values(newton_len, &history, path)?;
+        self.newton_offsets.set_rows(t0 + recs.len() + 1, path)?;
+        self.newton_offsets.write_values(t0 + 1, &offsets, path)
+    }
+}
+
+/// `/nodes/<label>/*` of one tracked node.
+struct NodeSets {
+    index: usize,
+    position: Series,
+    displacement: Series,
+    rotation: Series,
+}
+
+impl NodeSets {
+    /// Creates `/nodes/<label>` for node `index`: the group, its
+    /// `node_index` attribute and its datasets.
+    fn create(c: Creator<'_>, label: &str, index: usize) -> Result<Self, ResultError> {
+        c.indexed_group(
+            &names::node_group(label),
+            "tracked node",
+            &[(names::ATTR_NODE_INDEX, index)],
+        )?;
+        Ok(Self {
+            index,
+            position: c.f64s(
+                &names::node_path(label, names::NODE_POSITION),
+                &[3],
+                "position of the node",
+            )?,
+            displacement: c.f64s(
+                &names::node_path(label, names::NODE_DISPLACEMENT),
+                &[3],
+                "position minus initial position",
+            )?,
+            rotation: c.f64s(
+                &names::node_path(label, names::NODE_ROTATION),
+                &[3],
+                "rotation vector (axis times angle, |psi| <= pi) of the node's triad",
+            )?,
+        })
+    }
+
+    /// Writes the node's rows of `recs` from row `t0`; `initial_positions`
+    /// are the run's.
+    fn write(
+        &self,
+        t0: usize,
+        recs: &[StepRecord],
+        initial_positions: &[[f64; 3]],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        let p0 = initial_positions[self.index];
+        let p: Vec<[f64; 3]> = recs.iter().map(|r| r.positions[self.index]).collect();
+        let u: Vec<[f64; 3]> = p
+            .iter()
+            .map(|p| [p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]])
+            .collect();
+        let rot: Vec<[f64; 3]> = recs
+            .iter()
+            .map(|r| rotation_vector(r.quaternions[self.index]))
+            .collect();
+        self.position.push_rows(t0, &p, path)?;
+        self.displacement.push_rows(t0, &u, path)?;
+        self.rotation.push_rows(t0, &rot, path)
+    }
+}
+
+/// `/joints/<name>/*` of one joint.
+struct JointSets {
+    /// Absent for a joint without a released angle.
+    angle: Option<Series>,
+    reaction_force: Series,
+    reaction_moment: Series,
+    released_translation: Series,
+    constraint_error: Series,
+}
+
+impl JointSets {
+    /// Creates `/joints/<name>` for joint `index` of `meta`: the group, its
+    /// index and (where known) master and slave node attributes, and its
+    /// datasets (`angle` only for a joint with a released angle).
+    fn create(
+        c: Creator<'_>,
+        meta: &RunMeta,
+        index: usize,
+        name: &str,
+    ) -> Result<Self, ResultError> {
+        let mut attrs = vec![(names::ATTR_JOINT_INDEX, index)];
+        if let Some(nodes) = meta.joint_nodes.get(index) {
+            attrs.push((names::ATTR_JOINT_MASTER_NODE, nodes[0]));
+            attrs.push((names::ATTR_JOINT_SLAVE_NODE, nodes[1]));
+        }
+        c.indexed_group(&names::joint_group(name), "joint", &attrs)?;
+        let has_angle = meta.joint_angles.get(index).copied().unwrap_or(true);
+        Ok(Self {
+            angle: if has_angle {
+                Some(c.f64s(
+                    &names::joint_path(name, names::JOINT_ANGLE),
+                    &[],
+                    "released angle psi",
+                )?)
+            } else {
+                None
+            },
+            released_translation: c.f64s(
+                &names::joint_path(name, names::JOINT_RELEASED_TRANSLATION),
+                &[3],
+                "released translation r_R in the master frame",
+            )?,
+            reaction_force: c.f64s(
+                &names::joint_path(name, names::JOINT_REACTION_FORCE),
+                &[3],
+                "force the joint exerts on its slave node in the step's equations (NaN at t = 0)",
+            )?,
+            reaction_moment: c.f64s(
+                &names::joint_path(name, names::JOINT_REACTION_MOMENT),
+                &[3],
+                "moment the joint exerts on its slave node in the step's equations (NaN at t = 0)",
+            )?,
+            constraint_error: c.f64s(
+                &names::joint_path(name, names::JOINT_CONSTRAINT_ERROR),
+                &[],
+                "|r_s - r_m - L_m f(psi)| + |L_m^T L_s - exp(psi t^)|_F",
+            )?,
+        })
+    }
+
+    /// Writes joint `j`'s rows of `recs` from row `t0`.
+    fn write(
+        &self,
+        j: usize,
+        t0: usize,
+        recs: &[StepRecord],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        let of = |r: &StepRecord| r.joints[j];
+        if let Some(angle) = &self.angle {
+            let a: Vec<f64> = recs.iter().map(|r| of(r).angle).collect();
+            angle.push_scalars(t0, &a, path)?;
+        }
+        let released: Vec<[f64; 3]> = recs.iter().map(|r| of(r).released_translation).collect();
+        self.released_translation.push_rows(t0, &released, path)?;
+        let error: Vec<f64> = recs.iter().map(|r| of(r).constraint_error).collect();
+        self.constraint_error.push_scalars(t0, &error, path)?;
+        push_reactions(
+            [&self.reaction_force, &self.reaction_moment],
+            t0,
+            recs.iter().map(|r| of(r).reaction),
+            path,
+        )
+    }
+}
+
+/// Creates `/supports/<label>` and its reaction force and moment datasets.
+fn support_sets(c: Creator<'_>, label: &str) -> Result<[Series; 2], ResultError> {
+    c.group(&format!("{}/{label}", names::SUPPORTS), "supported node")?;
+    Ok([
+        c.f64s(
+            &names::support_path(label, names::JOINT_REACTION_FORCE),
+            &[3],
+            "force the supports exert on the node at its held DOFs (zero at free ones; \
+             NaN at t = 0)",
+        )?,
+        c.f64s(
+            &names::support_path(label, names::JOINT_REACTION_MOMENT),
+            &[3],
+            "moment the supports exert on the node at its held DOFs (zero at free ones; \
+             NaN at t = 0)",
+        )?,
+    ])
+}
+
+/// `/configuration/*`: every node at every stored step.
+struct ConfigurationSets {
+    position: Series,
+    quaternion: Series,
+    /// Dynamics only: translational and angular velocities of every node.
+    velocity: Option<[Series; 2]>,
+}
+
+impl ConfigurationSets {
+    /// Creates the configuration datasets of `nodes` nodes (the group
+    /// exists), the velocities for `dynamic` runs only.
+    fn create(c: Creator<'_>, nodes: usize, dynamic: bool) -> Result<Self, ResultError> {
+        Ok(Self {
+            position: c.block(
+                names::CONFIGURATION_POSITION,
+                nodes,
+                3,
+                "position of every node at every stored step (T x nodes x 3)",
+            )?,
+            quaternion: c.block(
+                names::CONFIGURATION_QUATERNION,
+                nodes,
+                4,
+                "rotation of every node's triad from its initial configuration as a unit \
+                 quaternion (w, x, y, z) (T x nodes x 4)",
+            )?,
+            velocity: if dynamic {
+                Some([
+                    c.block(
+                        names::CONFIGURATION_VELOCITY,
+                        nodes,
+                        3,
+                        "translational velocity of every node at every stored step (T x nodes x 3)",
+                    )?,
+                    c.block(
+                        names::CONFIGURATION_ANGULAR_VELOCITY,
+                        nodes,
+                        3,
+                        "angular velocity w = R W of every node's triad in spatial components \
+                         (T x nodes x 3)",
+                    )?,
+                ])
+            } else {
+                None
+            },
+        })
+    }
+
+    /// Writes every node's rows of `recs` from row `t0`.
+    fn write(&self, t0: usize, recs: &[StepRecord], path: &Path) -> Result<(), ResultError> {
+        let blocks3 = |f: fn(&StepRecord) -> &[[f64; 3]]| recs.iter().map(f).collect::<Vec<_>>();
+        self.position
+            .push_blocks(t0, &blocks3(|r| &r.positions), path)?;
+        let quaternions: Vec<&[[f64; 4]]> = recs.iter().map(|r| &r.quaternions[..]).collect();
+        self.quaternion.push_blocks(t0, &quaternions, path)?;
+        if let Some([v, w]) = &self.velocity {
+            v.push_blocks(t0, &blocks3(|r| &r.velocities), path)?;
+            w.push_blocks(t0, &blocks3(|r| &r.angular_velocities), path)?;
+        }
+        Ok(())
+    }
+}
+
+/// Creates `/resultants`: the force and moment at every Gauss point of
+/// `meta` (with the beams' ranges) and the points' arc lengths.
+fn resultant_sets(
+    c: Creator<'_>,
+    meta: &super::resultants::ResultantsMeta,
+) -> Result<[Series; 2], ResultError> {
+    let (arc, offsets) = meta.points();
+    let (file, path) = (c.file, c.path);
+    let group = names::RESULTANTS;
+    file.create_group(group)
+        .ctx(path, || format!("creating group {group}"))?;
+    let points = arc.len();
+    let force = c.block(
+        names::RESULTANTS_FORCE,
+        points,
+        3,
+        "material stress resultant N = C_N Gamma (axial, shear 2, shear 3) at every \
+         Gauss point, element order (T x G x 3)",
+    )?;
+    let moment = c.block(
+        names::RESULTANTS_MOMENT,
+        points,
+        3,
+        "material stress resultant M = C_M K (torsion, bending 2, bending 3) at every \
+         Gauss point, element order (T x G x 3)",
+    )?;
+    super::resultants::write_ranges(&force.ds, meta, &offsets).ctx(path, || {
+        "writing the beams' ranges of /resultants".to_owned()
+    })?;
+    file.new_dataset::<f64>()
+        .shape([points])
+        .create(names::RESULTANTS_ARC_LENGTH)
+        .and_then(|ds| ds.write_raw(&arc))
+        .ctx(path, || format!("writing {}", names::RESULTANTS_ARC_LENGTH))?;
+    Ok([force, moment])
+}
+
+/// Writes the resultants of `recs` (by `meta`) into `[force, moment]` from
+/// row `t0`.
+fn write_resultants(
+    [n, m]: &[Series; 2],
+    meta: &super::resultants::ResultantsMeta,
+    t0: usize,
+    recs: &[StepRecord],
+    path: &Path,
+) -> Result<(), ResultError> {
+    let (force, moment): (Vec<_>, Vec<_>) = recs.iter().map(|r| meta.of(r)).unzip();
+    let force: Vec<&[[f64; 3]]> = force.iter().map(Vec::as_slice).collect();
+    let moment: Vec<&[[f64; 3]]> = moment.iter().map(Vec::as_slice).collect();
+    n.push_blocks(t0, &force, path)?;
+    m.push_blocks(t0, &moment, path)
+}
+
+/// Every dataset handle of the file, kept open for the whole run.
+struct Datasets {
+    time: Series,
+    energy: EnergySets,
+    momentum_linear: Series,
+    momentum_angular: Series,
+    solver: SolverSets,
     nodes: Vec<NodeSets>,
     /// Per supported node: reaction force and moment.
     supports: Vec<[Series; 2]>,
     joints: Vec<JointSets>,
-    config_position: Series,
-    config_quaternion: Series,
-    /// Dynamics only: translational and angular velocities of every node.
-    config_velocity: Option<[Series; 2]>,
+    configuration: ConfigurationSets,
     /// `[output] resultants = true`: force and moment at every Gauss point.
     resultants: Option<[Series; 2]>,
 }
 
 impl Datasets {
+    /// Creates every dataset of the run `meta` with zero rows (the groups
+    /// exist), in the file's order: `/time`, `/energy`, `/momentum`,
+    /// `/solver`, `/nodes`, `/joints`, `/supports`, `/configuration`,
+    /// `/resultants`.
+    fn create(c: Creator<'_>, meta: &RunMeta) -> Result<Self, ResultError> {
+        let time = c.f64s(
+            names::TIME,
+            &[],
+            "time of each stored step (statics: load factor)",
+        )?;
+        let energy = EnergySets::create(c)?;
+        let momentum_linear = c.f64s(names::MOMENTUM_LINEAR, &[3], "total linear momentum")?;
+        let momentum_angular = c.f64s(
+            names::MOMENTUM_ANGULAR,
+            &[3],
+            "total angular momentum about the origin",
+        )?;
+        let solver = SolverSets::create(c, meta.integrator == "static")?;
+        let nodes = (meta.tracked.iter())
+            .map(|(label, node)| NodeSets::create(c, label, *node))
+            .collect::<Result<_, _>>()?;
+        let joints = (meta.joint_names.iter().enumerate())
+            .map(|(index, name)| JointSets::create(c, meta, index, name))
+            .collect::<Result<_, _>>()?;
+        let supports = (meta.supports.iter())
+            .map(|label| support_sets(c, label))
+            .collect::<Result<_, _>>()?;
+        let configuration = ConfigurationSets::create(
+            c,
+            meta.initial_positions.len(),
+            meta.integrator != "static",
+        )?;
+        let resultants = (meta.resultants.as_ref())
+            .map(|r| resultant_sets(c, r))
+            .transpose()?;
+        Ok(Self {
+            time,
+            energy,
+            momentum_linear,
+            momentum_angular,
+            solver,
+            nodes,
+            supports,
+            joints,
+            configuration,
+            resultants,
+        })
+    }
+
     /// Every dataset with one row per step.
     fn per_step(&self) -> impl Iterator<Item = &Series> {
+        let (e, s, c) = (&self.energy, &self.solver, &self.configuration);
         [
             &self.time,
-            &self.kinetic,
-            &self.strain,
-            &self.potential,
-            &self.total,
+            &e.kinetic,
+            &e.strain,
+            &e.potential,
+            &e.total,
             &self.momentum_linear,
             &self.momentum_angular,
-            &self.iterations,
-            &self.factorizations,
-            &self.dt,
-            &self.residual,
-            &self.beta,
-            &self.config_position,
-            &self.config_quaternion,
+            &s.iterations,
+            &s.factorizations,
+            &s.dt,
+            &s.residual,
+            &s.beta,
+            &c.position,
+            &c.quaternion,
         ]
         .into_iter()
-        .chain(self.config_velocity.iter().flatten())
+        .chain(c.velocity.iter().flatten())
         .chain(self.resultants.iter().flatten())
-        .chain(self.negative_pivots.iter())
+        .chain(s.negative_pivots.iter())
         .chain(
             self.nodes
                 .iter()
@@ -421,6 +1005,35 @@ impl Datasets {
             ])
         }))
         .chain(self.supports.iter().flatten())
+    }
+
+    /// Writes `/time`, the energies and the momenta of `recs` from row `t0`.
+    fn write_globals(
+        &self,
+        t0: usize,
+        recs: &[StepRecord],
+        path: &Path,
+    ) -> Result<(), ResultError> {
+        let e = &self.energy;
+        push_columns::<f64>(
+            t0,
+            recs,
+            path,
+            &[
+                (&self.time, |r| r.time),
+                (&e.kinetic, |r| r.energy.kinetic),
+                (&e.strain, |r| r.energy.strain),
+                (&e.potential, |r| r.energy.potential),
+                (&e.total, |r| r.energy.total),
+                (&e.driver_work, |r| r.energy.driver_work),
+                (&e.dissipated, |r| r.energy.dissipated),
+            ],
+        )?;
+        let rows = |f: fn(&StepRecord) -> [f64; 3]| recs.iter().map(f).collect::<Vec<_>>();
+        self.momentum_linear
+            .push_rows(t0, &rows(|r| r.momentum_linear), path)?;
+        self.momentum_angular
+            .push_rows(t0, &rows(|r| r.momentum_angular), path)
     }
 }
 
@@ -491,6 +1104,76 @@ fn check_names<'a>(
     Ok(())
 }
 
+/// Refuses a run whose labels or joint names cannot name groups, or whose
+/// tracked node is out of range, before the file is touched.
+fn check_meta(path: &Path, meta: &RunMeta) -> Result<(), ResultError> {
+    let n_nodes = meta.initial_positions.len();
+    check_names(
+        path,
+        "node label",
+        meta.tracked.iter().map(|(l, _)| l.as_str()),
+    )?;
+    check_names(path, "joint", meta.joint_names.iter().map(String::as_str))?;
+    if let Some((label, index)) = meta.tracked.iter().find(|(_, i)| *i >= n_nodes) {
+        return Err(ResultError::NodeIndex {
+            path: path.to_path_buf(),
+            label: label.clone(),
+            index: *index,
+            nodes: n_nodes,
+        });
+    }
+    Ok(())
+}
+
+/// Writes the root attributes of a new file: what the run is, where and
+/// when it was made, and `status = "running"`.
+fn write_root_attributes(file: &File, path: &Path, meta: &RunMeta) -> Result<(), ResultError> {
+    let created = super::mesh::utc_now();
+    let mut attrs = vec![
+        (names::ATTR_MODEL, meta.model_text.as_str()),
+        (names::ATTR_INTEGRATOR, meta.integrator.as_str()),
+        (names::ATTR_VERSION, env!("CARGO_PKG_VERSION")),
+        (names::ATTR_GIT_REVISION, env!("FLEXMECH_GIT_REVISION")),
+        (names::ATTR_CREATED, created.as_str()),
+        (names::ATTR_UNITS, names::UNITS_NOTE),
+        (names::ATTR_STATUS, names::STATUS_RUNNING),
+    ];
+    if !meta.command_line.is_empty() {
+        attrs.push((names::ATTR_COMMAND_LINE, meta.command_line.as_str()));
+    }
+    for (name, value) in attrs {
+        create_str_attr(file, name, value)
+            .ctx(path, || format!("writing root attribute {name}"))?;
+    }
+    Ok(())
+}
+
+/// Creates the top-level groups with their descriptions, `/supports` only
+/// when some node is supported.
+fn create_groups(c: Creator<'_>, supports: bool) -> Result<(), ResultError> {
+    let groups = [
+        (
+            names::ENERGY,
+            "energies of the whole mechanism at the end of each step",
+        ),
+        (names::MOMENTUM, "total momenta at the end of each step"),
+        (names::SOLVER, "solver statistics of each step"),
+        (names::NODES, "tracked nodes, one group per label"),
+        (names::JOINTS, "joints, one group per name, in model order"),
+        (names::CONFIGURATION, "every node at every stored step"),
+    ];
+    for (name, description) in groups {
+        c.group(name, description)?;
+    }
+    if supports {
+        c.group(
+            names::SUPPORTS,
+            "supported nodes (a fixed or prescribed DOF), one group per label",
+        )?;
+    }
+    Ok(())
+}
+
 impl ResultWriter {
     /// Creates (or truncates) the file at `path`, writes the root attributes
     /// `model`, `integrator`, `version` (this crate's version) and `status =
@@ -500,380 +1183,19 @@ impl ResultWriter {
     /// contains `/`, is `.` or is used twice, or if a tracked node index is
     /// out of range.
     pub fn create(path: &Path, meta: &RunMeta) -> Result<Self, ResultError> {
-        let n_nodes = meta.initial_positions.len();
-        check_names(
-            path,
-            "node label",
-            meta.tracked.iter().map(|(l, _)| l.as_str()),
-        )?;
-        check_names(path, "joint", meta.joint_names.iter().map(String::as_str))?;
-        if let Some((label, index)) = meta.tracked.iter().find(|(_, i)| *i >= n_nodes) {
-            return Err(ResultError::NodeIndex {
-                path: path.to_path_buf(),
-                label: label.clone(),
-                index: *index,
-                nodes: n_nodes,
-            });
-        }
-
+        check_meta(path, meta)?;
         // Lock before truncating: a second writer of the same file fails here
         // and leaves the first one's result intact.
         let lock = lock_result(path)?;
         let file = File::create(path).ctx(path, || "creating the file".to_owned())?;
-        let created = super::mesh::utc_now();
-        let mut attrs = vec![
-            (names::ATTR_MODEL, meta.model_text.as_str()),
-            (names::ATTR_INTEGRATOR, meta.integrator.as_str()),
-            (names::ATTR_VERSION, env!("CARGO_PKG_VERSION")),
-            (names::ATTR_GIT_REVISION, env!("FLEXMECH_GIT_REVISION")),
-            (names::ATTR_CREATED, created.as_str()),
-            (names::ATTR_UNITS, names::UNITS_NOTE),
-            (names::ATTR_STATUS, names::STATUS_RUNNING),
-        ];
-        if !meta.command_line.is_empty() {
-            attrs.push((names::ATTR_COMMAND_LINE, meta.command_line.as_str()));
-        }
-        for (name, value) in attrs {
-            create_str_attr(&file, name, value)
-                .ctx(path, || format!("writing root attribute {name}"))?;
-        }
+        write_root_attributes(&file, path, meta)?;
         if let Some(mesh) = &meta.mesh {
             super::mesh::write(&file, mesh, &meta.initial_positions)
                 .ctx(path, || "writing /mesh".to_owned())?;
         }
-
-        let groups = [
-            (
-                names::ENERGY,
-                "energies of the whole mechanism at the end of each step",
-            ),
-            (names::MOMENTUM, "total momenta at the end of each step"),
-            (names::SOLVER, "solver statistics of each step"),
-            (names::NODES, "tracked nodes, one group per label"),
-            (names::JOINTS, "joints, one group per name, in model order"),
-            (names::CONFIGURATION, "every node at every stored step"),
-        ];
-        for (name, description) in groups {
-            create_group(&file, path, name, description)?;
-        }
-        if !meta.supports.is_empty() {
-            create_group(
-                &file,
-                path,
-                names::SUPPORTS,
-                "supported nodes (a fixed or prescribed DOF), one group per label",
-            )?;
-        }
-
-        let f64s = |name: &str, tail: &[usize], description: &str| {
-            Series::time_series::<f64>(&file, path, name, tail, description)
-        };
-        let time = f64s(
-            names::TIME,
-            &[],
-            "time of each stored step (statics: load factor)",
-        )?;
-        let kinetic = f64s(names::ENERGY_KINETIC, &[], "kinetic energy")?;
-        let strain = f64s(names::ENERGY_STRAIN, &[], "strain energy")?;
-        let potential = f64s(
-            names::ENERGY_POTENTIAL,
-            &[],
-            "potential of gravity and dead external loads",
-        )?;
-        let total = f64s(names::ENERGY_TOTAL, &[], "kinetic + strain + potential")?;
-        let driver_work = f64s(
-            names::ENERGY_DRIVER_WORK,
-            &[],
-            "work done by driven joint coordinates and prescribed DOFs since t = 0",
-        )?;
-        let dissipated = f64s(
-            names::ENERGY_DISSIPATED,
-            &[],
-            "energy dissipated by structural damping since t = 0 (in potential and total)",
-        )?;
-        let momentum_linear = f64s(names::MOMENTUM_LINEAR, &[3], "total linear momentum")?;
-        let momentum_angular = f64s(
-            names::MOMENTUM_ANGULAR,
-            &[3],
-            "total angular momentum about the origin",
-        )?;
-        let iterations = Series::time_series::<u64>(
-            &file,
-            path,
-            names::SOLVER_ITERATIONS,
-            &[],
-            "Newton iterations of the step",
-        )?;
-        let factorizations = Series::time_series::<u64>(
-            &file,
-            path,
-            names::SOLVER_FACTORIZATIONS,
-            &[],
-            "tangent factorisations of the step",
-        )?;
-        let dt = f64s(
-            names::SOLVER_DT,
-            &[],
-            "step size actually used (after halvings)",
-        )?;
-        let residual = f64s(names::SOLVER_RESIDUAL, &[], "final scaled residual norm")?;
-        let beta = f64s(
-            names::SOLVER_BETA,
-            &[],
-            "energy-momentum beta of the step (NaN for other integrators)",
-        )?;
-        let negative_pivots = (meta.integrator == "static")
-            .then(|| {
-                Series::time_series::<i64>(
-                    &file,
-                    path,
-                    names::SOLVER_NEGATIVE_PIVOTS,
-                    &[],
-                    "number of negative eigenvalues of the converged reduced tangent (negative \
-                     pivots of its LDLT factorisation); > 0: the equilibrium is unstable; -1: \
-                     undefined (a zero pivot)",
-                )
-            })
-            .transpose()?;
-        let newton_residuals = Series::create::<f64>(
-            &file,
-            path,
-            names::SOLVER_NEWTON_RESIDUALS,
-            0,
-            &[],
-            &[NEWTON_CHUNK],
-            "scaled residual after each Newton iteration (first: before the first solve), \
-             all steps concatenated; see newton_offsets",
-        )?;
-        let newton_offsets = Series::create::<u64>(
-            &file,
-            path,
-            names::SOLVER_NEWTON_OFFSETS,
-            1,
-            &[],
-            &[NEWTON_CHUNK],
-            "T+1 offsets: step k's residuals are newton_residuals[offsets[k]..offsets[k+1]]",
-        )?;
-        newton_offsets.write_values(0, &[0_u64], path)?;
-
-        let mut nodes = Vec::with_capacity(meta.tracked.len());
-        for (label, node) in &meta.tracked {
-            let group = names::node_group(label);
-            create_group(&file, path, &group, "tracked node")?;
-            let g = file
-                .group(&group)
-                .ctx(path, || format!("opening group {group}"))?;
-            let node_attr = g.new_attr::<u64>().shape(()).create(names::ATTR_NODE_INDEX);
-            node_attr
-                .and_then(|a| a.as_writer().write_scalar(&(*node as u64)))
-                .ctx(path, || {
-                    format!("writing {group} attribute {}", names::ATTR_NODE_INDEX)
-                })?;
-            nodes.push(NodeSets {
-                index: *node,
-                position: f64s(
-                    &names::node_path(label, names::NODE_POSITION),
-                    &[3],
-                    "position of the node",
-                )?,
-                displacement: f64s(
-                    &names::node_path(label, names::NODE_DISPLACEMENT),
-                    &[3],
-                    "position minus initial position",
-                )?,
-                rotation: f64s(
-                    &names::node_path(label, names::NODE_ROTATION),
-                    &[3],
-                    "rotation vector (axis times angle, |psi| <= pi) of the node's triad",
-                )?,
-            });
-        }
-
-        let mut joints = Vec::with_capacity(meta.joint_names.len());
-        for (index, name) in meta.joint_names.iter().enumerate() {
-            let group = names::joint_group(name);
-            create_group(&file, path, &group, "joint")?;
-            let g = file
-                .group(&group)
-                .ctx(path, || format!("opening group {group}"))?;
-            let joint_attr = g
-                .new_attr::<u64>()
-                .shape(())
-                .create(names::ATTR_JOINT_INDEX);
-            joint_attr
-                .and_then(|a| a.as_writer().write_scalar(&(index as u64)))
-                .ctx(path, || {
-                    format!("writing {group} attribute {}", names::ATTR_JOINT_INDEX)
-                })?;
-            if let Some(nodes) = meta.joint_nodes.get(index) {
-                for (attr, node) in [
-                    (names::ATTR_JOINT_MASTER_NODE, nodes[0]),
-                    (names::ATTR_JOINT_SLAVE_NODE, nodes[1]),
-                ] {
-                    g.new_attr::<u64>()
-                        .shape(())
-                        .create(attr)
-                        .and_then(|a| a.as_writer().write_scalar(&(node as u64)))
-                        .ctx(path, || format!("writing {group} attribute {attr}"))?;
-                }
-            }
-            let has_angle = meta.joint_angles.get(index).copied().unwrap_or(true);
-            joints.push(JointSets {
-                angle: if has_angle {
-                    Some(f64s(
-                        &names::joint_path(name, names::JOINT_ANGLE),
-                        &[],
-                        "released angle psi",
-                    )?)
-                } else {
-                    None
-                },
-                released_translation: f64s(
-                    &names::joint_path(name, names::JOINT_RELEASED_TRANSLATION),
-                    &[3],
-                    "released translation r_R in the master frame",
-                )?,
-                reaction_force: f64s(
-                    &names::joint_path(name, names::JOINT_REACTION_FORCE),
-                    &[3],
-                    "force the joint exerts on its slave node in the step's equations (NaN at t = 0)",
-                )?,
-                reaction_moment: f64s(
-                    &names::joint_path(name, names::JOINT_REACTION_MOMENT),
-                    &[3],
-                    "moment the joint exerts on its slave node in the step's equations (NaN at t = 0)",
-                )?,
-                constraint_error: f64s(
-                    &names::joint_path(name, names::JOINT_CONSTRAINT_ERROR),
-                    &[],
-                    "|r_s - r_m - L_m f(psi)| + |L_m^T L_s - exp(psi t^)|_F",
-                )?,
-            });
-        }
-
-        let mut supports = Vec::with_capacity(meta.supports.len());
-        for label in &meta.supports {
-            create_group(
-                &file,
-                path,
-                &format!("{}/{label}", names::SUPPORTS),
-                "supported node",
-            )?;
-            supports.push([
-                f64s(
-                    &names::support_path(label, names::JOINT_REACTION_FORCE),
-                    &[3],
-                    "force the supports exert on the node at its held DOFs (zero at free ones; \
-                     NaN at t = 0)",
-                )?,
-                f64s(
-                    &names::support_path(label, names::JOINT_REACTION_MOMENT),
-                    &[3],
-                    "moment the supports exert on the node at its held DOFs (zero at free ones; \
-                     NaN at t = 0)",
-                )?,
-            ]);
-        }
-
-        // T x count x width, chunked by rows of at most CONFIG_CHUNK_BYTES.
-        let block = |name: &str, count: usize, width: usize, description: &str| {
-            let count_chunk = count.clamp(1, CONFIG_CHUNK_NODES);
-            let rows = (CONFIG_CHUNK_BYTES / (count_chunk * width * 8)).clamp(1, CONFIG_CHUNK_ROWS);
-            let chunk = [rows, count_chunk, width];
-            Series::create::<f64>(&file, path, name, 0, &[count, width], &chunk, description)
-        };
-        let config =
-            |name: &str, width: usize, description: &str| block(name, n_nodes, width, description);
-        let config_position = config(
-            names::CONFIGURATION_POSITION,
-            3,
-            "position of every node at every stored step (T x nodes x 3)",
-        )?;
-        let config_quaternion = config(
-            names::CONFIGURATION_QUATERNION,
-            4,
-            "rotation of every node's triad from its initial configuration as a unit \
-             quaternion (w, x, y, z) (T x nodes x 4)",
-        )?;
-
-        let config_velocity = if meta.integrator == "static" {
-            None
-        } else {
-            Some([
-                config(
-                    names::CONFIGURATION_VELOCITY,
-                    3,
-                    "translational velocity of every node at every stored step (T x nodes x 3)",
-                )?,
-                config(
-                    names::CONFIGURATION_ANGULAR_VELOCITY,
-                    3,
-                    "angular velocity w = R W of every node's triad in spatial components \
-                     (T x nodes x 3)",
-                )?,
-            ])
-        };
-
-        let resultants = match &meta.resultants {
-            None => None,
-            Some(r) => {
-                let (arc, offsets) = r.points();
-                let group = names::RESULTANTS;
-                file.create_group(group)
-                    .ctx(path, || format!("creating group {group}"))?;
-                let points = arc.len();
-                let force = block(
-                    names::RESULTANTS_FORCE,
-                    points,
-                    3,
-                    "material stress resultant N = C_N Gamma (axial, shear 2, shear 3) at every \
-                     Gauss point, element order (T x G x 3)",
-                )?;
-                let moment = block(
-                    names::RESULTANTS_MOMENT,
-                    points,
-                    3,
-                    "material stress resultant M = C_M K (torsion, bending 2, bending 3) at every \
-                     Gauss point, element order (T x G x 3)",
-                )?;
-                super::resultants::write_ranges(&force.ds, r, &offsets).ctx(path, || {
-                    "writing the beams' ranges of /resultants".to_owned()
-                })?;
-                file.new_dataset::<f64>()
-                    .shape([points])
-                    .create(names::RESULTANTS_ARC_LENGTH)
-                    .and_then(|ds| ds.write_raw(&arc))
-                    .ctx(path, || format!("writing {}", names::RESULTANTS_ARC_LENGTH))?;
-                Some([force, moment])
-            }
-        };
-
-        let sets = Datasets {
-            time,
-            kinetic,
-            strain,
-            potential,
-            total,
-            driver_work,
-            dissipated,
-            momentum_linear,
-            momentum_angular,
-            iterations,
-            factorizations,
-            dt,
-            residual,
-            beta,
-            negative_pivots,
-            newton_residuals,
-            newton_offsets,
-            nodes,
-            joints,
-            supports,
-            config_position,
-            config_quaternion,
-            config_velocity,
-            resultants,
-        };
+        let c = Creator { file: &file, path };
+        create_groups(c, !meta.supports.is_empty())?;
+        let sets = Datasets::create(c, meta)?;
         file.flush().ctx(path, || "flushing the file".to_owned())?;
         Ok(Self {
             path: path.to_path_buf(),
@@ -920,7 +1242,7 @@ impl ResultWriter {
         } else {
             step.support_reactions.len()
         };
-        let velocities = self.sets.config_velocity.as_ref().map_or(0, |_| n_nodes);
+        let velocities = (self.sets.configuration.velocity.as_ref()).map_or(0, |_| n_nodes);
         let lengths = lengths.into_iter().chain([
             ("support_reactions", supports, found_supports),
             ("velocities", velocities, step.velocities.len()),
@@ -989,110 +1311,22 @@ impl ResultWriter {
     fn write_steps(&self, t0: usize, recs: &[StepRecord]) -> Result<(), ResultError> {
         let path = self.path.as_path();
         let s = &self.sets;
-        let scalars = |f: fn(&StepRecord) -> f64| recs.iter().map(f).collect::<Vec<f64>>();
-        let counts =
-            |f: fn(&StepRecord) -> usize| recs.iter().map(|r| f(r) as u64).collect::<Vec<u64>>();
-        s.time.push_scalars(t0, &scalars(|r| r.time), path)?;
-        s.kinetic
-            .push_scalars(t0, &scalars(|r| r.energy.kinetic), path)?;
-        s.strain
-            .push_scalars(t0, &scalars(|r| r.energy.strain), path)?;
-        s.potential
-            .push_scalars(t0, &scalars(|r| r.energy.potential), path)?;
-        s.total
-            .push_scalars(t0, &scalars(|r| r.energy.total), path)?;
-        s.driver_work
-            .push_scalars(t0, &scalars(|r| r.energy.driver_work), path)?;
-        s.dissipated
-            .push_scalars(t0, &scalars(|r| r.energy.dissipated), path)?;
-        let rows = |f: fn(&StepRecord) -> [f64; 3]| recs.iter().map(f).collect::<Vec<_>>();
-        s.momentum_linear
-            .push_rows(t0, &rows(|r| r.momentum_linear), path)?;
-        s.momentum_angular
-            .push_rows(t0, &rows(|r| r.momentum_angular), path)?;
-        s.iterations
-            .push_scalars(t0, &counts(|r| r.iterations), path)?;
-        s.factorizations
-            .push_scalars(t0, &counts(|r| r.factorizations), path)?;
-        s.dt.push_scalars(t0, &scalars(|r| r.dt), path)?;
-        s.residual
-            .push_scalars(t0, &scalars(|r| r.residual), path)?;
-        s.beta.push_scalars(t0, &scalars(|r| r.beta), path)?;
-        if let Some(set) = &s.negative_pivots {
-            let counts: Vec<i64> = recs
-                .iter()
-                .map(|r| r.negative_pivots.map_or(-1, |n| n as i64))
-                .collect();
-            set.push_scalars(t0, &counts, path)?;
-        }
-
-        let history: Vec<f64> = recs
-            .iter()
-            .flat_map(|r| r.residual_history.iter().copied())
-            .collect();
-        let mut end = self.newton_len;
-        let offsets: Vec<u64> = recs
-            .iter()
-            .map(|r| {
-                end += r.residual_history.len();
-                end as u64
-            })
-            .collect();
-        s.newton_residuals.set_rows(end, path)?;
-        s.newton_residuals
-            .write_values(self.newton_len, &history, path)?;
-        s.newton_offsets.set_rows(t0 + recs.len() + 1, path)?;
-        s.newton_offsets.write_values(t0 + 1, &offsets, path)?;
-
+        s.write_globals(t0, recs, path)?;
+        s.solver.write(t0, recs, path)?;
+        s.solver.write_newton(t0, self.newton_len, recs, path)?;
         for node in &s.nodes {
-            let p0 = self.initial_positions[node.index];
-            let p: Vec<[f64; 3]> = recs.iter().map(|r| r.positions[node.index]).collect();
-            let u: Vec<[f64; 3]> = p
-                .iter()
-                .map(|p| [p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]])
-                .collect();
-            let rot: Vec<[f64; 3]> = recs
-                .iter()
-                .map(|r| rotation_vector(r.quaternions[node.index]))
-                .collect();
-            node.position.push_rows(t0, &p, path)?;
-            node.displacement.push_rows(t0, &u, path)?;
-            node.rotation.push_rows(t0, &rot, path)?;
+            node.write(t0, recs, &self.initial_positions, path)?;
         }
         for (j, joint) in s.joints.iter().enumerate() {
-            let of = |r: &StepRecord| r.joints[j];
-            if let Some(angle) = &joint.angle {
-                let a: Vec<f64> = recs.iter().map(|r| of(r).angle).collect();
-                angle.push_scalars(t0, &a, path)?;
-            }
-            let released: Vec<[f64; 3]> = recs.iter().map(|r| of(r).released_translation).collect();
-            joint.released_translation.push_rows(t0, &released, path)?;
-            let error: Vec<f64> = recs.iter().map(|r| of(r).constraint_error).collect();
-            joint.constraint_error.push_scalars(t0, &error, path)?;
-            let (force, moment) = force_moment(recs.iter().map(|r| of(r).reaction));
-            joint.reaction_force.push_rows(t0, &force, path)?;
-            joint.reaction_moment.push_rows(t0, &moment, path)?;
+            joint.write(j, t0, recs, path)?;
         }
         for (k, [force, moment]) in s.supports.iter().enumerate() {
-            let (f, m) = force_moment(recs.iter().map(|r| r.support_reactions[k]));
-            force.push_rows(t0, &f, path)?;
-            moment.push_rows(t0, &m, path)?;
+            let reactions = recs.iter().map(|r| r.support_reactions[k]);
+            push_reactions([force, moment], t0, reactions, path)?;
         }
-        let blocks3 = |f: fn(&StepRecord) -> &[[f64; 3]]| recs.iter().map(f).collect::<Vec<_>>();
-        s.config_position
-            .push_blocks(t0, &blocks3(|r| &r.positions), path)?;
-        let quaternions: Vec<&[[f64; 4]]> = recs.iter().map(|r| &r.quaternions[..]).collect();
-        s.config_quaternion.push_blocks(t0, &quaternions, path)?;
-        if let Some([v, w]) = &s.config_velocity {
-            v.push_blocks(t0, &blocks3(|r| &r.velocities), path)?;
-            w.push_blocks(t0, &blocks3(|r| &r.angular_velocities), path)?;
-        }
-        if let (Some([n, m]), Some(meta)) = (&s.resultants, &self.resultants) {
-            let (force, moment): (Vec<_>, Vec<_>) = recs.iter().map(|r| meta.of(r)).unzip();
-            let force: Vec<&[[f64; 3]]> = force.iter().map(Vec::as_slice).collect();
-            let moment: Vec<&[[f64; 3]]> = moment.iter().map(Vec::as_slice).collect();
-            n.push_blocks(t0, &force, path)?;
-            m.push_blocks(t0, &moment, path)?;
+        s.configuration.write(t0, recs, path)?;
+        if let (Some(sets), Some(meta)) = (&s.resultants, &self.resultants) {
+            write_resultants(sets, meta, t0, recs, path)?;
         }
         Ok(())
     }
@@ -1119,19 +1353,15 @@ impl ResultWriter {
             for series in sets.per_step() {
                 series.set_rows(steps, &path)?;
             }
-            sets.newton_residuals.set_rows(newton_len, &path)?;
-            sets.newton_offsets.set_rows(steps + 1, &path)?;
+            sets.solver.newton_residuals.set_rows(newton_len, &path)?;
+            sets.solver.newton_offsets.set_rows(steps + 1, &path)?;
         }
         set_str_attr(&file, names::ATTR_STATUS, status).ctx(&path, || {
             format!("writing root attribute {}", names::ATTR_STATUS)
         })?;
-        file.new_attr::<f64>()
-            .shape(())
-            .create(names::ATTR_WALL_TIME)
-            .and_then(|a| a.as_writer().write_scalar(&wall_time_s))
-            .ctx(&path, || {
-                format!("writing root attribute {}", names::ATTR_WALL_TIME)
-            })?;
+        scalar_attr(&file, names::ATTR_WALL_TIME, wall_time_s).ctx(&path, || {
+            format!("writing root attribute {}", names::ATTR_WALL_TIME)
+        })?;
         drop(sets);
         file.close().ctx(&path, || "closing the file".to_owned())?;
         flushed?;
@@ -1156,11 +1386,7 @@ impl ResultWriter {
     /// [`super::merit`]); called once, when the run ends.
     pub fn figures(&mut self, merit: &super::merit::Merit) -> Result<(), ResultError> {
         for (name, value) in merit.figures() {
-            self.file
-                .new_attr::<f64>()
-                .shape(())
-                .create(name)
-                .and_then(|a| a.as_writer().write_scalar(&value))
+            scalar_attr(&self.file, name, value)
                 .ctx(&self.path, || format!("writing root attribute {name}"))?;
         }
         Ok(())
@@ -1191,14 +1417,9 @@ impl ResultWriter {
         .ctx(&self.path, || {
             format!("writing root attribute {}", names::ATTR_RESTARTED_FROM)
         })?;
-        self.file
-            .new_attr::<f64>()
-            .shape(())
-            .create(names::ATTR_RESTART_TIME)
-            .and_then(|a| a.as_writer().write_scalar(&time))
-            .ctx(&self.path, || {
-                format!("writing root attribute {}", names::ATTR_RESTART_TIME)
-            })
+        scalar_attr(&self.file, names::ATTR_RESTART_TIME, time).ctx(&self.path, || {
+            format!("writing root attribute {}", names::ATTR_RESTART_TIME)
+        })
     }
 
     /// Number of steps appended (`T` once they are written; see

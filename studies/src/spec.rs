@@ -121,7 +121,6 @@ impl Figure {
     }
 }
 
-
 /// One swept key of `[grid]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GridKey {
@@ -562,198 +561,16 @@ pub fn parse_study_with(
     joints: &JointRegistry,
 ) -> Result<StudySpec, SpecError> {
     let file = path.to_path_buf();
-    let de = toml::de::DeTable::parse(text).map_err(|e| {
-        let line = e
-            .span()
-            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
-        SpecError::Syntax {
-            file: file.clone(),
-            line,
-            message: e.message().trim().to_owned(),
-        }
-    })?;
-    let lines = Lines::new(text, de.get_ref());
-    let root: Table = toml::from_str(text).map_err(|e| SpecError::Syntax {
-        file: file.clone(),
-        line: None,
-        message: e.message().trim().to_owned(),
-    })?;
-
-    for key in root.keys() {
-        if !matches!(key.as_str(), "name" | "model" | "grid" | "output") {
-            return Err(SpecError::UnknownKey {
-                file,
-                line: lines.get(key),
-                key: key.clone(),
-                allowed: "name, model, [grid], [output]",
-            });
-        }
-    }
-    let wrong_type = |key: &str, expected, v: &Value| SpecError::WrongType {
-        file: file.clone(),
-        line: lines.get(key),
-        key: key.to_owned(),
-        expected,
-        found: found(v),
+    let (root, lines) = parse_root(text, &file)?;
+    let study = StudyFile {
+        file: &file,
+        lines: &lines,
     };
-
-    let name = match root.get("name") {
-        None => {
-            return Err(SpecError::Missing {
-                file,
-                key: "name",
-                example: "name = \"pitch-dt\" (results go to <out>/<name>/)",
-            })
-        }
-        Some(Value::String(s)) => s.clone(),
-        Some(v) => return Err(wrong_type("name", "a string", v)),
-    };
-    if let Some(reason) = name_problem(&name) {
-        return Err(SpecError::BadName {
-            file,
-            line: lines.get("name"),
-            name,
-            reason,
-        });
-    }
-
-    let model_rel = match root.get("model") {
-        None => {
-            return Err(SpecError::Missing {
-                file,
-                key: "model",
-                example: "model = \"../dynamics/spinning_beam.toml\" (relative to the study file)",
-            })
-        }
-        Some(Value::String(s)) => PathBuf::from(s),
-        Some(v) => return Err(wrong_type("model", "a string (a path)", v)),
-    };
-    let model_file = if model_rel.is_absolute() {
-        model_rel
-    } else {
-        base_dir(path).join(model_rel)
-    };
-    load_model_with(&model_file, joints).map_err(|source| SpecError::Model {
-        file: file.clone(),
-        source,
-    })?;
-    // load_model read and parsed it; read it again as a plain TOML table.
-    let model_text = std::fs::read_to_string(&model_file).map_err(|e| SpecError::Model {
-        file: file.clone(),
-        source: ModelError::new(&model_file, "", None, format!("cannot read: {e}")),
-    })?;
-    let model_table: Table = toml::from_str(&model_text).map_err(|e| SpecError::Model {
-        file: file.clone(),
-        source: ModelError::new(&model_file, "", None, e.message().trim().to_owned()),
-    })?;
-
-    let mut grid = Vec::new();
-    match root.get("grid") {
-        None => {}
-        Some(Value::Table(t)) => {
-            for key in &lines.grid_order {
-                let Some(v) = t.get(key) else { continue };
-                let line_key = format!("grid.{key}");
-                let line = lines.get(&line_key);
-                let values = match v {
-                    Value::Array(a) => a.clone(),
-                    other => {
-                        return Err(SpecError::WrongType {
-                            file,
-                            line,
-                            key: format!("grid.\"{key}\""),
-                            expected: "a list of values, e.g. \"solver.dt\" = [0.02, 0.01] (quote dotted keys)",
-                            found: found(other),
-                        })
-                    }
-                };
-                if values.is_empty() {
-                    return Err(SpecError::EmptyList {
-                        file,
-                        line,
-                        key: key.clone(),
-                    });
-                }
-                let path = KeyPath::parse(key).map_err(|problem| SpecError::BadKey {
-                    file: file.clone(),
-                    line,
-                    key: key.clone(),
-                    problem,
-                })?;
-                check_key(&model_table, &path).map_err(|problem| SpecError::UnknownModelKey {
-                    file: file.clone(),
-                    line,
-                    key: key.clone(),
-                    model: model_file.clone(),
-                    problem,
-                })?;
-                grid.push(GridKey {
-                    key: key.clone(),
-                    path,
-                    values,
-                });
-            }
-        }
-        Some(v) => return Err(wrong_type("grid", "a table ([grid])", v)),
-    }
-
-    let mut figures = Figure::ALL.to_vec();
-    let mut titles = true;
-    match root.get("output") {
-        None => {}
-        Some(Value::Table(t)) => {
-            for key in t.keys() {
-                if key != "figures" && key != "titles" {
-                    return Err(SpecError::UnknownKey {
-                        file,
-                        line: lines.get(&format!("output.{key}")),
-                        key: format!("output.{key}"),
-                        allowed: "output.figures, output.titles",
-                    });
-                }
-            }
-            match t.get("titles") {
-                None => {}
-                Some(Value::Boolean(b)) => titles = *b,
-                Some(v) => return Err(wrong_type("output.titles", "true or false", v)),
-            }
-            if let Some(v) = t.get("figures") {
-                let line = lines.get("output.figures");
-                let Value::Array(names) = v else {
-                    return Err(wrong_type("output.figures", "a list of figure names", v));
-                };
-                figures.clear();
-                for n in names {
-                    let figure = match n {
-                        Value::String(s) => {
-                            Figure::from_name(s).ok_or_else(|| SpecError::UnknownFigure {
-                                file: file.clone(),
-                                line,
-                                name: s.clone(),
-                            })?
-                        }
-                        other => Figure::Dataset(DatasetFigure::parse(other).map_err(|why| {
-                            SpecError::BadFigure {
-                                file: file.clone(),
-                                line,
-                                why,
-                            }
-                        })?),
-                    };
-                    if figures.iter().any(|f| f.name() == figure.name()) {
-                        return Err(SpecError::DuplicateFigure {
-                            file,
-                            line,
-                            name: figure.name().to_string(),
-                        });
-                    }
-                    figures.push(figure);
-                }
-            }
-        }
-        Some(v) => return Err(wrong_type("output", "a table ([output])", v)),
-    }
-
+    study.check_top_keys(&root)?;
+    let name = study.name(&root)?;
+    let (model_file, model_table) = study.base_model(&root, path, joints)?;
+    let grid = study.grid(&root, &model_file, &model_table)?;
+    let (figures, titles) = study.output(&root)?;
     Ok(StudySpec {
         file,
         text: text.to_owned(),
@@ -767,6 +584,275 @@ pub fn parse_study_with(
         titles,
         joints: joints.clone(),
     })
+}
+
+/// Study-file `text` as a TOML table, with the lines of its keys; a syntax
+/// error names `file` and, where the parser knows it, the line.
+fn parse_root(text: &str, file: &Path) -> Result<(Table, Lines), SpecError> {
+    let de = toml::de::DeTable::parse(text).map_err(|e| {
+        let line = e
+            .span()
+            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        SpecError::Syntax {
+            file: file.to_path_buf(),
+            line,
+            message: e.message().trim().to_owned(),
+        }
+    })?;
+    let lines = Lines::new(text, de.get_ref());
+    let root: Table = toml::from_str(text).map_err(|e| SpecError::Syntax {
+        file: file.to_path_buf(),
+        line: None,
+        message: e.message().trim().to_owned(),
+    })?;
+    Ok((root, lines))
+}
+
+/// A `model` line, for the message of a study file without one.
+const MODEL_EXAMPLE: &str =
+    "model = \"../dynamics/spinning_beam.toml\" (relative to the study file)";
+
+/// What a grid key holds, for the message of one that holds something else.
+const GRID_VALUES: &str = "a list of values, e.g. \"solver.dt\" = [0.02, 0.01] (quote dotted keys)";
+
+/// The study file being read: its path and key lines, for the errors of
+/// each part of it.
+struct StudyFile<'a> {
+    file: &'a Path,
+    lines: &'a Lines,
+}
+
+impl StudyFile<'_> {
+    /// Key `key` holds `v`, which is not `expected`.
+    fn wrong_type(&self, key: &str, expected: &'static str, v: &Value) -> SpecError {
+        SpecError::WrongType {
+            file: self.file.to_path_buf(),
+            line: self.lines.get(key),
+            key: key.to_owned(),
+            expected,
+            found: found(v),
+        }
+    }
+
+    /// Refuses a top-level key other than `name`, `model`, `[grid]` and
+    /// `[output]`.
+    fn check_top_keys(&self, root: &Table) -> Result<(), SpecError> {
+        for key in root.keys() {
+            if !matches!(key.as_str(), "name" | "model" | "grid" | "output") {
+                return Err(SpecError::UnknownKey {
+                    file: self.file.to_path_buf(),
+                    line: self.lines.get(key),
+                    key: key.clone(),
+                    allowed: "name, model, [grid], [output]",
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// `name`: the study's name, which must name its output directory.
+    fn name(&self, root: &Table) -> Result<String, SpecError> {
+        let name = match root.get("name") {
+            None => {
+                return Err(SpecError::Missing {
+                    file: self.file.to_path_buf(),
+                    key: "name",
+                    example: "name = \"pitch-dt\" (results go to <out>/<name>/)",
+                })
+            }
+            Some(Value::String(s)) => s.clone(),
+            Some(v) => return Err(self.wrong_type("name", "a string", v)),
+        };
+        if let Some(reason) = name_problem(&name) {
+            return Err(SpecError::BadName {
+                file: self.file.to_path_buf(),
+                line: self.lines.get("name"),
+                name,
+                reason,
+            });
+        }
+        Ok(name)
+    }
+
+    /// `model`: the base model file (resolved against the study file's
+    /// directory `path`), loaded with every model-file check, and its text
+    /// as a plain TOML table.
+    fn base_model(
+        &self,
+        root: &Table,
+        path: &Path,
+        joints: &JointRegistry,
+    ) -> Result<(PathBuf, Table), SpecError> {
+        let file = self.file.to_path_buf();
+        let model_rel = match root.get("model") {
+            None => {
+                return Err(SpecError::Missing {
+                    file,
+                    key: "model",
+                    example: MODEL_EXAMPLE,
+                })
+            }
+            Some(Value::String(s)) => PathBuf::from(s),
+            Some(v) => return Err(self.wrong_type("model", "a string (a path)", v)),
+        };
+        let model_file = if model_rel.is_absolute() {
+            model_rel
+        } else {
+            base_dir(path).join(model_rel)
+        };
+        load_model_with(&model_file, joints).map_err(|source| SpecError::Model {
+            file: file.clone(),
+            source,
+        })?;
+        // load_model read and parsed it; read it again as a plain TOML table.
+        let model_text = std::fs::read_to_string(&model_file).map_err(|e| SpecError::Model {
+            file: file.clone(),
+            source: ModelError::new(&model_file, "", None, format!("cannot read: {e}")),
+        })?;
+        let model_table: Table = toml::from_str(&model_text).map_err(|e| SpecError::Model {
+            file: file.clone(),
+            source: ModelError::new(&model_file, "", None, e.message().trim().to_owned()),
+        })?;
+        Ok((model_file, model_table))
+    }
+
+    /// `[grid]`: the swept keys in the order written, each a list of values
+    /// at a key present in the base model `model_table` (`model_file`).
+    fn grid(
+        &self,
+        root: &Table,
+        model_file: &Path,
+        model_table: &Table,
+    ) -> Result<Vec<GridKey>, SpecError> {
+        let t = match root.get("grid") {
+            None => return Ok(Vec::new()),
+            Some(Value::Table(t)) => t,
+            Some(v) => return Err(self.wrong_type("grid", "a table ([grid])", v)),
+        };
+        let mut grid = Vec::new();
+        for key in &self.lines.grid_order {
+            let Some(v) = t.get(key) else { continue };
+            grid.push(self.grid_key(key, v, model_file, model_table)?);
+        }
+        Ok(grid)
+    }
+
+    /// Grid key `key` with its values `v`, checked against the base model.
+    fn grid_key(
+        &self,
+        key: &str,
+        v: &Value,
+        model_file: &Path,
+        model_table: &Table,
+    ) -> Result<GridKey, SpecError> {
+        let file = self.file.to_path_buf();
+        let line = self.lines.get(&format!("grid.{key}"));
+        let values = match v {
+            Value::Array(a) => a.clone(),
+            other => {
+                return Err(SpecError::WrongType {
+                    file,
+                    line,
+                    key: format!("grid.\"{key}\""),
+                    expected: GRID_VALUES,
+                    found: found(other),
+                })
+            }
+        };
+        if values.is_empty() {
+            return Err(SpecError::EmptyList {
+                file,
+                line,
+                key: key.to_owned(),
+            });
+        }
+        let path = KeyPath::parse(key).map_err(|problem| SpecError::BadKey {
+            file: file.clone(),
+            line,
+            key: key.to_owned(),
+            problem,
+        })?;
+        check_key(model_table, &path).map_err(|problem| SpecError::UnknownModelKey {
+            file: file.clone(),
+            line,
+            key: key.to_owned(),
+            model: model_file.to_path_buf(),
+            problem,
+        })?;
+        Ok(GridKey {
+            key: key.to_owned(),
+            path,
+            values,
+        })
+    }
+
+    /// `[output]`: the summary figures (every one by default) and whether
+    /// the summary charts have titles.
+    fn output(&self, root: &Table) -> Result<(Vec<Figure>, bool), SpecError> {
+        let mut figures = Figure::ALL.to_vec();
+        let mut titles = true;
+        let t = match root.get("output") {
+            None => return Ok((figures, titles)),
+            Some(Value::Table(t)) => t,
+            Some(v) => return Err(self.wrong_type("output", "a table ([output])", v)),
+        };
+        for key in t.keys() {
+            if key != "figures" && key != "titles" {
+                return Err(SpecError::UnknownKey {
+                    file: self.file.to_path_buf(),
+                    line: self.lines.get(&format!("output.{key}")),
+                    key: format!("output.{key}"),
+                    allowed: "output.figures, output.titles",
+                });
+            }
+        }
+        match t.get("titles") {
+            None => {}
+            Some(Value::Boolean(b)) => titles = *b,
+            Some(v) => return Err(self.wrong_type("output.titles", "true or false", v)),
+        }
+        if let Some(v) = t.get("figures") {
+            figures = self.figures(v)?;
+        }
+        Ok((figures, titles))
+    }
+
+    /// `output.figures`: a list of figure names and dataset-figure tables,
+    /// each figure once.
+    fn figures(&self, v: &Value) -> Result<Vec<Figure>, SpecError> {
+        let line = self.lines.get("output.figures");
+        let Value::Array(names) = v else {
+            return Err(self.wrong_type("output.figures", "a list of figure names", v));
+        };
+        let mut figures = Vec::new();
+        for n in names {
+            let figure = match n {
+                Value::String(s) => {
+                    Figure::from_name(s).ok_or_else(|| SpecError::UnknownFigure {
+                        file: self.file.to_path_buf(),
+                        line,
+                        name: s.clone(),
+                    })?
+                }
+                other => Figure::Dataset(DatasetFigure::parse(other).map_err(|why| {
+                    SpecError::BadFigure {
+                        file: self.file.to_path_buf(),
+                        line,
+                        why,
+                    }
+                })?),
+            };
+            if figures.iter().any(|f: &Figure| f.name() == figure.name()) {
+                return Err(SpecError::DuplicateFigure {
+                    file: self.file.to_path_buf(),
+                    line,
+                    name: figure.name().to_string(),
+                });
+            }
+            figures.push(figure);
+        }
+        Ok(figures)
+    }
 }
 
 /// Why `name` cannot name a study's output directory, if it cannot.

@@ -1,10 +1,13 @@
 //! The reproduction's figures, drawn from the result files into `DIR/charts/`:
 //!
-//! * `fig6_screw_free_post_top_y` — paper Figure 6: Y displacement of the top
-//!   of the vertical beam, the three schemes, Newmark's failure time marked;
-//! * `fig8_screw_driven_tip_uz`, `fig9_screw_driven_tip_rotation_x` — paper
-//!   Figures 8–9: the driven screw's tip displacement `u_z` and rotation
-//!   about X;
+//! * the paper's figures of node paths, as the table
+//!   `data/paper/charts/charts.toml` ([`super::chart_table`]) gives them:
+//!   * `fig6_screw_free_post_top_y` — paper Figure 6: Y displacement of the
+//!     top of the vertical beam, the three schemes, Newmark's failure time
+//!     marked;
+//!   * `fig8_screw_driven_tip_uz`, `fig9_screw_driven_tip_rotation_x` —
+//!     paper Figures 8–9: the driven screw's tip displacement `u_z` and
+//!     rotation about X;
 //! * per model: `<model>_energy` (total energy minus the drivers' work),
 //!   `<model>_energy_error` (its relative change, logarithmic),
 //!   `<model>_beta` (the energy–momentum corrections: the discrete
@@ -14,6 +17,7 @@
 //!   energy–momentum corrections at the model's step and at half of it — the
 //!   discrete gradient's falls by 4, the paper's β does not fall.
 
+use super::chart_table::PaperChart;
 use super::{ReproduceError, RunRecord, CONSISTENCY_INTEGRATORS, CONSISTENCY_MODEL, INTEGRATORS};
 use flexmech_plot::charts::{LineChart, Series};
 use flexmech_results::{ReadError, ResultReader};
@@ -96,9 +100,6 @@ impl Style {
     }
 }
 
-/// Energy–momentum markers on Fig. 8's curve (about this many).
-const FIG8_MARKERS: usize = 25;
-
 /// How far beyond the completed runs' range a failed run is still drawn,
 /// in units of that range: once past it, the run is off the chart's scale
 /// (its failure marker says when it failed).
@@ -164,9 +165,13 @@ fn scheme_chart(
     Ok(chart)
 }
 
-/// Draws every chart of the reproduction; returns the PNG paths.
+/// Draws every chart of the reproduction: per model, its figures of
+/// `paper` (the table of `data/paper/charts/charts.toml`, in table order),
+/// then its energy, energy error, step size, β and joint charts. Returns the
+/// PNG paths.
 pub fn draw_all(
     records: &[RunRecord],
+    paper: &[PaperChart],
     out: &Path,
     style: Style,
 ) -> Result<Vec<PathBuf>, ReproduceError> {
@@ -175,165 +180,200 @@ pub fn draw_all(
     let mut models: Vec<&str> = records.iter().map(|r| r.model.as_str()).collect();
     models.dedup();
     for model in models {
-        let runs: Vec<&RunRecord> = INTEGRATORS
-            .iter()
-            .filter_map(|i| {
-                records
-                    .iter()
-                    .find(|r| r.model == model && r.integrator == *i)
-            })
-            .collect();
+        let runs = model_runs(records, model);
         let mut draw = |name: String, chart: LineChart| -> Result<(), ReproduceError> {
             let png = style.render(chart, &dir.join(name))?;
             written.push(png);
             Ok(())
         };
-        if model == "screw_free" {
-            // A run that blew up is drawn until its energy error passes
-            // 1000 % (its last steps would set the scale); the marker shows
-            // where it failed.
-            let chart = scheme_chart(
-                &runs,
-                "Freely rotating screw joint: top of the vertical beam (paper Fig. 6)",
-                "Y displacement (m)",
-                |r| {
-                    let y = column(&r.file, "/nodes/post.end/displacement", 1)?;
-                    let b0 = r.balance.first().copied().unwrap_or(0.0);
-                    let mut blown = false;
-                    Ok(y.iter()
-                        .zip(&r.balance)
-                        .map(|(&y, b)| {
-                            blown |= (b - b0).abs() > 10.0 * r.energy_scale;
-                            if blown {
-                                f64::NAN
-                            } else {
-                                y
-                            }
-                        })
-                        .collect())
-                },
-            )?;
-            draw("fig6_screw_free_post_top_y".into(), chart)?;
+        for figure in paper.iter().filter(|c| c.model == model) {
+            draw(figure.name.clone(), paper_chart(figure, &runs)?)?;
         }
-        if model == "screw_driven" {
-            let chart = scheme_chart(
-                &runs,
-                "Driven screw joint: tip displacement (paper Fig. 8)",
-                "out-of-plane tip displacement (m)",
-                |r| column(&r.file, "/nodes/arm.end/displacement", 2),
-            )?;
-            // The two conserving schemes' curves lie on each other: markers
-            // keep the energy–momentum one visible.
-            let mut chart = chart;
-            for (s, r) in chart.series.iter_mut().zip(&runs) {
-                if r.integrator == "energy-momentum" {
-                    s.mark_every = (s.x.len() / FIG8_MARKERS).max(1);
-                }
-            }
-            draw("fig8_screw_driven_tip_uz".into(), chart)?;
-            let chart = scheme_chart(
-                &runs,
-                "Driven screw joint: tip rotation (paper Fig. 9)",
-                "rotation about X (rad)",
-                |r| column(&r.file, "/nodes/arm.end/rotation", 0),
-            )?;
-            draw("fig9_screw_driven_tip_rotation_x".into(), chart)?;
-        }
-        let energy_label = if model == "screw_free" {
-            "total energy (J)"
-        } else {
-            "total energy − work of the drive (J)"
-        };
-        let band = completed_band(&runs, |r| r.balance.clone());
-        let mut chart = scheme_chart(
-            &runs,
-            &format!("{model}: energy balance"),
-            energy_label,
-            |r| Ok(r.balance.clone()),
+        draw(format!("{model}_energy"), energy_chart(model, &runs)?)?;
+        draw(
+            format!("{model}_energy_error"),
+            energy_error_chart(model, &runs)?,
         )?;
-        if let Some(band) = band {
-            keep_on_scale(&mut chart, &runs, band);
-        }
-        draw(format!("{model}_energy"), chart)?;
-        let mut chart = scheme_chart(
-            &runs,
-            &format!("{model}: relative energy error"),
-            "relative energy error",
-            |r| {
-                let b0 = r.balance.first().copied().unwrap_or(0.0);
-                Ok(r.balance
-                    .iter()
-                    .map(|b| (b - b0).abs() / r.energy_scale)
-                    .collect())
-            },
-        )?;
-        chart.log_y = true;
-        draw(format!("{model}_energy_error"), chart)?;
-        let chart = scheme_chart(
-            &runs,
-            &format!("{model}: step size actually used"),
-            "Δt (s)",
-            |r| {
-                Ok(r.dt
-                    .iter()
-                    .map(|&d| if d > 0.0 { d } else { f64::NAN })
-                    .collect())
-            },
-        )?;
-        draw(format!("{model}_dt"), chart)?;
-        let em: Vec<&RunRecord> = runs
-            .iter()
-            .copied()
-            .filter(|r| CONSISTENCY_INTEGRATORS.contains(&r.integrator.as_str()))
-            .collect();
-        if em.iter().any(|r| r.beta.iter().any(|b| b.is_finite())) {
-            let mut chart = LineChart::new(
-                format!("{model}: energy–momentum corrections"),
-                "time (s)",
-                "|β|",
-            );
-            for r in em {
-                chart.series.push(Series::new(
-                    legend(&r.integrator),
-                    r.time.clone(),
-                    abs_beta(r),
-                ));
-            }
-            chart.log_y = true;
+        draw(format!("{model}_dt"), dt_chart(model, &runs)?)?;
+        if let Some(chart) = beta_chart(model, &runs) {
             draw(format!("{model}_beta"), chart)?;
         }
         if let Some(first) = runs.first() {
-            let joint = first_joint(&first.file)?;
-            let mut chart = LineChart::new(
-                format!("{model}: joint `{joint}`"),
-                "joint angle ψ (rad)",
-                "released translation (m)",
-            );
-            for r in &runs {
-                let angle = read(&r.file, &format!("/joints/{joint}/angle"))?;
-                let rr = read(&r.file, &format!("/joints/{joint}/released_translation"))?;
-                // The component that moves most.
-                let c = (0..3)
-                    .max_by(|&a, &b| {
-                        let range = |c: usize| {
-                            let v = rr.chunks(3).map(|x| x[c]);
-                            v.clone().fold(f64::MIN, f64::max) - v.fold(f64::MAX, f64::min)
-                        };
-                        range(a).total_cmp(&range(b))
-                    })
-                    .unwrap_or(0);
-                let axis = ["x", "y", "z"][c];
-                chart.y_label = format!("released translation, {axis} (m)");
-                chart.series.push(Series::new(
-                    legend(&r.integrator),
-                    angle,
-                    rr.chunks(3).map(|x| x[c]).collect(),
-                ));
-            }
-            draw(format!("{model}_joint"), chart)?;
+            draw(format!("{model}_joint"), joint_chart(model, &runs, first)?)?;
         }
     }
     Ok(written)
+}
+
+/// The runs of `model`, in the order of [`INTEGRATORS`].
+fn model_runs<'a>(records: &'a [RunRecord], model: &str) -> Vec<&'a RunRecord> {
+    INTEGRATORS
+        .iter()
+        .filter_map(|i| {
+            records
+                .iter()
+                .find(|r| r.model == model && r.integrator == *i)
+        })
+        .collect()
+}
+
+/// A figure of the paper's table: its dataset column over time for each
+/// scheme, cut where a run blew up and with its markers.
+fn paper_chart(figure: &PaperChart, runs: &[&RunRecord]) -> Result<LineChart, ReproduceError> {
+    let mut chart = scheme_chart(runs, &figure.title, &figure.y_label, |r| {
+        let values = column(&r.file, &figure.dataset, figure.component)?;
+        Ok(match figure.cut_at_energy_error {
+            Some(limit) => cut_where_blown(&values, r, limit),
+            None => values,
+        })
+    })?;
+    if let Some(markers) = &figure.markers {
+        for (s, r) in chart.series.iter_mut().zip(runs) {
+            if r.integrator == markers.integrator {
+                s.mark_every = (s.x.len() / markers.count).max(1);
+            }
+        }
+    }
+    Ok(chart)
+}
+
+/// `values` of run `r` up to the first step whose energy balance is off its
+/// initial value by more than `limit` times the run's energy scale, NaN from
+/// there on: a run that blew up is drawn until then (its last steps would
+/// set the scale); the failure marker shows where it failed.
+fn cut_where_blown(values: &[f64], r: &RunRecord, limit: f64) -> Vec<f64> {
+    let b0 = r.balance.first().copied().unwrap_or(0.0);
+    let mut blown = false;
+    values
+        .iter()
+        .zip(&r.balance)
+        .map(|(&y, b)| {
+            blown |= (b - b0).abs() > limit * r.energy_scale;
+            if blown {
+                f64::NAN
+            } else {
+                y
+            }
+        })
+        .collect()
+}
+
+/// `<model>_energy`: the energy balance of each scheme, a diverged run kept
+/// off the scale ([`keep_on_scale`]).
+fn energy_chart(model: &str, runs: &[&RunRecord]) -> Result<LineChart, ReproduceError> {
+    let energy_label = if model == "screw_free" {
+        "total energy (J)"
+    } else {
+        "total energy − work of the drive (J)"
+    };
+    let band = completed_band(runs, |r| r.balance.clone());
+    let mut chart = scheme_chart(
+        runs,
+        &format!("{model}: energy balance"),
+        energy_label,
+        |r| Ok(r.balance.clone()),
+    )?;
+    if let Some(band) = band {
+        keep_on_scale(&mut chart, runs, band);
+    }
+    Ok(chart)
+}
+
+/// `<model>_energy_error`: each scheme's relative energy error, logarithmic.
+fn energy_error_chart(model: &str, runs: &[&RunRecord]) -> Result<LineChart, ReproduceError> {
+    let mut chart = scheme_chart(
+        runs,
+        &format!("{model}: relative energy error"),
+        "relative energy error",
+        |r| {
+            let b0 = r.balance.first().copied().unwrap_or(0.0);
+            Ok(r.balance
+                .iter()
+                .map(|b| (b - b0).abs() / r.energy_scale)
+                .collect())
+        },
+    )?;
+    chart.log_y = true;
+    Ok(chart)
+}
+
+/// `<model>_dt`: the step size each scheme used.
+fn dt_chart(model: &str, runs: &[&RunRecord]) -> Result<LineChart, ReproduceError> {
+    scheme_chart(
+        runs,
+        &format!("{model}: step size actually used"),
+        "Δt (s)",
+        |r| {
+            Ok(r.dt
+                .iter()
+                .map(|&d| if d > 0.0 { d } else { f64::NAN })
+                .collect())
+        },
+    )
+}
+
+/// `<model>_beta`: `|β|` of the energy–momentum schemes, logarithmic; none
+/// when no β is finite.
+fn beta_chart(model: &str, runs: &[&RunRecord]) -> Option<LineChart> {
+    let em: Vec<&RunRecord> = runs
+        .iter()
+        .copied()
+        .filter(|r| CONSISTENCY_INTEGRATORS.contains(&r.integrator.as_str()))
+        .collect();
+    if !em.iter().any(|r| r.beta.iter().any(|b| b.is_finite())) {
+        return None;
+    }
+    let mut chart = LineChart::new(
+        format!("{model}: energy–momentum corrections"),
+        "time (s)",
+        "|β|",
+    );
+    for r in em {
+        chart.series.push(Series::new(
+            legend(&r.integrator),
+            r.time.clone(),
+            abs_beta(r),
+        ));
+    }
+    chart.log_y = true;
+    Some(chart)
+}
+
+/// `<model>_joint`: the released translation's component that moves most
+/// against the angle of the first joint of `first`'s result file.
+fn joint_chart(
+    model: &str,
+    runs: &[&RunRecord],
+    first: &RunRecord,
+) -> Result<LineChart, ReproduceError> {
+    let joint = first_joint(&first.file)?;
+    let mut chart = LineChart::new(
+        format!("{model}: joint `{joint}`"),
+        "joint angle ψ (rad)",
+        "released translation (m)",
+    );
+    for r in runs {
+        let angle = read(&r.file, &format!("/joints/{joint}/angle"))?;
+        let rr = read(&r.file, &format!("/joints/{joint}/released_translation"))?;
+        // The component that moves most.
+        let c = (0..3)
+            .max_by(|&a, &b| {
+                let range = |c: usize| {
+                    let v = rr.chunks(3).map(|x| x[c]);
+                    v.clone().fold(f64::MIN, f64::max) - v.fold(f64::MAX, f64::min)
+                };
+                range(a).total_cmp(&range(b))
+            })
+            .unwrap_or(0);
+        let axis = ["x", "y", "z"][c];
+        chart.y_label = format!("released translation, {axis} (m)");
+        chart.series.push(Series::new(
+            legend(&r.integrator),
+            angle,
+            rr.chunks(3).map(|x| x[c]).collect(),
+        ));
+    }
+    Ok(chart)
 }
 
 /// `|β|` of a run, with zeros (nothing to correct) left out of a log axis.

@@ -13,8 +13,11 @@
 //! ParaView series per run and an animation per example.
 //!
 //! The model files are compiled into the program, so the command works from
-//! any directory; they are the files of `data/paper/`, byte for byte.
+//! any directory; they are the files of `data/paper/`, byte for byte. So is
+//! the table of the paper's figures, `data/paper/charts/charts.toml`
+//! ([`chart_table`]), read when a reproduction starts.
 
+pub mod chart_table;
 pub mod charts;
 pub mod runs;
 pub mod summary;
@@ -134,6 +137,30 @@ pub enum ReproduceError {
         /// What went wrong.
         message: String,
     },
+    /// The table of the paper's figures (`data/paper/charts/charts.toml`)
+    /// is not valid TOML.
+    #[error("{}{}: not valid TOML: {message}", .file.display(), at_line(.line))]
+    ChartTableSyntax {
+        /// The table's file.
+        file: PathBuf,
+        /// 1-based line, where known.
+        line: Option<usize>,
+        /// The parser's message.
+        message: String,
+    },
+    /// An entry of the table of the paper's figures
+    /// (`data/paper/charts/charts.toml`) is malformed.
+    #[error("{}{}: key `{key}`: {message}", .file.display(), at_line(.line))]
+    ChartTable {
+        /// The table's file.
+        file: PathBuf,
+        /// 1-based line, where known.
+        line: Option<usize>,
+        /// The key, e.g. `chart[1].component`.
+        key: String,
+        /// What is wrong, and the fix.
+        message: String,
+    },
     /// Drawing a chart failed.
     #[error(transparent)]
     Chart(#[from] flexmech_plot::charts::ChartError),
@@ -145,6 +172,11 @@ pub enum ReproduceError {
         /// The system's error.
         source: std::io::Error,
     },
+}
+
+/// `:<line>` where the line is known, for messages.
+fn at_line(line: &Option<usize>) -> String {
+    line.map(|l| format!(":{l}")).unwrap_or_default()
 }
 
 /// Everything a reproduction produced.
@@ -184,12 +216,13 @@ pub fn reproduce(options: &ReproduceOptions) -> Result<Reproduction, ReproduceEr
         .copied()
         .filter(|m| options.models.is_empty() || options.models.iter().any(|n| n == m.0))
         .collect();
+    let paper_charts = chart_table::paper_charts()?;
     let (runs, half_step) = run_all(&selected, &options.out, options.time_scale)?;
     let style = charts::Style {
         titles: options.titles,
         pdf: options.pdf,
     };
-    let mut charts = charts::draw_all(&runs, &options.out, style)?;
+    let mut charts = charts::draw_all(&runs, &paper_charts, &options.out, style)?;
     charts.extend(charts::draw_consistency(
         &runs,
         &half_step,
