@@ -60,6 +60,36 @@
 //! with arguments the same binary is flexmech's command line with the cam
 //! ([`App::main`]).
 //!
+//! ## A model in Rust, a run into memory
+//!
+//! [`Model::new`](prelude::Model::new) writes a model with a few calls and
+//! reads it through the same checks as a model file; [`run`](prelude::run)
+//! hands its steps to a sink: the result file ([`run_model`](prelude::run_model)),
+//! memory ([`Memory`](prelude::Memory)) or a closure ([`OnStep`](prelude::OnStep)).
+//!
+//! ```
+//! use flexmech::prelude::*;
+//!
+//! let rod = SectionValues { ea: 1e7, ga: [1e6; 2], gj: 1e3, ei: [1e3; 2], rho_a: 0.0, rho_j: [0.0; 3] };
+//! let arm = BeamGeometry::Straight { start: Vector3::zeros(), end: Vector3::x(), e2: Vector3::y() };
+//! let model = Model::new("cantilever")
+//!     .section("rod", rod)
+//!     .beam("arm", "rod", arm, 10)
+//!     .support("arm.start", "all")
+//!     .load("arm.end", [0.0, 0.0, -0.1], [0.0; 3])
+//!     .statics(1)
+//!     .track("arm.end")
+//!     .build()?;
+//! let mut memory = Memory::default();
+//! run(&model, &mut memory)?;
+//! let tip = memory.positions("arm.end").unwrap();
+//! // Timoshenko's F L³/(3EI) + F L/GA, less the 2-node element's
+//! // trapezoidal-rule error F L³/(12 EI n²) (n = 10 elements).
+//! let expected = 0.1 / 3e3 + 0.1 / 1e6 - 0.1 / (12.0 * 1e3 * 100.0);
+//! assert!((tip.last().unwrap()[2] + expected).abs() < 1e-3 * expected);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! ## 2. A study over its parameter
 //!
 //! A [`Study`](prelude::Study) sweeps model keys (`joint.cam.b`,

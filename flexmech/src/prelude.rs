@@ -6,7 +6,10 @@ pub use flexmech_core::{cst, Scalar};
 pub use flexmech_integrators::dynamics::{Integrator, Simulation};
 pub use flexmech_joints::model_joint::{direction, perpendicular_slide, positive};
 pub use flexmech_joints::{DependentJoint, ModelJoint, ParamError};
-pub use flexmech_model::{load_model, parse_model, JointRegistry, Model, ModelError};
+pub use flexmech_model::{
+    load_model, parse_model, BeamGeometry, JointRegistry, Model, ModelBuilder, ModelError,
+    SectionValues,
+};
 pub use nalgebra::Vector3;
 pub use serde::Deserialize;
 pub use std::path::Path;
