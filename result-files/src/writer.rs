@@ -977,6 +977,8 @@ impl Datasets {
             &e.strain,
             &e.potential,
             &e.total,
+            &e.driver_work,
+            &e.dissipated,
             &self.momentum_linear,
             &self.momentum_angular,
             &s.iterations,
