@@ -30,6 +30,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 pub mod bench;
+mod plot_study;
 pub mod reproduce;
 
 #[derive(Parser)]
@@ -154,7 +155,7 @@ struct PlotArgs {
     result: PathBuf,
     /// Dataset paths, e.g. /energy/total or /nodes/<label>/displacement
     /// (shape T: one curve; T x 3: x, y and z curves).
-    #[arg(required = true)]
+    #[arg(required_unless_present = "study")]
     datasets: Vec<String>,
     /// Output directory for the charts.
     #[arg(long, short, default_value = "plots")]
@@ -182,6 +183,12 @@ struct PlotArgs {
     /// Also a PDF of each chart, from its PGFPlots copy (needs pdflatex).
     #[arg(long)]
     pdf: bool,
+    /// A study's output directory (`<out>/<name>`, with summary.csv and
+    /// runs/): every positional argument is then a dataset (DATASET[k] for
+    /// column k, or x, y, z), drawn across the runs, one curve per run
+    /// named by its swept values.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["x", "with"])]
+    study: Option<PathBuf>,
 }
 
 /// The arguments of `flexmech export`.
@@ -487,6 +494,7 @@ fn plot_command(args: PlotArgs) -> ExitCode {
         title,
         with,
         pdf,
+        study,
     } = args;
     let options = PlotOptions {
         log_y: log,
@@ -497,6 +505,9 @@ fn plot_command(args: PlotArgs) -> ExitCode {
         overlay: with,
         pdf,
     };
+    if let Some(dir) = study {
+        return plot_study::command(&dir, &result, &datasets, &out, &options);
+    }
     match plot_with(&result, &datasets, &out, &options) {
         Ok(files) => {
             for f in files {

@@ -749,3 +749,239 @@ fn plot_labels_units_draws_x_y_plots_and_overlays_files() {
     let err = plot_with(&a, &[layout::ENERGY_STRAIN.to_owned()], &out, &bad).unwrap_err();
     assert!(err.to_string().contains("[0]"), "{err}");
 }
+
+/// `(x, y)` of the SVG `<text>` element whose content is `content`.
+fn text_position(svg: &str, content: &str) -> Option<(f64, f64)> {
+    svg.split("<text").skip(1).find_map(|rest| {
+        let start = rest.find('>')? + 1;
+        let end = rest.find("</text>")?;
+        if rest[start..end].trim() != content {
+            return None;
+        }
+        let attr = |name: &str| -> Option<f64> {
+            let at = rest.find(&format!(" {name}=\""))? + name.len() + 3;
+            rest[at..].split('"').next()?.parse().ok()
+        };
+        Some((attr("x")?, attr("y")?))
+    })
+}
+
+/// The `{…}` of every `key={…}` (one level of braces inside) in a `.tex`.
+fn tex_values(tex: &str, key: &str) -> Vec<String> {
+    tex.split(key)
+        .skip(1)
+        .filter_map(|rest| {
+            let mut depth = 0usize;
+            for (i, c) in rest.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 1 => return Some(rest[1..i].to_owned()),
+                    '}' => depth = depth.saturating_sub(1),
+                    _ => {}
+                }
+            }
+            None
+        })
+        .collect()
+}
+
+#[test]
+fn the_svg_and_the_tex_agree_on_labels_legend_entries_and_the_legend_corner() {
+    use flexmech::plot::charts::pgfplots::latex;
+    let dir = tempfile::tempdir().unwrap();
+    // Rising curves fill the upper right: the legend goes upper left. An
+    // unlabelled curve has no legend entry in either file.
+    let x = linspace(0.0, 1.0, 60);
+    let rising = |k: f64| x.iter().map(|x| k * x * x).collect::<Vec<f64>>();
+    let upper_left = LineChart {
+        title: "Tip of the arm".into(),
+        x_label: "time (s)".into(),
+        y_label: "Δz (m)".into(),
+        log_y: false,
+        series: vec![
+            Series::new("run 1", x.clone(), rising(1.0)),
+            Series::new("", x.clone(), rising(0.9)),
+            Series::new("run 3", x.clone(), rising(0.8)),
+        ],
+        markers: vec![],
+    };
+    // Eight crossing curves leave no corner free: the legend goes below the
+    // plot, left-aligned, in three columns.
+    let t = linspace(0.0, 2.0, 201);
+    let below = LineChart {
+        series: (0..8)
+            .map(|k| {
+                let y = t.iter().map(|t| ((k + 1) as f64 * t).sin()).collect();
+                Series::new(format!("mode {k}"), t.clone(), y)
+            })
+            .collect(),
+        ..LineChart::new("Modes", "time (s)", "amplitude (m)")
+    };
+    for (chart, stem, corner) in [
+        (&upper_left, "upper_left", "legend pos=north west"),
+        (&below, "below", "anchor=north west"),
+    ] {
+        let (_, svg) = chart.render(&dir.path().join(stem)).expect("render");
+        let svg = svg_text(&svg);
+        let texts = text_elements(&svg);
+        let tex = std::fs::read_to_string(dir.path().join(format!("{stem}.tex"))).unwrap();
+        for (key, label) in [
+            ("title=", &chart.title),
+            ("xlabel=", &chart.x_label),
+            ("ylabel=", &chart.y_label),
+        ] {
+            assert_eq!(texts.iter().filter(|t| *t == label).count(), 1, "{label}");
+            assert_eq!(tex_values(&tex, key), [latex(label)], "{stem}: {key}");
+        }
+        let labelled: Vec<&String> = chart
+            .series
+            .iter()
+            .map(|s| &s.label)
+            .filter(|l| !l.is_empty())
+            .collect();
+        let in_tex = tex_values(&tex, "\\addlegendentry");
+        assert_eq!(in_tex.len(), labelled.len(), "{stem}: {in_tex:?}");
+        for (label, entry) in labelled.iter().zip(&in_tex) {
+            assert_eq!(texts.iter().filter(|t| t == label).count(), 1, "{label}");
+            assert_eq!(entry, &latex(label));
+        }
+        assert!(tex.contains(corner), "{stem}: {tex}");
+        let (lx, ly) = text_position(&svg, labelled[0]).expect("the legend's first entry");
+        match stem {
+            "upper_left" => assert!(lx < 800.0 && ly < 500.0, "upper left: {lx}, {ly}"),
+            _ => {
+                assert!(tex.contains("legend columns=3"), "{tex}");
+                assert!(lx < 400.0 && ly > 800.0, "below, at the left: {lx}, {ly}");
+            }
+        }
+    }
+}
+
+#[test]
+fn panels_draw_each_chart_as_it_is_alone() {
+    use flexmech::plot::charts::{Color, Dash, Marker, Panels};
+    let dir = tempfile::tempdir().unwrap();
+    let first = three_series_chart();
+    let mut second = three_series_chart();
+    second.title = "Styled".into();
+    second.series[0] = second.series[0]
+        .clone()
+        .color(Color::rgb(120, 0, 0))
+        .dash(Dash::LongDashed)
+        .marker(Marker::Triangle);
+    second.series[2] = second.series[2].clone().marker(Marker::Cross);
+    let (a, _) = first.render(&dir.path().join("first")).unwrap();
+    let (b, _) = second.render(&dir.path().join("second")).unwrap();
+    let (row, svg) = Panels::row(vec![first, second])
+        .render(&dir.path().join("row"))
+        .unwrap();
+    keep(&[&row, &svg]);
+    let row = image::open(&row).unwrap().to_rgb8();
+    assert_eq!(row.dimensions(), (3200, 1000));
+    for (k, alone) in [a, b].iter().enumerate() {
+        let alone = image::open(alone).unwrap().to_rgb8();
+        let panel = image::imageops::crop_imm(&row, 1600 * k as u32, 0, 1600, 1000).to_image();
+        assert!(panel == alone, "panel {k} is drawn as the chart alone");
+    }
+    let texts = text_elements(&svg_text(&svg));
+    assert!(texts.iter().any(|t| t == "Styled"));
+    let tex = std::fs::read_to_string(dir.path().join("row.tex")).unwrap();
+    assert!(
+        tex.contains("mark=triangle*") && tex.contains("mark=x"),
+        "{tex}"
+    );
+    compiles(&dir.path().join("row.tex"));
+}
+
+/// A two-run study of the driven screw (its pitch swept, five steps), run
+/// by the `flexmech` binary below `dir`; returns its output directory.
+fn screw_pitch_study(dir: &Path) -> PathBuf {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper/screw_driven.toml");
+    let study = dir.join("pitch.toml");
+    std::fs::write(
+        &study,
+        format!(
+            "name = \"pitch\"\nmodel = \"{}\"\n\n[grid]\n\"joint.screw.pitch\" = [0.01, 0.03]\n\
+             \"solver.t_end\" = [0.05]\n",
+            model.display()
+        ),
+    )
+    .unwrap();
+    let run = Command::new(env!("CARGO_BIN_EXE_flexmech"))
+        .arg("study")
+        .arg(&study)
+        .arg("--out")
+        .arg(dir.join("studies"))
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    dir.join("studies").join("pitch")
+}
+
+#[test]
+fn flexmech_plot_over_a_study_overlays_its_runs_named_by_their_values() {
+    let _guard = serial();
+    let dir = tempfile::tempdir().unwrap();
+    let study = screw_pitch_study(dir.path());
+    let out = dir.path().join("plots");
+    let run = Command::new(env!("CARGO_BIN_EXE_flexmech"))
+        .args(["plot", "--study"])
+        .arg(&study)
+        .arg("/joints/screw/released_translation[z]")
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let stem = out.join("joints_screw_released_translation_z");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        stdout.contains("joints_screw_released_translation_z.png"),
+        "{stdout}"
+    );
+    let tex = std::fs::read_to_string(stem.with_extension("tex")).expect("the .tex");
+    let entries = tex_values(&tex, "\\addlegendentry");
+    assert_eq!(entries, ["screw pitch = 0.01", "screw pitch = 0.03"]);
+    let texts = text_elements(&svg_text(&stem.with_extension("svg")));
+    for entry in &entries {
+        assert!(texts.contains(entry), "{entry} in {texts:?}");
+    }
+    assert!(
+        texts.iter().any(|t| t.ends_with(", z (m)")),
+        "the y label names the column and unit: {texts:?}"
+    );
+    // The lift is the pitch times the same prescribed angle: three times
+    // as much in the second run.
+    let csv = read_csv(&stem.with_extension("csv"));
+    assert_eq!(csv.len(), 4, "two runs");
+    let (lift_1, lift_3) = (csv[1].last().unwrap(), csv[3].last().unwrap());
+    assert!(*lift_1 > 0.0, "{lift_1}");
+    assert!((lift_3 / lift_1 - 3.0).abs() < 1e-3, "{lift_1} {lift_3}");
+
+    // A T×3 dataset needs its column; a directory that is no study is
+    // refused naming what it should hold; --x has no meaning here.
+    let refused = |args: &[&str], dir: &Path| {
+        let run = Command::new(env!("CARGO_BIN_EXE_flexmech"))
+            .args(["plot", "--study"])
+            .arg(dir)
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(!run.status.success());
+        String::from_utf8_lossy(&run.stderr).into_owned()
+    };
+    let err = refused(&["/joints/screw/released_translation"], &study);
+    assert!(err.contains("released_translation[x]"), "{err}");
+    let err = refused(&["/energy/total"], dir.path());
+    assert!(err.contains("summary.csv"), "{err}");
+    let err = refused(&["/energy/total", "--x", "/time"], &study);
+    assert!(err.contains("--x"), "{err}");
+}
