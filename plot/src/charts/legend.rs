@@ -8,11 +8,11 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::font::{self, text_width};
-use super::line::{
+use super::figure::{
     px, Corner, Figure, Layout, AXIS_WIDTH, HEIGHT, LEGEND_COLUMN_GAP, LEGEND_FONT, LEGEND_GAP,
     LEGEND_INSET, LEGEND_PAD, LEGEND_ROW, LEGEND_SAMPLE, LINE_WIDTH, MARGIN,
 };
+use super::font::{self, text_width};
 use super::marks::draw_mark;
 use super::strokes::{dashed, pixels};
 

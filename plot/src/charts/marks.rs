@@ -3,7 +3,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::line::{px, LINE_WIDTH, MARKER_RADIUS};
+use super::figure::{px, LINE_WIDTH, MARKER_RADIUS};
 use super::style::Marker;
 
 /// Draws `marker` centred on `(x, y)` (pixels of `root`) at drawing scale

@@ -14,6 +14,7 @@
 
 mod chart;
 mod clip;
+mod figure;
 pub mod font;
 mod legend;
 mod line;
@@ -28,7 +29,8 @@ mod tests;
 mod ticks;
 
 pub use chart::{LineChart, Series, AUTO_MARKERS};
-pub use line::{ChartError, HEIGHT, WIDTH};
+pub use figure::{HEIGHT, WIDTH};
+pub use line::ChartError;
 pub use panels::Panels;
 pub use plot::{plot_datasets, plot_with, unit_of, PlotError, PlotOptions};
 pub use style::{auto_style, Color, Dash, Marker};

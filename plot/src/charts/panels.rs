@@ -11,7 +11,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::chart::LineChart;
-use super::line::{render_files, with_suffix, Canvas, ChartError, Figure, HEIGHT, WIDTH};
+use super::figure::{Figure, HEIGHT, WIDTH};
+use super::line::{render_files, with_suffix, Canvas, ChartError};
 use super::pgfplots::{axis_body, axis_options, compile_pdf, csv_of, document, legend_rows_below};
 
 /// A figure of several [`LineChart`]s laid out in rows of `columns` panels,

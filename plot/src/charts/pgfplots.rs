@@ -22,7 +22,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::chart::{LineChart, Series};
-use super::line::{Corner, Figure};
+use super::figure::{Corner, Figure};
 use super::style::{Color, PGF_COLOR_NAMES};
 
 fn number(v: f64) -> String {

@@ -178,8 +178,8 @@ fn the_tex_has_the_pngs_labels_legend_entries_and_legend_corner() {
         ],
     );
     c.y_label = "E_ref (J)".into();
-    let figure = super::line::Figure::prepare(&c, std::path::Path::new("x.png")).unwrap();
-    assert_eq!(figure.legend, Some(super::line::Corner::UpperLeft));
+    let figure = super::figure::Figure::prepare(&c, std::path::Path::new("x.png")).unwrap();
+    assert_eq!(figure.legend, Some(super::figure::Corner::UpperLeft));
     let t = tex(&c, "c.csv");
     assert!(t.contains("legend pos=north west"), "{t}");
     assert!(t.contains(&format!("title={{{}}}", latex("Δ of the tip"))));
