@@ -15,7 +15,7 @@ pub use serde::Deserialize;
 pub use std::path::Path;
 
 #[cfg(feature = "plot")]
-pub use flexmech_plot::charts::{LineChart, Series};
+pub use flexmech_plot::charts::{Color, Dash, LineChart, Marker, Panels, Series};
 #[cfg(feature = "hdf5")]
 pub use flexmech_results::{
     restart_model, run, run_model, FileSink, Memory, OnStep, ResultReader, RunError, RunSummary,
