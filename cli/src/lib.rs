@@ -54,7 +54,7 @@ enum Command {
     /// Prints `<file>: ok (…)` per valid model; errors name the file, line,
     /// key and fix, as `run` does.
     Check(CheckArgs),
-    /// Reproduce the paper's examples (data/paper) with all three integrators.
+    /// Reproduce the paper's examples (data/paper) with every integrator.
     ///
     /// Writes `<out>/<model>/<integrator>.h5` for every run with its
     /// ParaView series `<out>/<model>/<integrator>.pvd`, an animation per
@@ -100,7 +100,7 @@ enum Command {
     /// Writes `<out>/<name>/runs/<run id>.h5` per run, `summary.csv`,
     /// `summary.h5` and `charts/<figure>.png/.svg` (see "Study files" in
     /// MODEL_FORMAT.md). Without --shard, a Slurm array task runs the shard
-    /// SLURM_ARRAY_TASK_ID/_MIN/_COUNT select.
+    /// that SLURM_ARRAY_TASK_ID, _MIN and _COUNT select.
     Study(StudyArgs),
 }
 

@@ -52,6 +52,9 @@
 //! // Without the kind, the error lists every kind the program knows.
 //! let e = App::new().parse(&text, "auger.toml").unwrap_err().to_string();
 //! assert!(e.contains("unknown joint type \"auger\"") && e.contains("rack_pinion"), "{e}");
+//! // A misspelt kind: the list names every kind, the user's included.
+//! let e = app.parse(&text.replace("\"auger\"", "\"augur\""), "a.toml").unwrap_err().to_string();
+//! assert!(e.contains("\"lobe\", \"auger\""), "{e}");
 //! # Ok::<(), ModelError>(())
 //! ```
 //!
@@ -63,7 +66,7 @@
 //! ## A model in Rust, a run into memory
 //!
 //! [`Model::new`](prelude::Model::new) writes a model with a few calls and
-//! reads it through the same checks as a model file; [`run`](prelude::run)
+//! reads it through the same checks as a model file; [`run`](fn@prelude::run)
 //! hands its steps to a sink: the result file ([`run_model`](prelude::run_model)),
 //! memory ([`Memory`](prelude::Memory)) or a closure ([`OnStep`](prelude::OnStep)).
 //!

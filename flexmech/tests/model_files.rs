@@ -967,7 +967,7 @@ fn pitch_on_a_revolute_joint() {
     let e = expect_err(
         &text,
         "joint[0].pitch",
-        &["`pitch` does not belong to a revolute joint", "`axis`"],
+        &["`pitch` does not belong to a joint of type revolute", "`axis`"],
     );
     assert_eq!(e.line(), Some(line_of(&text, "pitch = 0.1")));
 }
@@ -1221,7 +1221,7 @@ fn angle_on_a_rigid_joint() {
     expect_err(
         &text,
         "joint[0].angle",
-        &["does not belong to a rigid joint"],
+        &["does not belong to a joint of type rigid"],
     );
 }
 

@@ -140,7 +140,7 @@ pub fn perpendicular_slide(
         return Err(ParamError::new(
             "slide",
             format!(
-                "must be perpendicular to `axis` for a {kind} joint, found slide = {} and axis = {} \
+                "must be perpendicular to `axis` for a joint of type {kind}, found slide = {} and axis = {} \
                  with |cos(angle)| = {:.3e}",
                 format_vector(slide),
                 format_vector([axis.x, axis.y, axis.z]),

@@ -1,5 +1,5 @@
 //! `flexmech reproduce`: the paper's numerical examples (data/paper) with all
-//! three integrators, their result files and the paper's figures.
+//! integrators, their result files and the paper's figures.
 //!
 //! Every model of [`PAPER_MODELS`] runs with `newmark`, `momentum`,
 //! `energy-momentum` and `energy-momentum-paper` ([`INTEGRATORS`]), all runs

@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::{Ctx, Res};
+use super::{quoted_list, Ctx, Res};
 use crate::locate::span_at;
 use crate::raw::{RawJoint, RawSupport, S};
 use crate::registry::{JointKind, ParamsError};
@@ -99,7 +99,9 @@ impl Ctx<'_> {
         let k = |f: &str| format!("{tk}.{f}");
         let hs = entry.span();
         let j = entry.get_ref();
-        let all_types = self.registry.names().collect::<Vec<_>>().join("|");
+        // Quoted and comma-separated: every name stays whole however many
+        // kinds a program registers (a message cuts only over-long words).
+        let all_types = quoted_list(self.registry.names());
         let type_s = self.need(
             &j.kind,
             &k("type"),
@@ -146,7 +148,7 @@ impl Ctx<'_> {
                     k(key),
                     v,
                     format!(
-                        "`{key}` does not belong to a {type_name} joint{why}; a {type_name} joint takes {}",
+                        "`{key}` does not belong to a joint of type {type_name}{why}; a joint of type {type_name} takes {}",
                         self.takes(type_name)
                     ),
                 ));
@@ -269,7 +271,7 @@ impl Ctx<'_> {
                 format!("{tk}.{key}"),
                 span_at(self.text, &format!("{tk}.{key}")),
                 format!(
-                    "`{key}` does not belong to a {type_name} joint; a {type_name} joint takes {} \
+                    "`{key}` does not belong to a joint of type {type_name}; a joint of type {type_name} takes {} \
                      (besides name, type, master, slave, and angle and rate where it has a \
                      released angle)",
                     self.takes(type_name)
@@ -279,7 +281,7 @@ impl Ctx<'_> {
                 format!("{tk}.{key}"),
                 Some(table.clone()),
                 format!(
-                    "missing key `{key}`: a {type_name} joint needs {}",
+                    "missing key `{key}`: a joint of type {type_name} needs {}",
                     help.map_or_else(|| format!("`{key}`"), str::to_string)
                 ),
             ),
