@@ -967,7 +967,10 @@ fn pitch_on_a_revolute_joint() {
     let e = expect_err(
         &text,
         "joint[0].pitch",
-        &["`pitch` does not belong to a joint of type revolute", "`axis`"],
+        &[
+            "`pitch` does not belong to a joint of type revolute",
+            "`axis`",
+        ],
     );
     assert_eq!(e.line(), Some(line_of(&text, "pitch = 0.1")));
 }
