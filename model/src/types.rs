@@ -297,7 +297,7 @@ impl Default for OutputSpec {
 /// A validated model file. [`Default`] is the empty model (no name, no
 /// beams, [`SolverSpec::default`]), for struct-update syntax in Rust:
 /// `Model { name: "arm".into(), sections, beams, ..Model::default() }`;
-/// [`crate::build`] checks what it is given.
+/// [`crate::build()`] checks what it is given.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Model {
     /// The model's name (result file `<name>.h5`).

@@ -25,7 +25,7 @@ use flexmech_integrators::StepRecord;
 
 use crate::{layout, Merit, ResultWriter, RunMeta};
 
-/// What a sink may fail with; a result file's errors are [`ResultError`]s.
+/// What a sink may fail with; a result file's errors are [`crate::ResultError`]s.
 pub type SinkError = Box<dyn std::error::Error + Send + Sync>;
 
 /// How a run ended, as its sink records it.

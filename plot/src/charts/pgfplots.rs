@@ -11,7 +11,7 @@
 //! is what a paper copies. Labels are the chart's, with Greek letters, sub-
 //! and superscripts and the minus sign written as LaTeX math.
 //!
-//! The copy agrees with the PNG and SVG ([`super::line`]) on what a reader
+//! The copy agrees with the PNG and SVG (the `line` module) on what a reader
 //! compares: the title, axis labels and legend entries (a curve without a
 //! label has none in either), the legend's corner (`legend pos`) or its
 //! place below the plot with as many columns, the axis limits, and each
