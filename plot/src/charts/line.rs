@@ -142,6 +142,18 @@ impl LineChart {
         })
     }
 
+    /// [`Self::render`], or [`Self::render_with_pdf`] when `pdf`: the files
+    /// written (PNG, SVG and, with `pdf`, the PDF).
+    pub fn render_all(&self, stem: &Path, pdf: bool) -> Result<Vec<PathBuf>, ChartError> {
+        Ok(if pdf {
+            let (png, svg, pdf) = self.render_with_pdf(stem)?;
+            vec![png, svg, pdf]
+        } else {
+            let (png, svg) = self.render(stem)?;
+            vec![png, svg]
+        })
+    }
+
     /// [`Self::render`], then the PDF of the chart's PGFPlots copy
     /// (`<stem>.pdf`, by `pdflatex`: [`super::pgfplots::compile_pdf`]).
     pub fn render_with_pdf(&self, stem: &Path) -> Result<(PathBuf, PathBuf, PathBuf), ChartError> {

@@ -334,13 +334,7 @@ pub fn plot_with(
             dataset: name.clone(),
             source,
         };
-        if options.pdf {
-            let (png, svg, pdf) = chart.render_with_pdf(&stem).map_err(error)?;
-            written.extend([png, svg, pdf]);
-        } else {
-            let (png, svg) = chart.render(&stem).map_err(error)?;
-            written.extend([png, svg]);
-        }
+        written.extend(chart.render_all(&stem, options.pdf).map_err(error)?);
     }
     Ok(written)
 }
