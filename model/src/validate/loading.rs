@@ -3,12 +3,38 @@
 use super::{quoted_list, Ctx, Res, DOFS, DOF_LIST};
 use crate::labels::resolve_label;
 use crate::raw::{
-    v3, RawDistributedLoad, RawInitialVelocity, RawLoad, RawPrescribed, RawSupport, StrOrList,
-    Vec3, S,
+    v3, RawDistributedLoad, RawInitialVelocity, RawLoad, RawPrescribed, RawSupport, RawTimeFn,
+    StrOrList, Vec3, S,
 };
 use crate::types::*;
 
+/// What a nodal and a distributed load share: force and moment (zero where
+/// left out), time function, follower flag.
+type LoadValues = ([f64; 3], [f64; 3], Option<TimeFunction>, bool);
+
 impl Ctx<'_> {
+    /// The values a `[[load]]` and a `[[distributed_load]]` share; `time_key`
+    /// names the time function in messages.
+    fn load_values(
+        &self,
+        force: &Option<S<Vec3>>,
+        moment: &Option<S<Vec3>>,
+        time: &Option<S<RawTimeFn>>,
+        follower: &Option<S<bool>>,
+        time_key: &str,
+    ) -> Res<LoadValues> {
+        let time = match time {
+            Some(t) => Some(self.time_fn(t, time_key)?),
+            None => None,
+        };
+        Ok((
+            force.as_ref().map_or([0.0; 3], |f| v3(f.get_ref())),
+            moment.as_ref().map_or([0.0; 3], |m| v3(m.get_ref())),
+            time,
+            follower.as_ref().is_some_and(|f| *f.get_ref()),
+        ))
+    }
+
     pub(super) fn supports(
         &self,
         raw: &[S<RawSupport>],
@@ -103,16 +129,14 @@ impl Ctx<'_> {
                     "a load needs `force` and/or `moment`, e.g. force = [0.0, 0.0, -1.0]",
                 ));
             }
-            let time = match &l.time {
-                Some(t) => Some(self.time_fn(t, &k("time"))?),
-                None => None,
-            };
+            let (force, moment, time, follower) =
+                self.load_values(&l.force, &l.moment, &l.time, &l.follower, &k("time"))?;
             out.push(LoadSpec {
                 node,
-                force: l.force.as_ref().map_or([0.0; 3], |f| v3(f.get_ref())),
-                moment: l.moment.as_ref().map_or([0.0; 3], |m| v3(m.get_ref())),
+                force,
+                moment,
                 time,
-                follower: l.follower.as_ref().is_some_and(|f| *f.get_ref()),
+                follower,
             });
         }
         Ok(out)
@@ -155,16 +179,14 @@ impl Ctx<'_> {
                      force = [0.0, 0.0, -1.0]",
                 ));
             }
-            let time = match &l.time {
-                Some(t) => Some(self.time_fn(t, &k("time"))?),
-                None => None,
-            };
+            let (force, moment, time, follower) =
+                self.load_values(&l.force, &l.moment, &l.time, &l.follower, &k("time"))?;
             out.push(DistributedLoadSpec {
                 beam,
-                force: l.force.as_ref().map_or([0.0; 3], |f| v3(f.get_ref())),
-                moment: l.moment.as_ref().map_or([0.0; 3], |m| v3(m.get_ref())),
+                force,
+                moment,
                 time,
-                follower: l.follower.as_ref().is_some_and(|f| *f.get_ref()),
+                follower,
             });
         }
         Ok(out)
