@@ -37,6 +37,7 @@ mod result_metadata;
 mod resultants;
 mod results_file;
 mod rigid_bodies;
+mod rust_loads;
 mod rust_study;
 mod sinks;
 mod slider_crank;

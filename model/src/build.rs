@@ -337,7 +337,32 @@ fn add_loads(
         .map_err(|e| refused(model, format!("distributed_load[{i}]"), e))?;
     }
     b.gravity(v(model.gravity), schedule(&None, &model.solver.analysis))
-        .map_err(|e| refused(model, "gravity".into(), e))
+        .map_err(|e| refused(model, "gravity".into(), e))?;
+    add_rust_loads(model, b, beam_nodes);
+    Ok(())
+}
+
+/// The `[[rust_load]]` functions as load fields of the mechanism: row `k`
+/// of a function's output goes to the 6 generalised forces of its `k`-th
+/// node. (Unbound functions were refused by [`Model::check`].)
+fn add_rust_loads(model: &Model, b: &mut MechanismBuilder, beam_nodes: &[Vec<NodeId>]) {
+    for l in &model.rust_loads {
+        let Some(f) = l.field.clone() else { continue };
+        let dofs: Vec<usize> = l
+            .nodes
+            .iter()
+            .map(|r| 6 * beam_nodes[r.beam][r.node].index())
+            .collect();
+        b.load_field(move |t, out| {
+            let mut rows = vec![[0.0; 6]; dofs.len()];
+            (f.0)(t, &mut rows);
+            for (row, &d) in rows.iter().zip(&dofs) {
+                for (c, x) in row.iter().enumerate() {
+                    out[d + c] += x;
+                }
+            }
+        });
+    }
 }
 
 /// The ids of placed joints, and the ground node of every joint to the

@@ -229,6 +229,29 @@ impl Checker<'_> {
         Ok(())
     }
 
+    /// Every `[[rust_load]]` names nodes of the mesh, and has a function:
+    /// one read from text without its program is refused here.
+    fn rust_loads(&self) -> Res {
+        for (i, l) in self.model.rust_loads.iter().enumerate() {
+            for &r in &l.nodes {
+                self.node(&format!("rust_load[{i}].nodes"), r)?;
+            }
+            if l.field.is_none() {
+                return Err(self.fail(
+                    format!("rust_load[{i}]"),
+                    format!(
+                        "\"{}\" is a load field written in Rust and its function is not in \
+                         this model: a model with Rust load fields runs and restarts only from \
+                         a program that binds them; call model.bind_load(\"{}\", f) before \
+                         running it",
+                        l.name, l.name
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     fn solver_and_output(&self) -> Res {
         let s = &self.model.solver;
         self.positive("solver.tolerance", &[s.tolerance])?;
@@ -275,6 +298,7 @@ impl Model {
         let c = Checker { model: self };
         c.sections_and_beams()?;
         c.loading()?;
+        c.rust_loads()?;
         c.solver_and_output()
     }
 }

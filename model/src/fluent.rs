@@ -27,7 +27,9 @@ use std::path::PathBuf;
 use flexmech_integrators::dynamics::Integrator;
 use toml::{Table, Value};
 
-use crate::{parse_model_with, BeamGeometry, JointRegistry, Model, ModelError, SectionValues};
+use crate::{
+    parse_model_with, BeamGeometry, JointRegistry, LoadFn, Model, ModelError, SectionValues,
+};
 
 /// The model-file tables of a model being written in Rust (see the module
 /// docs). Node names are the labels of model files (`arm.start`,
@@ -37,6 +39,8 @@ pub struct ModelBuilder {
     root: Table,
     /// A table that could not be read (its text), reported by `build`.
     refused: Option<(String, String)>,
+    /// The functions of the `[[rust_load]]` tables, by name.
+    fields: Vec<(String, LoadFn)>,
 }
 
 fn floats(values: &[f64]) -> Value {
@@ -54,6 +58,7 @@ impl Model {
         ModelBuilder {
             root,
             refused: None,
+            fields: Vec::new(),
         }
     }
 }
@@ -165,6 +170,26 @@ impl ModelBuilder {
         self.push("load", t)
     }
 
+    /// A load field written in Rust, `[[rust_load]]` named `name` on the
+    /// nodes `nodes`: `f(t, out)` adds to row `k` of `out` the force and
+    /// moment `[f₁, f₂, f₃, m₁, m₂, m₃]` (global axes) on `nodes[k]` at time
+    /// `t` (statics: the load factor). The model's text names the load and
+    /// says that the model runs and restarts only from a program that binds
+    /// it ([`Model::bind_load`]).
+    pub fn rust_load(
+        mut self,
+        name: &str,
+        nodes: &[&str],
+        f: impl Fn(f64, &mut [[f64; 6]]) + Send + Sync + 'static,
+    ) -> Self {
+        let mut t = Table::new();
+        t.insert("name".into(), Value::String(name.into()));
+        let labels = nodes.iter().map(|&n| Value::String(n.into())).collect();
+        t.insert("nodes".into(), Value::Array(labels));
+        self.fields.push((name.into(), LoadFn::new(f)));
+        self.push("rust_load", t)
+    }
+
     /// A `[[prescribed]]` released angle of joint `joint`: the expression
     /// `expr` of `t`.
     pub fn drive(self, joint: &str, expr: &str) -> Self {
@@ -244,6 +269,13 @@ impl ModelBuilder {
                 format!("{what}: {why}"),
             ));
         }
-        parse_model_with(&self.to_toml(), &path, joints)
+        let mut model = parse_model_with(&self.to_toml(), &path, joints)?;
+        for (name, f) in self.fields {
+            model.bind_load_fn(&name, f)?;
+        }
+        if !model.rust_loads.is_empty() {
+            model.source_text = model.to_toml();
+        }
+        Ok(model)
     }
 }

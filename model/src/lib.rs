@@ -28,6 +28,7 @@ mod labels;
 mod locate;
 mod raw;
 pub mod registry;
+mod rust_loads;
 pub mod time_function;
 pub mod types;
 mod validate;

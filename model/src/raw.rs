@@ -62,6 +62,8 @@ pub(crate) struct RawModel {
     pub initial_velocity: Vec<S<RawInitialVelocity>>,
     #[serde(default)]
     pub rigid_body: Vec<S<RawRigidBody>>,
+    #[serde(default)]
+    pub rust_load: Vec<S<RawRustLoad>>,
     pub solver: Option<S<RawSolver>>,
     pub output: Option<S<RawOutput>>,
 }
@@ -152,6 +154,14 @@ pub(crate) struct RawLoad {
     pub moment: Option<S<Vec3>>,
     pub time: Option<S<RawTimeFn>>,
     pub follower: Option<S<bool>>,
+}
+
+/// `[[rust_load]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawRustLoad {
+    pub name: Option<S<String>>,
+    pub nodes: Option<S<Vec<S<String>>>>,
 }
 
 /// `[[distributed_load]]`.

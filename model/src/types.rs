@@ -294,6 +294,53 @@ impl Default for OutputSpec {
     }
 }
 
+/// The function of a [`RustLoad`]: at time `t` (statics: the load factor
+/// λ) it adds, for the `k`-th of the load's nodes, the force and the
+/// moment `[f₁, f₂, f₃, m₁, m₂, m₃]` (global axes, moment about fixed axes)
+/// to `out[k]`. `out` holds zeros when it is called.
+pub type NodeLoadFn = dyn Fn(f64, &mut [[f64; 6]]) + Send + Sync;
+
+/// A shared [`NodeLoadFn`]. Two are equal when they are the same function
+/// object (the same `Arc`); debug output shows `LoadFn(<fn>)`.
+#[derive(Clone)]
+pub struct LoadFn(pub std::sync::Arc<NodeLoadFn>);
+
+impl LoadFn {
+    /// Wraps a closure `f(t, out)` (see [`NodeLoadFn`]).
+    pub fn new(f: impl Fn(f64, &mut [[f64; 6]]) + Send + Sync + 'static) -> Self {
+        LoadFn(std::sync::Arc::new(f))
+    }
+}
+
+impl std::fmt::Debug for LoadFn {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("LoadFn(<fn>)")
+    }
+}
+
+impl PartialEq for LoadFn {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+/// A `[[rust_load]]`: forces and moments on named nodes computed by a Rust
+/// function of the program's (a wind field, a controller, a contact
+/// law). The model file records the load's name and nodes; the function
+/// itself lives only in the program, so a model with Rust load fields runs
+/// and restarts only from a program that binds them
+/// ([`Model::bind_load`], `ModelBuilder::rust_load`). Building a model
+/// whose Rust load has no function is refused with a message saying so.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RustLoad {
+    /// The load's name, unique in the model (`[[rust_load]] name`).
+    pub name: String,
+    /// The loaded nodes, in the order of the function's `out` rows.
+    pub nodes: Vec<NodeRef>,
+    /// The function; `None` for a model read from text, until bound.
+    pub field: Option<LoadFn>,
+}
+
 /// A validated model file. [`Default`] is the empty model (no name, no
 /// beams, [`SolverSpec::default`]), for struct-update syntax in Rust:
 /// `Model { name: "arm".into(), sections, beams, ..Model::default() }`;
@@ -329,6 +376,9 @@ pub struct Model {
     pub initial_velocities: Vec<InitialVelocitySpec>,
     /// `[[rigid_body]]` entries (point masses included).
     pub rigid_bodies: Vec<RigidBodySpec>,
+    /// `[[rust_load]]` entries: load fields whose function is Rust code of
+    /// the program that runs the model (see [`RustLoad`]).
+    pub rust_loads: Vec<RustLoad>,
     /// `[solver]`.
     pub solver: SolverSpec,
     /// `[output]`.

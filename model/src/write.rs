@@ -101,7 +101,16 @@ impl Model {
         self.write_motion(&mut root);
         root.insert("solver".into(), Value::Table(self.solver_table()));
         root.insert("output".into(), Value::Table(self.output_table()));
-        toml::to_string(&root).unwrap_or_default()
+        let text = toml::to_string(&root).unwrap_or_default();
+        if self.rust_loads.is_empty() {
+            return text;
+        }
+        let names: Vec<&str> = self.rust_loads.iter().map(|l| l.name.as_str()).collect();
+        format!(
+            "# Load fields written in Rust: {}. This model runs and restarts only from\n\
+             # a program that binds their functions (Model::bind_load).\n{text}",
+            names.join(", ")
+        )
     }
 
     fn label(&self, node: NodeRef) -> Value {
@@ -187,6 +196,13 @@ impl Model {
             t.insert("beam".into(), Value::String(beam.unwrap_or_default()));
             common(&mut t, l.force, l.moment, &l.time, l.follower);
             push(root, "distributed_load", t);
+        }
+        for l in &self.rust_loads {
+            let mut t = Table::new();
+            t.insert("name".into(), Value::String(l.name.clone()));
+            let nodes = l.nodes.iter().map(|&n| self.label(n)).collect();
+            t.insert("nodes".into(), Value::Array(nodes));
+            push(root, "rust_load", t);
         }
     }
 

@@ -17,6 +17,7 @@ mod joints;
 pub mod limits;
 mod loading;
 mod rigid_bodies;
+mod rust_loads;
 mod solver;
 
 type Res<T> = Result<T, ModelError>;
@@ -351,6 +352,7 @@ pub(crate) fn validate(
     let prescribed = cx.prescribed(&raw.prescribed, &beams, &joints, &supports)?;
     let initial_velocities = cx.initial_velocities(&raw.initial_velocity, &beams)?;
     let rigid_bodies = cx.rigid_bodies(&raw.rigid_body, &beams)?;
+    let rust_loads = cx.rust_loads(&raw.rust_load, &beams)?;
     let solver = cx.solver(raw.solver.as_ref())?;
     cx.massive(&raw.section, &sections, &beams, &solver)?;
     let output = cx.output(raw.output.as_ref(), &beams)?;
@@ -368,6 +370,7 @@ pub(crate) fn validate(
         prescribed,
         initial_velocities,
         rigid_bodies,
+        rust_loads,
         solver,
         output,
     })
