@@ -230,6 +230,20 @@ fn base_file_parses_with_defaults() {
 }
 
 #[test]
+fn a_model_changed_in_rust_records_what_runs() {
+    // Unchanged, the stored text is the file's own (comments and all);
+    // changed in Rust, it is the model writer's text of the changed model.
+    let text = format!("# my notes\n{BASE}");
+    let mut m = parse(&text).unwrap();
+    assert_eq!(m.text(), text);
+    m.beams[0].elements = 7;
+    let stored = m.text();
+    assert!(!stored.contains("# my notes"), "{stored}");
+    let again = parse(&stored).unwrap();
+    assert_eq!(again.beams[0].elements, 7);
+}
+
+#[test]
 #[allow(clippy::approx_constant)] // the numbers of MODEL_FORMAT.md's example
 fn full_file_parses_with_the_right_values() {
     let m = parse(FULL).unwrap();

@@ -86,6 +86,12 @@ fn a_function_that_gives_no_model_stops_the_study_naming_the_run() {
         .source_text
         .starts_with("# study `stiffness`, run-0000 (EI = 1000"));
     assert!(first.source_text.contains("name = \"screw-driven\""));
+    // The stored text is the model that ran, with the run's EI.
+    assert!(
+        first.text().contains("EI = [1000.0, 1000.0]"),
+        "{}",
+        first.text()
+    );
     // EI = −1 passes the function but not the model's checks.
     let e = model_for(&spec, &all[1]).unwrap_err();
     assert!(matches!(e, SweepError::Function { .. }));

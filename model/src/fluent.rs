@@ -276,6 +276,7 @@ impl ModelBuilder {
         if !model.rust_loads.is_empty() {
             model.source_text = model.to_toml();
         }
+        model.source_written = model.to_toml();
         Ok(model)
     }
 }

@@ -351,11 +351,15 @@ pub struct Model {
     pub name: String,
     /// The file the model came from (for error messages).
     pub path: PathBuf,
-    /// The TOML text, stored verbatim in result files; empty for a model
-    /// built in Rust, whose result files store [`Model::to_toml`] instead.
-    /// After changing a loaded model in Rust, set it to `model.to_toml()`
-    /// (or clear it) so that result files record what ran.
+    /// The TOML text the model was read from (comments and all); empty for
+    /// a model written as a Rust struct. Result files store it while the
+    /// model still is what it says, else [`Model::to_toml`] (see
+    /// [`Model::text`]).
     pub source_text: String,
+    /// [`Model::to_toml`] of the model as `source_text` was read: a model
+    /// changed in Rust since writes another text, and its result files
+    /// store that one ([`Model::text`]).
+    pub source_written: String,
     /// Gravity acceleration (acts on ρA).
     pub gravity: [f64; 3],
     /// `[[section]]` entries.

@@ -113,6 +113,20 @@ impl Model {
         )
     }
 
+    /// The model text a result file stores: [`Model::source_text`] (the
+    /// file's own words and comments) while the model still writes
+    /// [`Model::source_written`] — it was not changed in Rust since it was
+    /// read — and [`Model::to_toml`] otherwise, so the text always
+    /// describes what ran.
+    pub fn text(&self) -> String {
+        let written = self.to_toml();
+        if !self.source_text.is_empty() && written == self.source_written {
+            self.source_text.clone()
+        } else {
+            written
+        }
+    }
+
     fn label(&self, node: NodeRef) -> Value {
         Value::String(self.node_label(node))
     }
@@ -335,6 +349,7 @@ mod tests {
                 let mut again = parse_model(&text, &path)
                     .unwrap_or_else(|e| panic!("{}: {e}\n{text}", path.display()));
                 again.source_text.clone_from(&model.source_text);
+                again.source_written.clone_from(&model.source_written);
                 assert_eq!(again, model, "{}:\n{text}", path.display());
                 count += 1;
             }

@@ -386,12 +386,7 @@ fn run_meta(model: &Model, built: &Built) -> RunMeta {
         .map(|n| mesh.node_labels[n].clone())
         .collect();
     RunMeta {
-        // A model built in Rust has no text: the model writer's.
-        model_text: if model.source_text.is_empty() {
-            model.to_toml()
-        } else {
-            model.source_text.clone()
-        },
+        model_text: model.text(),
         integrator: match model.solver.analysis {
             Analysis::Static { .. } | Analysis::ArcLength { .. } => "static".to_string(),
             Analysis::Dynamic { integrator, .. } => integrator.name().to_string(),

@@ -54,17 +54,13 @@ impl StudySpec {
 impl Study {
     /// A study named `name` over `base`: grid keys are the model key paths
     /// of study files (`joint.cam.b`, `section.rod.EI[0]`, `solver.dt`), set
-    /// in the model text `base` was read from ([`Model::source_text`]), or,
-    /// for a model built in Rust (no text), in [`Model::to_toml`].
+    /// in the model's text ([`Model::text`]: the file's own while `base` is
+    /// unchanged since it was read, else [`Model::to_toml`]).
     pub fn over(name: &str, base: &Model) -> Self {
         Self {
             name: name.to_owned(),
             model_file: base.path.clone(),
-            model_text: if base.source_text.is_empty() {
-                base.to_toml()
-            } else {
-                base.source_text.clone()
-            },
+            model_text: base.text(),
             grid: Vec::new(),
             figures: Vec::new(),
             joints: JointRegistry::builtin(),

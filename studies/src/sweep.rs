@@ -193,11 +193,13 @@ pub fn model_for(spec: &StudySpec, plan: &RunPlan) -> Result<Model, SweepError> 
             };
             let mut model = (build.0)(&params).map_err(refuse)?;
             model.check().map_err(|e| refuse(e.to_string()))?;
+            let written = model.to_toml();
             model.source_text = format!(
                 "# study `{}`, {} ({overrides}): the model was built by a Rust function; the \
-                 text below, if any, is the model it started from, before these values\n{}",
-                spec.name, plan.id, model.source_text
+                 text below is the model that ran\n{written}",
+                spec.name, plan.id
             );
+            model.source_written = written;
             Ok(model)
         }
     }

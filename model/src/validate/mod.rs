@@ -356,7 +356,7 @@ pub(crate) fn validate(
     let solver = cx.solver(raw.solver.as_ref())?;
     cx.massive(&raw.section, &sections, &beams, &solver)?;
     let output = cx.output(raw.output.as_ref(), &beams)?;
-    Ok(Model {
+    let mut model = Model {
         name,
         path: file.to_path_buf(),
         source_text: text.to_string(),
@@ -373,5 +373,8 @@ pub(crate) fn validate(
         rust_loads,
         solver,
         output,
-    })
+        source_written: String::new(),
+    };
+    model.source_written = model.to_toml();
+    Ok(model)
 }
