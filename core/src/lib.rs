@@ -4,6 +4,7 @@
 
 #![warn(missing_docs)]
 
+pub mod expr;
 pub mod rotation;
 pub mod rotation_derivatives;
 pub mod scalar;

@@ -54,7 +54,7 @@
 //! assert!(e.contains("unknown joint type \"auger\"") && e.contains("rack_pinion"), "{e}");
 //! // A misspelt kind: the list names every kind, the user's included.
 //! let e = app.parse(&text.replace("\"auger\"", "\"augur\""), "a.toml").unwrap_err().to_string();
-//! assert!(e.contains("\"lobe\", \"auger\""), "{e}");
+//! assert!(e.contains("did you mean \"auger\"?") && e.contains("\"expression\", \"auger\""), "{e}");
 //! # Ok::<(), ModelError>(())
 //! ```
 //!

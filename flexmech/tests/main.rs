@@ -16,6 +16,7 @@ mod distributed_loads;
 mod dynamic_models;
 mod element_rotation;
 mod energy_balance;
+mod expression_joints;
 mod expressions;
 mod follower_loads;
 mod four_bar;

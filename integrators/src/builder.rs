@@ -320,6 +320,19 @@ pub enum BuildError {
         /// Where relation (1) puts the slave.
         expected: [f64; 3],
     },
+    /// The derivative of the kind's released translation or rotation at ψ₀
+    /// (the variational map `N` of paper eqs 5–6) is not finite.
+    #[error(
+        "joint `{joint}`: the derivative of its released translation at the initial angle is \
+         not finite (the map N of paper eqs 5-6 holds {bad}); a function such as sqrt(psi) \
+         at psi = 0 has no derivative there: change the function or the joint's `angle`"
+    )]
+    NonFiniteDerivative {
+        /// The joint's name.
+        joint: String,
+        /// The first non-finite entry.
+        bad: f64,
+    },
     /// A rigid body's mass or inertia is not physical.
     #[error("rigid body `{body}`: {why}")]
     Body {
@@ -753,6 +766,15 @@ impl MechanismBuilder {
             return Err(BuildError::NonFiniteRelease {
                 joint: def.name,
                 expected: arr(&expected),
+            });
+        }
+        let n = def
+            .map
+            .variation(&x0[master], &Matrix3::identity(), &initial);
+        if let Some(&bad) = n.iter().find(|v| !v.is_finite()) {
+            return Err(BuildError::NonFiniteDerivative {
+                joint: def.name,
+                bad,
             });
         }
         let scale = x0.iter().map(|x| x.norm()).fold(1.0, f64::max);

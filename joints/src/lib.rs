@@ -16,6 +16,7 @@
 pub mod cam;
 pub mod cylindrical;
 pub mod dependent;
+pub mod expression;
 pub mod incremental;
 pub mod joint_map;
 pub mod kinematics;
@@ -32,6 +33,7 @@ pub mod spherical;
 pub use cam::Cam;
 pub use cylindrical::Cylindrical;
 pub use dependent::{DependentJoint, DependentJointMaps};
+pub use expression::ExpressionJoint;
 pub use incremental::JointStep;
 pub use joint_map::JointMap;
 pub use kinematics::{

@@ -21,7 +21,7 @@ use std::path::Path;
 pub mod build;
 mod check;
 pub mod error;
-pub mod expr;
+pub use flexmech_core::expr;
 mod fluent;
 mod initial_check;
 mod labels;

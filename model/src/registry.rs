@@ -3,7 +3,7 @@
 //! Every kind, built-in or written in a user's crate, implements
 //! [`ModelJoint`] (its `type` name and a serde parameter struct, declared once
 //! in the kind's own file). A [`JointRegistry`] holds the kinds a program
-//! knows; [`JointRegistry::builtin`] the nine of flexmech. A user's binary adds
+//! knows; [`JointRegistry::builtin`] the ten of flexmech. A user's binary adds
 //! its own and hands the registry to the command line
 //! (`flexmech::cli::main_with`), so `run`, `check`, `study` and `reproduce` read
 //! model files that name them:
@@ -24,8 +24,8 @@ use std::sync::Arc;
 
 use flexmech_joints::model_joint::ParamError;
 use flexmech_joints::{
-    Cam, Cylindrical, JointMap, Lobe, ModelJoint, Prismatic, RackPinion, Revolute, Rigid, Screw,
-    Spherical,
+    Cam, Cylindrical, ExpressionJoint, JointMap, Lobe, ModelJoint, Prismatic, RackPinion, Revolute,
+    Rigid, Screw, Spherical,
 };
 use serde::de::{self, Deserializer, Visitor};
 use thiserror::Error;
@@ -167,11 +167,11 @@ impl JointRegistry {
         Self::default()
     }
 
-    /// flexmech's nine kinds: rigid, revolute, spherical, prismatic,
-    /// cylindrical, screw, rack_pinion, cam, lobe.
+    /// flexmech's ten kinds: rigid, revolute, spherical, prismatic,
+    /// cylindrical, screw, rack_pinion, cam, lobe, expression.
     pub fn builtin() -> Self {
         let mut r = Self::empty();
-        let all: [Register; 9] = [
+        let all: [Register; 10] = [
             Self::register::<Rigid>,
             Self::register::<Revolute>,
             Self::register::<Spherical>,
@@ -181,6 +181,7 @@ impl JointRegistry {
             Self::register::<RackPinion>,
             Self::register::<Cam>,
             Self::register::<Lobe>,
+            Self::register::<ExpressionJoint>,
         ];
         for add in all {
             // The built-in names are distinct and well formed (tested).
@@ -345,12 +346,17 @@ mod tests {
                 "screw",
                 "rack_pinion",
                 "cam",
-                "lobe"
+                "lobe",
+                "expression"
             ]
         );
         assert_eq!(r.keys("rigid"), Some(&[][..]));
         assert_eq!(r.keys("screw"), Some(&["axis", "pitch"][..]));
         assert_eq!(r.keys("lobe"), Some(&["axis", "slide", "lift"][..]));
+        assert_eq!(
+            r.keys("expression"),
+            Some(&["axis", "translation", "parameters"][..])
+        );
     }
 
     #[test]

@@ -225,4 +225,39 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn the_harmonic_cam_written_as_an_expression_runs_as_the_rust_kind() {
+        // No compiling: the same f(ψ) = −(a + rise (1 − cos nψ)/2) t_r in the
+        // model file. The two evaluate the same operations in the same
+        // order, so the runs agree to round-off of the positions (1e-12 of
+        // the mechanism's size) at every stored step.
+        let rust_text = std::fs::read_to_string(here("cam.toml"))
+            .unwrap()
+            .replace("t_end = 1.0", "t_end = 0.5");
+        let expression_text = rust_text
+            .replace("type = \"harmonic_cam\"", "type = \"expression\"")
+            .replace("slide = [1.0, 0.0, 0.0]", "")
+            .replace("rise = 0.1", "")
+            .replace("offset = 0.02 ", "#")
+            .replace(
+                "lobes = 1 ",
+                "translation = [\"-(a + (1 - cos(psi*n))*(0.5*rise))\", \"0\", \"0\"]\n\
+                 parameters = { a = 0.02, rise = 0.1, n = 1.0 }\n#",
+            );
+        let positions = |text: &str| {
+            let model = parse_model_with(text, &here("cam.toml"), &registry()).unwrap();
+            let mut memory = flexmech::results::Memory::default();
+            flexmech::results::run(&model, &mut memory).unwrap();
+            assert_eq!(memory.status(), "completed");
+            memory.positions("arm.end").unwrap()
+        };
+        let (a, b) = (positions(&rust_text), positions(&expression_text));
+        assert_eq!(a.len(), b.len());
+        for (x, y) in a.iter().zip(&b) {
+            for c in 0..3 {
+                assert!((x[c] - y[c]).abs() <= 1e-12, "{x:?} vs {y:?}");
+            }
+        }
+    }
 }

@@ -43,3 +43,41 @@ fn the_follower_rides_the_ellipse_and_obeys_relation_1() {
     assert!((psi[half] - std::f64::consts::FRAC_PI_2).abs() <= 1e-12);
     assert!((released[half][0] + B).abs() <= ROUND_OFF);
 }
+
+#[test]
+fn the_same_cam_written_as_an_expression_joint_runs_alike() {
+    // data/examples/expression_cam.toml: f(ψ) in the file, no Rust. The
+    // expression evaluates the rim with other operations than the Rust
+    // kind (a power for a product), so the runs agree to round-off of the
+    // positions, not bit for bit.
+    let rust = App::new()
+        .joint::<EllipseCam>()
+        .load(flexmech::data("examples/ellipse_cam.toml"))
+        .unwrap();
+    let expression = load_model(&flexmech::data("examples/expression_cam.toml")).unwrap();
+    let (mut a, mut b) = (Memory::default(), Memory::default());
+    flexmech::results::run(&rust, &mut a).unwrap();
+    flexmech::results::run(&expression, &mut b).unwrap();
+    assert_eq!(b.status(), "completed");
+    for label in ["arm.start", "arm.end"] {
+        let (pa, pb) = (a.positions(label).unwrap(), b.positions(label).unwrap());
+        assert_eq!(pa.len(), 101);
+        for (x, y) in pa.iter().zip(&pb) {
+            let gap = (Vector3::from(*x) - Vector3::from(*y)).norm();
+            assert!(gap <= ROUND_OFF, "{label}: {gap:e}");
+        }
+    }
+    // Its study sweeps the parameter by key: every follower ends at −b.
+    let out = tempfile::tempdir().unwrap();
+    let report = App::new()
+        .load_study(flexmech::data("examples/expression_cam_study.toml"))
+        .unwrap()
+        .run(out.path())
+        .unwrap();
+    let csv = std::fs::read_to_string(out.path().join("expression-cam/summary.csv")).unwrap();
+    assert_eq!(report.study_runs().unwrap().len(), 3);
+    for (line, b) in csv.lines().skip(1).zip([0.02, 0.03, 0.04]) {
+        let x: f64 = line.rsplit(',').next().unwrap().parse().unwrap();
+        assert!((x + b).abs() <= ROUND_OFF, "{line}");
+    }
+}

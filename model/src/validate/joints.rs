@@ -110,12 +110,15 @@ impl Ctx<'_> {
         )?;
         let type_name = type_s.get_ref().as_str();
         if !self.registry.contains(type_name) {
+            let guess = super::closest(type_name, self.registry.names())
+                .map(|n| format!("did you mean \"{n}\"? "))
+                .unwrap_or_default();
             return Err(self.at(
                 k("type"),
                 type_s,
                 format!(
-                    "unknown joint type \"{type_name}\"; expected one of {all_types} (a \
-                     kind written in Rust is known once registered with the program that \
+                    "unknown joint type \"{type_name}\"; {guess}expected one of {all_types} \
+                     (a kind written in Rust is known once registered with the program that \
                      reads the model: `App::new().joint::<MyJoint>()`)"
                 ),
             ));

@@ -18,22 +18,26 @@
 //! atom  := number | name | name "(" expr ("," expr)* ")" | "(" expr ")"
 //! ```
 //!
-//! Names: the variable `t` (in statics also `lambda`, the load factor), the
-//! constants `pi` and `e`; functions `sin cos tan asin acos atan sinh cosh
+//! Names: the variable — `t` for time functions (in statics also `lambda`,
+//! the load factor), `psi` for the released translation of an expression
+//! joint ([`Expression::parse_with`]) — the constants `pi` and `e`, the
+//! named parameters given with the text; functions `sin cos tan asin acos atan sinh cosh
 //! tanh exp ln log sqrt abs` (one argument), `atan2 min max pow` (two) and
 //! `if(condition, a, b)` (a condition is true when non-zero; comparisons and
 //! `&&`, `||`, `!` give 1 or 0 and have zero derivative). `min`, `max`,
 //! `abs` and `if` take the derivative of the branch they choose.
 
-use num_dual::DualNum;
+use crate::{cst, Scalar};
 use std::fmt;
 
-/// A parsed expression of one variable.
+/// A parsed expression of one variable and named parameters.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Expression {
     text: String,
     root: Node,
     uses_lambda: bool,
+    /// The named parameters' values, in the order of [`Node::Param`].
+    parameters: Vec<(String, f64)>,
 }
 
 /// Why an expression was refused: the 0-based character where it went
@@ -97,6 +101,8 @@ enum Fn2 {
 enum Node {
     Number(f64),
     Var,
+    /// A named parameter (index into [`Expression::parameters`]).
+    Param(usize),
     Call1(Fn1, Box<Node>),
     Call2(Fn2, Box<Node>, Box<Node>),
     If(Box<Node>, Box<Node>, Box<Node>),
@@ -124,13 +130,36 @@ const FUNCTIONS_2: [(&str, Fn2); 4] = [
     ("pow", Fn2::Pow),
 ];
 
-/// The names a user may write, for the "unknown name" message.
-const NAMES: &str = "t, lambda (statics), pi, e, sin, cos, tan, asin, acos, atan, atan2, sinh, \
-                     cosh, tanh, exp, ln, log, sqrt, abs, min, max, pow, if";
+/// The constants and functions a user may write, for the "unknown name"
+/// message (after the variable and the parameters).
+const NAMES: &str = "pi, e, sin, cos, tan, asin, acos, atan, atan2, sinh, cosh, tanh, exp, ln, \
+                     log, sqrt, abs, min, max, pow, if";
+
+/// Whether `name` is taken by the expression language — a variable (`t`,
+/// `lambda`, `psi`), a constant or a function — so that a parameter may
+/// not be called so.
+pub fn reserved(name: &str) -> bool {
+    matches!(name, "t" | "lambda" | "psi" | "pi" | "e" | "log" | "if")
+        || FUNCTIONS_1.iter().any(|(n, _)| *n == name)
+        || FUNCTIONS_2.iter().any(|(n, _)| *n == name)
+}
 
 impl Expression {
-    /// Parses `text`.
+    /// Parses a time function's `text`: the variable is `t` (in statics also
+    /// `lambda`, the load factor).
     pub fn parse(text: &str) -> Result<Self, ExprError> {
+        Self::parse_with(text, "t", &[])
+    }
+
+    /// Parses `text` with the variable `variable` (`"t"` also accepts
+    /// `lambda`) and the named constants `parameters`, which must not be
+    /// [`reserved`] names (the caller checks; a reserved name here is never
+    /// looked up).
+    pub fn parse_with(
+        text: &str,
+        variable: &str,
+        parameters: &[(String, f64)],
+    ) -> Result<Self, ExprError> {
         let chars: Vec<char> = text.chars().collect();
         let mut p = Parser {
             chars: &chars,
@@ -138,6 +167,8 @@ impl Expression {
             uses_lambda: false,
             depth: 0,
             operators: 0,
+            variable,
+            parameters,
         };
         let root = p.or()?;
         p.skip_space();
@@ -151,7 +182,13 @@ impl Expression {
             text: text.to_string(),
             root,
             uses_lambda: p.uses_lambda,
+            parameters: parameters.to_vec(),
         })
+    }
+
+    /// The named parameters and their values.
+    pub fn parameters(&self) -> &[(String, f64)] {
+        &self.parameters
     }
 
     /// The text it was parsed from.
@@ -165,8 +202,8 @@ impl Expression {
     }
 
     /// The value at `t` (any dual number: its derivatives come along).
-    pub fn eval<T: DualNum<Primitive = f64> + Copy>(&self, t: T) -> T {
-        eval(&self.root, t)
+    pub fn eval<T: Scalar>(&self, t: T) -> T {
+        eval(&self.root, &self.parameters, t)
     }
 
     /// The value and its first and second derivatives at `t`, exact (by
@@ -176,14 +213,16 @@ impl Expression {
     }
 }
 
-fn truth<T: DualNum<Primitive = f64>>(b: bool) -> T {
-    T::from(if b { 1.0 } else { 0.0 })
+fn truth<T: Scalar>(b: bool) -> T {
+    cst(if b { 1.0 } else { 0.0 })
 }
 
-fn eval<T: DualNum<Primitive = f64> + Copy>(node: &Node, t: T) -> T {
+fn eval<T: Scalar>(node: &Node, params: &[(String, f64)], t: T) -> T {
+    let eval = |node: &Node, t: T| eval(node, params, t);
     match node {
-        Node::Number(v) => T::from(*v),
+        Node::Number(v) => cst(*v),
         Node::Var => t,
+        Node::Param(i) => cst(params[*i].1),
         Node::Call1(f, a) => {
             let a = eval(a, t);
             match f {
@@ -200,24 +239,24 @@ fn eval<T: DualNum<Primitive = f64> + Copy>(node: &Node, t: T) -> T {
                 Fn1::Ln => a.ln(),
                 Fn1::Sqrt => a.sqrt(),
                 Fn1::Abs => {
-                    if a.re() < 0.0 {
+                    if a.value() < 0.0 {
                         -a
                     } else {
                         a
                     }
                 }
                 Fn1::Neg => -a,
-                Fn1::Not => truth(a.re() == 0.0),
+                Fn1::Not => truth(a.value() == 0.0),
             }
         }
         Node::Call2(Fn2::Pow, a, b) if !b.depends_on_t() => {
             // A constant exponent: integer powers of negative bases stay
             // defined (t^2 at t < 0), and no logarithm is taken.
-            let (a, n) = (eval(a, t), eval::<f64>(b, 0.0));
+            let (a, n) = (eval(a, t), self::eval::<f64>(b, params, 0.0));
             if n.fract() == 0.0 && n.abs() <= f64::from(i32::MAX) {
                 a.powi(n as i32)
             } else {
-                a.powf(n)
+                a.powf(cst(n))
             }
         }
         Node::Call2(f, a, b) => {
@@ -227,34 +266,34 @@ fn eval<T: DualNum<Primitive = f64> + Copy>(node: &Node, t: T) -> T {
                 Fn2::Sub => a - b,
                 Fn2::Mul => a * b,
                 Fn2::Div => a / b,
-                Fn2::Pow => a.powd(b),
+                Fn2::Pow => a.powf(b),
                 Fn2::Atan2 => a.atan2(b),
                 Fn2::Min => {
-                    if b.re() < a.re() {
+                    if b.value() < a.value() {
                         b
                     } else {
                         a
                     }
                 }
                 Fn2::Max => {
-                    if b.re() > a.re() {
+                    if b.value() > a.value() {
                         b
                     } else {
                         a
                     }
                 }
-                Fn2::Lt => truth(a.re() < b.re()),
-                Fn2::Le => truth(a.re() <= b.re()),
-                Fn2::Gt => truth(a.re() > b.re()),
-                Fn2::Ge => truth(a.re() >= b.re()),
-                Fn2::Eq => truth(a.re() == b.re()),
-                Fn2::Ne => truth(a.re() != b.re()),
-                Fn2::And => truth(a.re() != 0.0 && b.re() != 0.0),
-                Fn2::Or => truth(a.re() != 0.0 || b.re() != 0.0),
+                Fn2::Lt => truth(a.value() < b.value()),
+                Fn2::Le => truth(a.value() <= b.value()),
+                Fn2::Gt => truth(a.value() > b.value()),
+                Fn2::Ge => truth(a.value() >= b.value()),
+                Fn2::Eq => truth(a.value() == b.value()),
+                Fn2::Ne => truth(a.value() != b.value()),
+                Fn2::And => truth(a.value() != 0.0 && b.value() != 0.0),
+                Fn2::Or => truth(a.value() != 0.0 || b.value() != 0.0),
             }
         }
         Node::If(c, a, b) => {
-            if eval(c, t).re() != 0.0 {
+            if eval(c, t).value() != 0.0 {
                 eval(a, t)
             } else {
                 eval(b, t)
@@ -267,7 +306,7 @@ impl Node {
     /// Whether the value changes with `t`.
     fn depends_on_t(&self) -> bool {
         match self {
-            Node::Number(_) => false,
+            Node::Number(_) | Node::Param(_) => false,
             Node::Var => true,
             Node::Call1(_, a) => a.depends_on_t(),
             Node::Call2(_, a, b) => a.depends_on_t() || b.depends_on_t(),
@@ -290,6 +329,10 @@ struct Parser<'a> {
     uses_lambda: bool,
     depth: usize,
     operators: usize,
+    /// The variable's name.
+    variable: &'a str,
+    /// The named parameters.
+    parameters: &'a [(String, f64)],
 }
 
 impl Parser<'_> {
@@ -509,14 +552,27 @@ impl Parser<'_> {
     }
 
     fn named(&mut self, name: &str, start: usize) -> Result<Node, ExprError> {
+        let mut known = vec![self.variable.to_string()];
+        if self.variable == "t" {
+            known.push("lambda (statics)".into());
+        }
+        known.extend(self.parameters.iter().map(|(n, _)| n.clone()));
         let unknown = |what: &str| ExprError {
             position: start,
-            message: format!("unknown {what} `{name}`; known names: {NAMES}"),
+            message: format!(
+                "unknown {what} `{name}`; known names: {}, {NAMES}",
+                known.join(", ")
+            ),
         };
         if !self.eat("(") {
+            if name == self.variable {
+                return Ok(Node::Var);
+            }
+            if let Some(i) = self.parameters.iter().position(|(n, _)| n == name) {
+                return Ok(Node::Param(i));
+            }
             return match name {
-                "t" => Ok(Node::Var),
-                "lambda" => {
+                "lambda" if self.variable == "t" => {
                     self.uses_lambda = true;
                     Ok(Node::Var)
                 }
