@@ -178,7 +178,8 @@ class Result(Mapping[str, np.ndarray]):
                 name = line.split("=", 1)[-1].strip()
                 break
         steps = self.time.shape[0] if "/time" in self._data else 0
-        return f"<flexmech.Result {name} {self.status!r}, {steps} stored steps, {len(self)} datasets>"
+        status = self.status if len(self.status) <= 60 else self.status[:57] + "..."
+        return f"<flexmech.Result {name} {status!r}, {steps} stored steps, {len(self)} datasets>"
 
     # -- charts ------------------------------------------------------------
     def plot(

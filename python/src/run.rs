@@ -180,7 +180,7 @@ pub fn run_model<'py>(
         drop(tmp);
         outcome
     });
-    let message = outcome_error(py, model, outcome.error, outcome.interrupt)?;
+    let message = outcome_error(py, model, outcome.error, outcome.interrupt, out.is_some())?;
     if let Some(e) = outcome.read_error {
         return Err(run_error(e));
     }
@@ -195,19 +195,30 @@ pub fn run_model<'py>(
 }
 
 /// The exception of a run's error, or the message of a solve failure
-/// (which is a result, not an exception).
+/// (which is a result, not an exception; `kept` says whether its file is
+/// kept, which the message then names).
 pub fn outcome_error(
     py: Python<'_>,
     model: &Bound<'_, PyModel>,
     error: Option<RustRunError>,
     interrupt: Option<PyErr>,
+    kept: bool,
 ) -> PyResult<Option<String>> {
     if let Some(e) = interrupt {
         return Err(e);
     }
     match error {
         None => Ok(None),
-        Some(e @ RustRunError::Solve { .. }) => Ok(Some(e.to_string())),
+        Some(e @ RustRunError::Solve { .. }) if kept => Ok(Some(e.to_string())),
+        Some(RustRunError::Solve {
+            model: name,
+            path,
+            error,
+            ..
+        }) => Ok(Some(format!(
+            "{}: model \"{name}\": {error}",
+            path.display()
+        ))),
         Some(RustRunError::Model(e)) => Err(model.borrow().model_error(py, &e)),
         Some(e) => Err(run_error(e)),
     }
