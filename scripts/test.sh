@@ -25,8 +25,19 @@ else
   echo "flexmech tests: pdflatex with pgfplots is not available: the PGFPlots compile checks are skipped" >&2
 fi
 # Every test target but the criterion benchmarks (clippy below still checks
-# that they compile); the examples' tests run their code.
-cargo test --workspace --lib --bins --tests --examples
-cargo test --workspace --doc
+# that they compile); the examples' tests run their code. The Python
+# extension (python/) has no Rust tests: its pytest suite runs below.
+cargo test --workspace --exclude flexmech-python --lib --bins --tests --examples
+cargo test --workspace --exclude flexmech-python --doc
+# The Python package: a virtual environment in target/pyenv, `pip install
+# ./python` (maturin from the registry builds the extension in the
+# workspace's dev profile and target directory, so it reuses the build
+# above), then its pytest suite, which compares its results with those of
+# the workspace's `flexmech` binary built above.
+PYENV="$ROOT/target/pyenv"
+[ -x "$PYENV/bin/python" ] || python3 -m venv "$PYENV"
+"$PYENV/bin/python" -m pip install --quiet --disable-pip-version-check pytest h5py matplotlib
+CARGO_TARGET_DIR="$ROOT/target" "$PYENV/bin/python" -m pip install --quiet --disable-pip-version-check ./python
+FLEXMECH_BIN="$ROOT/target/debug/flexmech" MPLBACKEND=Agg "$PYENV/bin/python" -m pytest -q python/tests
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings
