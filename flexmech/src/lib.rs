@@ -157,6 +157,8 @@ pub mod book {
     pub mod paper_examples {}
     #[doc = include_str!("../../docs/book/performance.md")]
     pub mod performance {}
+    #[doc = include_str!("../../docs/book/python.md")]
+    pub mod python {}
     #[doc = include_str!("../../docs/book/results.md")]
     pub mod results {}
     #[doc = include_str!("../../docs/book/stepping.md")]
