@@ -10,7 +10,7 @@ pub use flexmech_model::{
     load_model, parse_model, BeamGeometry, JointRegistry, Model, ModelBuilder, ModelError,
     SectionValues,
 };
-pub use nalgebra::Vector3;
+pub use nalgebra::{Rotation3, Vector3};
 pub use serde::Deserialize;
 pub use std::path::Path;
 

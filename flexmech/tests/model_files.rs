@@ -89,7 +89,7 @@ moment = [0.0, 1.0, 0.0]
 
 [[prescribed]]
 joint = "screw"
-angle = { table = [[0.0, 0.0], [2.0, 6.2832]] }
+angle = { table = [[0.0, 0.25], [2.0, 6.2832]] }
 
 [[prescribed]]
 node = "bend.2"
@@ -352,7 +352,7 @@ fn full_file_parses_with_the_right_values() {
         m.prescribed[0],
         PrescribedSpec::JointAngle {
             joint: 0,
-            angle: TimeFunction::Table(vec![(0.0, 0.0), (2.0, 6.2832)]),
+            angle: TimeFunction::Table(vec![(0.0, 0.25), (2.0, 6.2832)]),
         }
     );
     assert_eq!(

@@ -202,3 +202,25 @@ fn a_static_run_without_loads_records_a_converged_residual() {
         "{tip:?}"
     );
 }
+
+#[test]
+fn a_drive_that_does_not_start_at_the_joints_angle_is_refused() {
+    // angle = 1.0 with a drive from 0: an impulsive jump of the angle at
+    // t = 0 that no integrator can follow (it ended in an element "turning
+    // by 2.4 rad" far from the cause).
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/paper/cam.toml");
+    let text = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("offset = 0.02 ", "angle = 1.0\noffset = 0.02 ");
+    let e = parse_model(&text, Path::new("jump.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("jump.toml:") && e.contains("key `prescribed[0].angle`"),
+        "{e}"
+    );
+    assert!(
+        e.contains("angle 0 at t = 0") && e.contains("angle = 1"),
+        "{e}"
+    );
+}

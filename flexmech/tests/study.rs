@@ -516,6 +516,34 @@ fn an_invalid_value_is_an_error_naming_the_run_before_anything_runs() {
 }
 
 #[test]
+fn a_value_that_moves_a_joints_slave_is_refused_before_anything_runs() {
+    // The expression cam's f(0) = −a x: the slave was placed for a = 0.02,
+    // so a = 0.03 puts relation (1) 0.01 away from it — a mistake in the
+    // study, refused whole, not a failed row among completed ones.
+    let dir = scratch("slave-moved");
+    let file = dir.join("moved.toml");
+    let text = format!(
+        "name = \"moved\"\nmodel = \"{}\"\n[grid]\n\"joint.cam.parameters.a\" = [0.02, 0.03]\n",
+        data("examples/expression_cam.toml").display()
+    );
+    std::fs::write(&file, &text).unwrap();
+    let spec = load_study(&file).unwrap();
+    let out = dir.join("out");
+    let msg = run_study(&spec, &options(&out, None))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("run-0001") && msg.contains("joint.cam.parameters.a = 0.03"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("off by 1.000e-2") && msg.contains("angle"),
+        "{msg}"
+    );
+    assert!(!out.join("moved/runs/run-0000.h5").exists());
+}
+
+#[test]
 fn shard_strings() {
     assert_eq!("2/4".parse::<Shard>(), Ok(Shard { k: 2, n: 4 }));
     assert_eq!(" 1/1 ".parse::<Shard>(), Ok(Shard { k: 1, n: 1 }));

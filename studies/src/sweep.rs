@@ -161,13 +161,17 @@ fn model_text(spec: &StudySpec, table: &Table, plan: &RunPlan) -> Result<String,
 /// The model of `plan`. Over a base model file, the base with each grid key
 /// set to the run's value, written back as TOML and loaded with every
 /// model-file check. From a Rust function, what the function returns for
-/// the run's parameters, checked ([`Model::check`]), its model text headed by
-/// the study, run and values.
+/// the run's parameters, its model text headed by the study, run and values.
+/// Either is also built ([`flexmech_model::build`]: joints placed by
+/// relation (1), the initial state checked), so a run that cannot start is
+/// refused before any runs.
 pub fn model_for(spec: &StudySpec, plan: &RunPlan) -> Result<Model, SweepError> {
     match &spec.source {
         RunSource::ModelFile { file, table } => {
             let text = model_text(spec, table, plan)?;
-            parse_model_with(&text, file, &spec.joints).map_err(|e| {
+            let built = parse_model_with(&text, file, &spec.joints)
+                .and_then(|m| flexmech_model::build(&m).map(|_| m));
+            built.map_err(|e| {
                 SweepError::InvalidRun(Box::new(InvalidRun {
                     study: spec.file.clone(),
                     run: plan.id.clone(),
@@ -192,7 +196,7 @@ pub fn model_for(spec: &StudySpec, plan: &RunPlan) -> Result<Model, SweepError> 
                 message,
             };
             let mut model = (build.0)(&params).map_err(refuse)?;
-            model.check().map_err(|e| refuse(e.to_string()))?;
+            flexmech_model::build(&model).map_err(|e| refuse(e.to_string()))?;
             let written = model.to_toml();
             model.source_text = format!(
                 "# study `{}`, {} ({overrides}): the model was built by a Rust function; the \

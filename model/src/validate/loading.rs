@@ -12,6 +12,12 @@ use crate::types::*;
 /// left out), time function, follower flag.
 type LoadValues = ([f64; 3], [f64; 3], Option<TimeFunction>, bool);
 
+/// Largest difference, relative to the angle's size (at least 1 rad),
+/// between a joint's initial angle and its drive's value at t = 0: the
+/// round-off of writing the same number twice (π/2 as 1.5707963267948966
+/// or as an expression).
+const DRIVE_START_TOLERANCE: f64 = 1e-12;
+
 impl Ctx<'_> {
     /// The values a `[[load]]` and a `[[distributed_load]]` share; `time_key`
     /// names the time function in messages.
@@ -262,6 +268,22 @@ impl Ctx<'_> {
             "the released angle as a function of time, e.g. angle = { table = [[0.0, 0.0], [1.0, 6.2832]] }",
         )?;
         let angle = self.time_fn(angle_s, &k("angle"))?;
+        // In dynamics the drive must start where the joint does: a jump at
+        // t = 0 is an impulsive start the discrete equations cannot follow.
+        // (In statics the drive is a function of the load factor and the
+        // path from the reference state is an equilibrium sequence.)
+        let (start, psi0) = (angle.eval(0.0), joints[ji].angle);
+        if self.dynamic && (start - psi0).abs() > DRIVE_START_TOLERANCE * psi0.abs().max(1.0) {
+            return Err(self.at(
+                k("angle"),
+                angle_s,
+                format!(
+                    "the drive gives joint \"{jname}\" the angle {start} at t = 0, but the \
+                     joint starts at angle = {psi0}; start the drive at {psi0} or set the \
+                     joint's `angle` to {start}"
+                ),
+            ));
+        }
         Ok(PrescribedSpec::JointAngle { joint: ji, angle })
     }
 

@@ -142,16 +142,20 @@ impl LineChart {
         })
     }
 
-    /// [`Self::render`], or [`Self::render_with_pdf`] when `pdf`: the files
-    /// written (PNG, SVG and, with `pdf`, the PDF).
+    /// [`Self::render`], or [`Self::render_with_pdf`] when `pdf`: every file
+    /// written (PNG, SVG, the PGFPlots `.tex`, its data `.csv` and, with
+    /// `pdf`, the PDF).
     pub fn render_all(&self, stem: &Path, pdf: bool) -> Result<Vec<PathBuf>, ChartError> {
-        Ok(if pdf {
+        let mut files = if pdf {
             let (png, svg, pdf) = self.render_with_pdf(stem)?;
             vec![png, svg, pdf]
         } else {
             let (png, svg) = self.render(stem)?;
             vec![png, svg]
-        })
+        };
+        files.insert(2, with_suffix(stem, ".tex"));
+        files.insert(3, with_suffix(stem, ".csv"));
+        Ok(files)
     }
 
     /// [`Self::render`], then the PDF of the chart's PGFPlots copy
