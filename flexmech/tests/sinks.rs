@@ -57,3 +57,33 @@ fn a_failed_run_leaves_its_steps_and_status_in_memory() {
     );
     assert!(!memory.records.is_empty());
 }
+
+#[test]
+fn a_file_read_whole_holds_what_the_reader_reads() {
+    use flexmech::results::{read_contents, Values};
+    let model = load_model(&data("paper/screw_driven.toml")).unwrap();
+    let mut short = model.clone();
+    if let flexmech::model::Analysis::Dynamic { t_end, .. } = &mut short.solver.analysis {
+        *t_end = 0.1;
+    }
+    let out = tempfile::tempdir().unwrap();
+    let file = run_model(&short, out.path()).unwrap().file;
+    let reader = ResultReader::open(&file).unwrap();
+    let contents = read_contents(&file).unwrap();
+    let names: Vec<&str> = contents.datasets.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names.len(), reader.dataset_names().len());
+    for (name, array) in &contents.datasets {
+        if let Values::Float(v) = &array.values {
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(v), bits(&reader.values(name).unwrap()), "{name}");
+            assert_eq!(array.shape, reader.shape(name).unwrap(), "{name}");
+        }
+    }
+    let root = &contents.attrs.iter().find(|(p, _)| p == "/").unwrap().1;
+    let status = root.iter().find(|(k, _)| k == "status").unwrap();
+    assert_eq!(status.1.values, Values::Text(vec!["completed".into()]));
+    assert!(read_contents(Path::new("no/such.h5"))
+        .unwrap_err()
+        .to_string()
+        .contains("no/such.h5"));
+}

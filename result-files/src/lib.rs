@@ -86,6 +86,7 @@
 //! ```
 
 pub mod checks;
+pub mod contents;
 pub mod export;
 pub mod layout;
 pub mod merit;
@@ -98,6 +99,7 @@ pub mod sink;
 pub mod table;
 mod writer;
 
+pub use contents::{read_contents, Array, Contents, Values};
 pub use merit::Merit;
 pub use mesh::MeshMeta;
 pub use reader::{EnergyDrift, ReadError, ResultReader};
