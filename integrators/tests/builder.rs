@@ -313,21 +313,10 @@ fn a_load_field_is_a_line_load_with_the_beam_theorys_deflection() {
 #[test]
 fn load_fields_enter_every_scheme_like_nodal_loads() {
     use flexmech_core::MassKind;
-    use flexmech_integrators::dynamics::{DynamicSettings, Integrator, Motion, Simulation};
+    use flexmech_integrators::dynamics::{Integrator, Motion, Simulation};
     use std::ops::ControlFlow;
 
-    let settings = DynamicSettings {
-        dt: 1e-3,
-        t_end: 0.02,
-        newton: NewtonSettings {
-            tolerance: 1e-10,
-            max_iterations: 20,
-            modified: false,
-            exact_tangent: false,
-        },
-        max_halvings: 4,
-        mass: MassKind::Consistent,
-    };
+    let settings = crate::common::settings(1e-3, 0.02, 1e-10, 20, 4, MassKind::Consistent);
     let force = |t: f64| 5.0 * (40.0 * t).sin();
     for integrator in [
         Integrator::Newmark,

@@ -4,7 +4,7 @@
 
 use flexmech_core::{MassKind, Mesh, Section};
 use flexmech_integrators::dynamics::{momentum, DynamicSettings, Motion};
-use flexmech_integrators::{Mechanism, NewtonSettings, StepRecord};
+use flexmech_integrators::{Mechanism, StepRecord};
 use nalgebra::Vector3;
 
 /// A free beam of length 10 with a rigid initial velocity field
@@ -38,28 +38,8 @@ fn spinning_beam_of(
     .unwrap();
     let mech = Mechanism::new(mesh);
     let (v0, om) = (Vector3::new(0.5, -0.2, 0.3), Vector3::new(0.3, 0.2, 1.0));
-    let motion = Motion {
-        v: mech
-            .mesh
-            .positions
-            .iter()
-            .map(|x| v0 + om.cross(x))
-            .collect(),
-        w: vec![om; mech.mesh.node_count()],
-        joint_rates: Vec::new(),
-    };
-    let settings = DynamicSettings {
-        dt: 0.05,
-        t_end: 15.0,
-        newton: NewtonSettings {
-            tolerance: 1e-12,
-            max_iterations: 30,
-            modified: false,
-            exact_tangent: false,
-        },
-        max_halvings: 6,
-        mass,
-    };
+    let motion = crate::common::rigid_motion(&mech.mesh.positions, v0, om);
+    let settings = crate::common::settings(0.05, 15.0, 1e-12, 30, 6, mass);
     (mech, motion, settings)
 }
 
@@ -222,18 +202,7 @@ fn tumbling_rigid_body_keeps_its_exact_energy_and_momentum() {
         rho_j[2] * l + rod,
     ));
     let (t_exact, h_exact) = (0.5 * om.dot(&(i_c * om)), i_c * om);
-    let settings = DynamicSettings {
-        dt: 0.05,
-        t_end: 10.0,
-        newton: NewtonSettings {
-            tolerance: 1e-12,
-            max_iterations: 30,
-            modified: false,
-            exact_tangent: false,
-        },
-        max_halvings: 6,
-        mass: MassKind::Consistent,
-    };
+    let settings = crate::common::settings(0.05, 10.0, 1e-12, 30, 6, MassKind::Consistent);
     let mut em: Vec<StepRecord> = Vec::new();
     energy_momentum::solve(&mech, &settings, &motion, |s| em.push(s.clone())).unwrap();
     let mut mc: Vec<StepRecord> = Vec::new();

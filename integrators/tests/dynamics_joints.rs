@@ -5,8 +5,8 @@
 //! (kinetic + strain + gravity).
 
 use flexmech_core::{MassKind, Mesh, Section};
-use flexmech_integrators::dynamics::{energy_momentum, momentum, newmark, DynamicSettings, Motion};
-use flexmech_integrators::{JointInstance, Mechanism, NewtonSettings, StepRecord};
+use flexmech_integrators::dynamics::{energy_momentum, momentum, newmark, Motion};
+use flexmech_integrators::{JointInstance, Mechanism, StepRecord};
 use flexmech_joints::{ReleasedState, Screw, MAX_RELEASED};
 use nalgebra::Vector3;
 use std::sync::Arc;
@@ -75,18 +75,7 @@ enum Scheme {
 #[test]
 fn arm_descends_the_screw_with_the_rigid_body_acceleration() {
     let mech = screw_arm();
-    let settings = DynamicSettings {
-        dt: 0.01,
-        t_end: 1.0,
-        newton: NewtonSettings {
-            tolerance: 1e-10,
-            max_iterations: 30,
-            modified: false,
-            exact_tangent: false,
-        },
-        max_halvings: 6,
-        mass: MassKind::Consistent,
-    };
+    let settings = crate::common::settings(0.01, 1.0, 1e-10, 30, 6, MassKind::Consistent);
     // Rigid arm: mass m = ρA·L, moment of inertia about the screw axis
     // I = ρA L³/3 (consistent mass, exact for the linear velocity field) +
     // ρI₃·L (the sections' own rotational inertia about z).
@@ -153,18 +142,7 @@ fn driven_screw_balances_energy_with_the_drive_work() {
     mech.joints[0].driven = vec![Some(Schedule::new(|t| {
         4.0 * (t - (2.0 * std::f64::consts::PI * t).sin() / (2.0 * std::f64::consts::PI))
     }))];
-    let settings = DynamicSettings {
-        dt: 0.01,
-        t_end: 1.0,
-        newton: NewtonSettings {
-            tolerance: 1e-11,
-            max_iterations: 30,
-            modified: false,
-            exact_tangent: false,
-        },
-        max_halvings: 6,
-        mass: MassKind::Consistent,
-    };
+    let settings = crate::common::settings(0.01, 1.0, 1e-11, 30, 6, MassKind::Consistent);
     let rest = Motion::rest(mech.mesh.node_count());
     for scheme in [Scheme::Newmark, Scheme::Momentum, Scheme::EnergyMomentum] {
         let mut steps: Vec<StepRecord> = Vec::new();

@@ -2,6 +2,7 @@
 
 mod arc_length;
 mod builder;
+mod common;
 mod damping;
 mod dynamics;
 mod dynamics_free_joints;

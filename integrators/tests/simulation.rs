@@ -7,7 +7,7 @@
 use flexmech_core::{MassKind, Mesh, Section};
 use flexmech_integrators::dynamics::simulation::{self, Integrator, Simulation};
 use flexmech_integrators::dynamics::{DynamicSettings, Motion};
-use flexmech_integrators::{Mechanism, NewtonSettings, StepRecord};
+use flexmech_integrators::{Mechanism, StepRecord};
 use nalgebra::Vector3;
 
 const ALL: [Integrator; 5] = [
@@ -38,28 +38,8 @@ fn free_beam(v0: Vector3<f64>, om: Vector3<f64>) -> (Mechanism, Motion, DynamicS
     )
     .unwrap();
     let mech = Mechanism::new(mesh);
-    let motion = Motion {
-        v: mech
-            .mesh
-            .positions
-            .iter()
-            .map(|x| v0 + om.cross(x))
-            .collect(),
-        w: vec![om; mech.mesh.node_count()],
-        joint_rates: Vec::new(),
-    };
-    let settings = DynamicSettings {
-        dt: 0.05,
-        t_end: 1.0,
-        newton: NewtonSettings {
-            tolerance: 1e-12,
-            max_iterations: 30,
-            modified: false,
-            exact_tangent: false,
-        },
-        max_halvings: 6,
-        mass: MassKind::Consistent,
-    };
+    let motion = crate::common::rigid_motion(&mech.mesh.positions, v0, om);
+    let settings = crate::common::settings(0.05, 1.0, 1e-12, 30, 6, MassKind::Consistent);
     (mech, motion, settings)
 }
 

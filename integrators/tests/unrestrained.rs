@@ -138,18 +138,7 @@ fn dynamics(rho_a: f64, rho_j: f64) -> (Mechanism, Motion, DynamicSettings) {
         w: vec![Vector3::new(0.0, 0.0, 0.1); n],
         joint_rates: Vec::new(),
     };
-    let settings = DynamicSettings {
-        dt: 0.01,
-        t_end: 0.05,
-        newton: NewtonSettings {
-            tolerance: 1e-12,
-            max_iterations: 30,
-            modified: false,
-            exact_tangent: false,
-        },
-        max_halvings: 4,
-        mass: MassKind::Consistent,
-    };
+    let settings = crate::common::settings(0.01, 0.05, 1e-12, 30, 4, MassKind::Consistent);
     (mech, motion, settings)
 }
 
