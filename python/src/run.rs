@@ -14,8 +14,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::run_error;
-use crate::h5read::{read_file, Contents};
+use crate::h5read::read_file;
 use crate::model::PyModel;
+use flexmech::results::Contents;
 
 /// How often a run looks for Ctrl-C (a pending signal of the interpreter).
 const POLL: Duration = Duration::from_millis(200);
@@ -189,7 +190,7 @@ pub fn run_model<'py>(
             message.unwrap_or_else(|| "the run left no result file".into()),
         ));
     };
-    let (datasets, attrs) = contents.into_py(py)?;
+    let (datasets, attrs) = crate::h5read::into_py(contents, py)?;
     let file = out.map(|_| file.display().to_string());
     Ok((file, datasets, attrs, message))
 }
