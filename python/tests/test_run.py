@@ -17,6 +17,7 @@ MODELS = [
     "data/paper/screw_driven.toml",  # the paper's driven screw, energy-momentum
     "data/statics/follower_tip_force.toml",  # statics, follower load
     "data/dynamics/body_pendulum.toml",  # a rigid body on an offset
+    "data/examples/expression_cam.toml",  # an expression joint: f(psi) in the file
 ]
 
 WHIP = "python/tests/models/whip.toml"  # fails part-way
@@ -123,3 +124,17 @@ def test_a_model_built_in_python_runs_as_its_text_through_the_cli(cli, tmp_path)
     text.write_text(model.to_toml())
     run_cli(cli, "run", str(text), "--out", str(tmp_path / "cli"))
     assert differences(tmp_path / "cli" / "cantilever.h5", result.file) == []
+
+
+def test_an_expression_joints_parameter_by_its_key(in_root):
+    # The cam's rim reaches -b at psi = pi/2 (t = 0.5 s) whatever b is.
+    model = flexmech.Model.load("data/examples/expression_cam.toml")
+    model.set("joint.cam.parameters.b", 0.03)
+    model.set("solver.t_end", 0.5)
+    result = flexmech.run(model)
+    assert result.attrs["status"] == "completed"
+    follower = result["/joints/cam/released_translation"][:, 0]
+    assert abs(follower.min() + 0.03) <= 1e-12
+    with pytest.raises(flexmech.ModelError) as e:
+        model.set("joint.cam.parameters.pi", 3.0)
+    assert "parameters.pi" in str(e.value)
