@@ -11,7 +11,9 @@ use flexmech::integrators::{NewtonSettings, StepRecord};
 use flexmech::model::build::{build, Built};
 use flexmech::model::{Analysis, Model};
 use flexmech::results::layout;
-use flexmech::results::{read_checkpoint, FileSink, Merit, RunEnd, RunMeta, Sink, SinkError};
+use flexmech::results::{
+    read_checkpoint, FileSink, Merit, RunChecks, RunEnd, RunMeta, Sink, SinkError,
+};
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
@@ -79,6 +81,8 @@ pub struct PySimulation {
     pending: Option<StepRecord>,
     count: usize,
     merit: Merit,
+    /// The checks a run passes (energy balance), for the file's `warnings`.
+    checks: RunChecks,
     current: StepRecord,
     failed: Option<String>,
     finished: bool,
@@ -167,6 +171,7 @@ impl PySimulation {
                 .map(|&(_, n)| (n, meta.initial_positions[n]))
                 .collect(),
         );
+        let checks = RunChecks::new(&model);
         let mut sim = Self {
             stepper,
             model,
@@ -175,6 +180,7 @@ impl PySimulation {
             pending: None,
             count: 0,
             merit,
+            checks,
             current: current.clone(),
             failed: None,
             finished: false,
@@ -190,6 +196,8 @@ impl PySimulation {
     /// (every `output.every`-th, and the last).
     fn keep(&mut self, record: StepRecord) {
         self.merit.push(&record);
+        let mech = &self.stepper.borrow_owner().mechanism;
+        self.checks.push(mech, &record);
         self.count += 1;
         if self.count.is_multiple_of(self.model.output.every.max(1)) {
             self.pending = None;
@@ -251,11 +259,17 @@ impl PySimulation {
             (None, true) => layout::STATUS_COMPLETED.to_owned(),
             (None, false) => layout::STATUS_RUNNING.to_owned(),
         };
+        // As a run's: the checks speak for a completed run only.
+        let completed = status == layout::STATUS_COMPLETED;
         sink.finish(&RunEnd {
             status,
             wall_time_s: self.wall_time_s,
             merit: self.merit.clone(),
-            warnings: Vec::new(),
+            warnings: if completed {
+                self.checks.warnings()
+            } else {
+                Vec::new()
+            },
         })
     }
 

@@ -121,3 +121,26 @@ def test_a_restart_of_another_mechanism_is_refused(in_root, tmp_path):
     other = flexmech.Model.load(PAPER).set("beam.arm.elements", 5)
     with pytest.raises(flexmech.RunError, match="nodes"):
         flexmech.Simulation.restart(other, tmp_path / "screw_driven.h5")
+
+
+def test_a_saved_file_carries_the_runs_warnings(cli, in_root, tmp_path):
+    # Newmark on the free screw to 5 s blows its energy up (the run's
+    # energy-balance check warns); the stepped and saved simulation's file
+    # carries the same `warnings` as the command line's.
+    text = (
+        open("data/paper/screw_free.toml")
+        .read()
+        .replace('integrator = "energy-momentum"', 'integrator = "newmark"')
+        .replace("t_end = 6.0", "t_end = 5.0")
+    )
+    path = tmp_path / "screw_newmark.toml"
+    path.write_text(text)
+    sim = flexmech.Simulation(flexmech.Model.load(path))
+    sim.run_until(5.0)
+    assert sim.status == "completed"
+    saved = sim.save(tmp_path / "sim.h5")
+    run_cli(cli, "run", str(path), "--out", str(tmp_path / "cli"))
+    expected = tmp_path / "cli" / "screw_free.h5"
+    assert differences(expected, saved) == []
+    warnings = flexmech.Result.load(saved).attrs["warnings"]
+    assert "energy balance" in str(warnings)

@@ -4,7 +4,9 @@
 //! gives a warning (stderr, the summary line and the result file's root
 //! attribute `warnings`) when the result is doubtful.
 
+use flexmech_integrators::dynamics::Integrator;
 use flexmech_integrators::{Mechanism, StepRecord};
+use flexmech_model::{Analysis, Model, PrescribedSpec};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// The energy balance a dynamic run is checked against: the largest change
@@ -175,4 +177,70 @@ impl Stability {
             )
         })
     }
+}
+
+/// The checks of a run of `model`, watching its converged steps: the
+/// energy balance of a dynamic run, the stability of a static load path.
+/// A run driven step by step outside [`crate::run`] (the Python package's
+/// `Simulation`) keeps one to give its file the same `warnings`.
+#[derive(Debug)]
+pub struct RunChecks {
+    balance: Option<Balance>,
+    stability: Option<Stability>,
+}
+
+impl RunChecks {
+    /// The checks a run of `model` passes.
+    pub fn new(model: &Model) -> Self {
+        let dynamic = matches!(model.solver.analysis, Analysis::Dynamic { .. });
+        let dissipative = matches!(
+            model.solver.analysis,
+            Analysis::Dynamic {
+                integrator: Integrator::GeneralizedAlpha { .. },
+                ..
+            }
+        );
+        Self {
+            balance: dynamic.then(|| Balance::new(dissipative)),
+            stability: (!dynamic).then(|| Stability::new(conservative(model))),
+        }
+    }
+
+    /// Takes a converged step of `mech`.
+    pub fn push(&mut self, mech: &Mechanism, step: &StepRecord) {
+        if let Some(b) = &mut self.balance {
+            b.push(mech, step);
+        }
+        if let Some(s) = &mut self.stability {
+            s.push(step);
+        }
+    }
+
+    /// The warnings so far (for a completed run).
+    pub fn warnings(&self) -> Vec<String> {
+        self.balance
+            .as_ref()
+            .and_then(Balance::warning)
+            .into_iter()
+            .chain(self.stability.as_ref().and_then(Stability::warning))
+            .collect()
+    }
+}
+
+/// Whether the stability count of a static `model` is a stability
+/// statement (see [`Stability`]): no applied nodal moment, no prescribed
+/// nodal rotation.
+fn conservative(model: &Model) -> bool {
+    model
+        .loads
+        .iter()
+        .all(|l| l.moment == [0.0; 3] && !l.follower)
+        && model
+            .distributed_loads
+            .iter()
+            .all(|l| l.moment == [0.0; 3] && !l.follower)
+        && model.prescribed.iter().all(|p| match p {
+            PrescribedSpec::NodeDof { dof, .. } => *dof < 3,
+            PrescribedSpec::JointAngle { .. } => true,
+        })
 }

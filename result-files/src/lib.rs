@@ -99,6 +99,7 @@ pub mod sink;
 pub mod table;
 mod writer;
 
+pub use checks::RunChecks;
 pub use contents::{read_contents, Array, Contents, Values};
 pub use merit::Merit;
 pub use mesh::MeshMeta;

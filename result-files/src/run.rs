@@ -3,7 +3,7 @@
 //! a closure ([`run`]). A run that fails part-way still leaves its sink
 //! every step computed before the failure and `status = "failed: …"`.
 
-use crate::checks::{Balance, Stability};
+use crate::checks::RunChecks;
 use crate::sink::{FileSink, OutputDirError, RunEnd, Sink, SinkError};
 use crate::{
     layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultantsMeta, RunMeta,
@@ -163,10 +163,8 @@ impl RunError {
 struct Keeper<'a> {
     sink: &'a mut dyn Sink,
     mech: &'a Mechanism,
-    /// The energy balance, for dynamic runs.
-    balance: Option<Balance>,
-    /// The stability of the load path, for static runs.
-    stability: Option<Stability>,
+    /// The energy balance (dynamics) or the load path's stability (statics).
+    checks: RunChecks,
     /// The run's figures of merit over every converged step.
     merit: Merit,
     every: usize,
@@ -180,12 +178,7 @@ struct Keeper<'a> {
 impl Keeper<'_> {
     /// Takes a step's record; returns whether it was handed to the sink now.
     fn push(&mut self, step: &StepRecord) -> bool {
-        if let Some(b) = &mut self.balance {
-            b.push(self.mech, step);
-        }
-        if let Some(s) = &mut self.stability {
-            s.push(step);
-        }
+        self.checks.push(self.mech, step);
         self.merit.push(step);
         self.count += 1;
         self.iterations += step.iterations;
@@ -235,31 +228,8 @@ impl Keeper<'_> {
 
     /// The warnings of a completed run's checks.
     fn warnings(&self) -> Vec<String> {
-        self.balance
-            .as_ref()
-            .and_then(Balance::warning)
-            .into_iter()
-            .chain(self.stability.as_ref().and_then(Stability::warning))
-            .collect()
+        self.checks.warnings()
     }
-}
-
-/// Whether the stability count of a static `model` is a stability
-/// statement (see [`Stability`]): no applied nodal moment, no prescribed
-/// nodal rotation.
-fn conservative(model: &Model) -> bool {
-    model
-        .loads
-        .iter()
-        .all(|l| l.moment == [0.0; 3] && !l.follower)
-        && model
-            .distributed_loads
-            .iter()
-            .all(|l| l.moment == [0.0; 3] && !l.follower)
-        && model.prescribed.iter().all(|p| match p {
-            flexmech_model::PrescribedSpec::NodeDof { dof, .. } => *dof < 3,
-            flexmech_model::PrescribedSpec::JointAngle { .. } => true,
-        })
 }
 
 /// Full Newton with the model's tolerance and iteration limit (statics
@@ -436,19 +406,10 @@ fn run_with(
     let built: Built = build(model)?;
     let meta = run_meta(model, &built);
     sink.begin(&meta).map_err(RunError::from_sink)?;
-    let dynamic = matches!(model.solver.analysis, Analysis::Dynamic { .. });
-    let dissipative = matches!(
-        model.solver.analysis,
-        Analysis::Dynamic {
-            integrator: IntegratorKind::GeneralizedAlpha { .. },
-            ..
-        }
-    );
     let mut keeper = Keeper {
         sink,
         mech: &built.mechanism,
-        balance: dynamic.then(|| Balance::new(dissipative)),
-        stability: (!dynamic).then(|| Stability::new(conservative(model))),
+        checks: RunChecks::new(model),
         merit: Merit::new(
             meta.tracked
                 .iter()
