@@ -32,7 +32,7 @@ fn variants(file: &str, translation: [&str; 3], parameters: &[(&str, f64)]) -> (
         .as_table_mut()
         .unwrap();
     let keep = ["name", "master", "slave", "axis", "angle", "rate"];
-    joint.retain(|k, _| keep.iter().any(|n| *n == k));
+    joint.retain(|k, _| keep.contains(&k));
     joint.insert("type".into(), "expression".into());
     let f = translation.iter().map(|&e| Value::from(e)).collect();
     joint.insert("translation".into(), Value::Array(f));
