@@ -181,7 +181,7 @@ impl Stability {
 
 /// The checks of a run of `model`, watching its converged steps: the
 /// energy balance of a dynamic run, the stability of a static load path.
-/// A run driven step by step outside [`crate::run`] (the Python package's
+/// A run driven step by step outside [`crate::run()`] (the Python package's
 /// `Simulation`) keeps one to give its file the same `warnings`.
 #[derive(Debug)]
 pub struct RunChecks {
