@@ -162,7 +162,7 @@ fn model_text(spec: &StudySpec, table: &Table, plan: &RunPlan) -> Result<String,
 /// set to the run's value, written back as TOML and loaded with every
 /// model-file check. From a Rust function, what the function returns for
 /// the run's parameters, its model text headed by the study, run and values.
-/// Either is also built ([`flexmech_model::build`]: joints placed by
+/// Either is also built ([`flexmech_model::build()`]: joints placed by
 /// relation (1), the initial state checked), so a run that cannot start is
 /// refused before any runs.
 pub fn model_for(spec: &StudySpec, plan: &RunPlan) -> Result<Model, SweepError> {
