@@ -381,6 +381,7 @@ fn record(step: usize) -> StepRecord {
         negative_pivots: None,
         velocities: Vec::new(),
         angular_velocities: Vec::new(),
+        sensitivities: Vec::new(),
     }
 }
 

@@ -40,6 +40,7 @@ mod results_file;
 mod rigid_bodies;
 mod rust_loads;
 mod rust_study;
+mod sensitivity;
 mod sinks;
 mod slider_crank;
 mod stability;

@@ -20,6 +20,7 @@ pub mod mechanism;
 pub mod newton;
 pub mod record;
 pub mod rotation_guard;
+pub mod sensitivity;
 pub mod stability;
 pub mod statics;
 pub mod step_control;
@@ -35,4 +36,5 @@ pub use mechanism::{
 };
 pub use newton::NewtonSettings;
 pub use record::{Energies, JointRecord, StepRecord};
-pub use statics::{solve_static, StaticOutcome, StaticSettings};
+pub use sensitivity::Parameter;
+pub use statics::{solve_static, solve_static_with, StaticOutcome, StaticSettings};

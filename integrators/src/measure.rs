@@ -112,6 +112,7 @@ pub fn static_record(
         support_reactions: vec![[f64::NAN; 6]; mech.supported_nodes().len()],
         velocities: Vec::new(),
         angular_velocities: Vec::new(),
+        sensitivities: Vec::new(),
     }
 }
 

@@ -85,4 +85,7 @@ pub struct StepRecord {
     /// tangent (see [`crate::stability`]); non-zero means the equilibrium
     /// is unstable (past a bifurcation or limit point). `None` in dynamics.
     pub negative_pivots: Option<usize>,
+    /// Statics with sensitivities (`statics::solve_static_with`): for each
+    /// parameter, `dx/dp` of every node; empty otherwise.
+    pub sensitivities: Vec<Vec<[f64; 3]>>,
 }

@@ -16,6 +16,7 @@ use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSettings, NewtonSystem};
 use crate::record::StepRecord;
 use crate::rotation_guard::{as_step_failure, RotationGuard};
+use crate::sensitivity::{Parameter, StaticSensitivities};
 use crate::stability::InertiaCount;
 use crate::step_control::StepControl;
 use crate::system::{ReducedSystem, Reduction, StepTerms};
@@ -62,6 +63,19 @@ const GROW_AFTER: usize = 3;
 pub fn solve_static(
     mech: &Mechanism,
     settings: &StaticSettings,
+    on_step: impl FnMut(&StepRecord),
+) -> Result<StaticOutcome, SolveError> {
+    solve_static_with(mech, settings, &[], on_step)
+}
+
+/// [`solve_static`] with the exact sensitivities of every converged step to
+/// `params` in its record ([`StepRecord::sensitivities`], see
+/// [`crate::sensitivity`]): one more factorisation of the converged tangent
+/// per step and one solve per parameter.
+pub fn solve_static_with(
+    mech: &Mechanism,
+    settings: &StaticSettings,
+    params: &[Parameter],
     mut on_step: impl FnMut(&StepRecord),
 ) -> Result<StaticOutcome, SolveError> {
     if settings.load_steps == 0 {
@@ -70,6 +84,7 @@ pub fn solve_static(
         ));
     }
     let (mut prob, mut lu, mut inertia) = static_system(mech)?;
+    let mut sensitivities = StaticSensitivities::new(&prob, params)?;
     let n = prob.topo.dofs.n_eq;
     let (mut r, mut dq) = (vec![0.0; n], vec![0.0; n]);
     let nominal = 1.0 / settings.load_steps as f64;
@@ -111,7 +126,7 @@ pub fn solve_static(
                 );
                 lambda = target;
                 steps += 1;
-                let step = converged_record(
+                let mut step = converged_record(
                     &mut prob,
                     &mut inertia,
                     &mut r,
@@ -119,6 +134,7 @@ pub fn solve_static(
                     &report,
                     Some(follower),
                 );
+                step.sensitivities = sensitivities.at(&prob, lambda)?;
                 on_step(&step);
                 control.succeeded();
             }

@@ -1,0 +1,186 @@
+//! Exact parameter sensitivities of static equilibria, by direct
+//! differentiation of the discrete equations.
+//!
+//! A converged static step satisfies the reduced equations `r(q(p), p) = 0`
+//! at its load factor λ. Differentiating with respect to a parameter `p`,
+//!
+//! ```text
+//! K · dq/dp = −∂r/∂p,     K = ∂r/∂q (the exact tangent at the converged state),
+//! ```
+//!
+//! one solve per parameter with one factorisation of `K` per step. In
+//! statics the equilibrium at λ depends on λ and `p` only (no history), so
+//! each step's derivatives come from its own state. `dq/dp` maps to every
+//! node's translation by the same linear map the Newton increments go
+//! through (`DofMap::node_increment`, slaves by the joints' `N`).
+//!
+//! `∂r/∂p` is exact: the internal forces `Bᵀ C (ε − ε₀)` are linear in each
+//! stiffness of `C = diag(EA, GA₂, GA₃, GJ, EI₂, EI₃)`, so their derivative
+//! is the internal force of the same elements, in the same state, with that
+//! stiffness 1 and the others 0; a dead load's component enters `r` as
+//! `−s(λ) e`.
+
+use nalgebra::Vector3;
+
+use crate::error::SolveError;
+use crate::linsolve::SparseLu;
+use crate::mechanism::Mechanism;
+use crate::statics::StaticTerms;
+use crate::system::ReducedSystem;
+use flexmech_core::{Configuration, Element, Section};
+
+/// A real number of the mechanism a sensitivity is taken with respect to.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Parameter {
+    /// One stiffness of the sections of the elements `elements` (indices
+    /// into the mesh): `component` 0–5 is EA, GA₂, GA₃, GJ, EI₂, EI₃.
+    Stiffness {
+        /// The elements whose section carries it.
+        elements: Vec<usize>,
+        /// Which stiffness, 0–5.
+        component: usize,
+    },
+    /// Component `component` (0–2 force, 3–5 moment, global axes) of the
+    /// dead nodal load `load` (index into [`Mechanism::loads`]).
+    Load {
+        /// The load.
+        load: usize,
+        /// Which component, 0–5.
+        component: usize,
+    },
+}
+
+impl Parameter {
+    /// Whether it names elements, a load and a component that exist.
+    pub fn check(&self, mech: &Mechanism) -> Result<(), SolveError> {
+        let ok = match self {
+            Parameter::Stiffness {
+                elements,
+                component,
+            } => *component < 6 && elements.iter().all(|&e| e < mech.mesh.elements.len()),
+            Parameter::Load { load, component } => *load < mech.loads.len() && *component < 6,
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(SolveError::InvalidMechanism(format!(
+                "sensitivity parameter {self:?} names no element, load or component of this \
+                 mechanism"
+            )))
+        }
+    }
+
+    /// `∂g/∂p`, the derivative of the nodal residual `g = f_int − f_ext`
+    /// (6 per node) at `config` and load factor `lambda`, into `out`.
+    fn nodal_derivative(
+        &self,
+        mech: &Mechanism,
+        config: &Configuration,
+        lambda: f64,
+        out: &mut [f64],
+    ) {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        match self {
+            Parameter::Stiffness {
+                elements,
+                component,
+            } => {
+                let mut r = Vec::new();
+                for &e in elements {
+                    let unit = with_unit_stiffness(&mech.mesh.elements[e], *component);
+                    r.resize(unit.dofs(), 0.0);
+                    unit.internal_force_into(&config.x, &config.rot, &mut r);
+                    for (k, &n) in unit.nodes().iter().enumerate() {
+                        for c in 0..6 {
+                            out[6 * n + c] += r[6 * k + c];
+                        }
+                    }
+                }
+            }
+            Parameter::Load { load, component } => {
+                let l = &mech.loads[*load];
+                out[6 * l.node + component] = -l.scale.at(lambda);
+            }
+        }
+    }
+}
+
+/// `element` with a section whose stiffness `component` is 1 and every
+/// other stiffness 0.
+fn with_unit_stiffness(element: &Element, component: usize) -> Element {
+    let mut stiffness = [0.0; 6];
+    stiffness[component] = 1.0;
+    let section = |s: &Section| Section {
+        c_n: Vector3::new(stiffness[0], stiffness[1], stiffness[2]),
+        c_m: Vector3::new(stiffness[3], stiffness[4], stiffness[5]),
+        ..*s
+    };
+    let mut unit = element.clone();
+    match &mut unit {
+        Element::Linear(e) => e.section = section(&e.section),
+        Element::Quadratic(e) => e.section = section(&e.section),
+    }
+    unit
+}
+
+/// The sensitivities of a static solve: its parameters and the
+/// factorisation of the converged tangent.
+pub(crate) struct StaticSensitivities {
+    params: Vec<Parameter>,
+    lu: SparseLu,
+    nodal: Vec<f64>,
+}
+
+impl StaticSensitivities {
+    /// Sensitivities to `params` of the solve whose system is `sys`.
+    pub(crate) fn new(
+        sys: &ReducedSystem<'_, StaticTerms>,
+        params: &[Parameter],
+    ) -> Result<Self, SolveError> {
+        for p in params {
+            p.check(sys.mech)?;
+        }
+        let lu = SparseLu::new(sys.asm.pattern().clone()).map_err(SolveError::Singular)?;
+        Ok(Self {
+            params: params.to_vec(),
+            lu,
+            nodal: vec![0.0; 6 * sys.mech.mesh.node_count()],
+        })
+    }
+
+    /// `dx/dp` of every node for every parameter at the converged step to
+    /// `lambda`, whose exact tangent `sys` holds (as the converged record
+    /// leaves it).
+    pub(crate) fn at(
+        &mut self,
+        sys: &ReducedSystem<'_, StaticTerms>,
+        lambda: f64,
+    ) -> Result<Vec<Vec<[f64; 3]>>, SolveError> {
+        if self.params.is_empty() {
+            return Ok(Vec::new());
+        }
+        self.lu.factor(&sys.asm.values).map_err(|why| {
+            SolveError::InvalidMechanism(format!("sensitivities at λ = {lambda}: {why}"))
+        })?;
+        let n_eq = sys.topo.dofs.n_eq;
+        let nodes = sys.mech.mesh.node_count();
+        let mut out = Vec::with_capacity(self.params.len());
+        for p in &self.params {
+            p.nodal_derivative(sys.mech, &sys.end.config, lambda, &mut self.nodal);
+            let mut dq = vec![0.0; n_eq];
+            sys.reduce(&self.nodal, &mut dq);
+            dq.iter_mut().for_each(|v| *v = -*v);
+            self.lu.solve(&mut dq).map_err(|why| {
+                SolveError::InvalidMechanism(format!("sensitivities at λ = {lambda}: {why}"))
+            })?;
+            let dx = (0..nodes)
+                .map(|n| {
+                    let d = sys.topo.dofs.node_increment(n, &dq);
+                    [d[0], d[1], d[2]]
+                })
+                .collect();
+            out.push(dx);
+        }
+        Ok(out)
+    }
+}
