@@ -24,6 +24,9 @@ if command -v pdflatex >/dev/null 2>&1 && kpsewhich pgfplots.sty >/dev/null 2>&1
 else
   echo "flexmech tests: pdflatex with pgfplots is not available: the PGFPlots compile checks are skipped" >&2
 fi
+# A one-shot build (CI, a fresh clone) is faster without incremental
+# compilation's caches; a developer's repeated runs keep them.
+if [ -n "${CI:-}" ]; then export CARGO_INCREMENTAL=0; fi
 # Every test target but the criterion benchmarks (clippy below still checks
 # that they compile); the examples' tests run their code. The Python
 # extension (python/) has no Rust tests: its pytest suite runs below.
