@@ -31,7 +31,9 @@ if [ -n "${CI:-}" ]; then export CARGO_INCREMENTAL=0; fi
 # that they compile); the examples' tests run their code. The Python
 # extension (python/) has no Rust tests: its pytest suite runs below.
 cargo test --workspace --exclude flexmech-python --lib --bins --tests --examples
+echo "flexmech tests: unit, integration and example tests done at ${SECONDS} s" >&2
 cargo test --workspace --exclude flexmech-python --doc
+echo "flexmech tests: doc tests done at ${SECONDS} s" >&2
 # The Python package: a virtual environment in target/pyenv, `pip install
 # ./python` (maturin from the registry builds the extension in the
 # workspace's dev profile and target directory, so it reuses the build
@@ -41,6 +43,8 @@ PYENV="$ROOT/target/pyenv"
 [ -x "$PYENV/bin/python" ] || python3 -m venv "$PYENV"
 "$PYENV/bin/python" -m pip install --quiet --disable-pip-version-check pytest h5py matplotlib
 CARGO_TARGET_DIR="$ROOT/target" "$PYENV/bin/python" -m pip install --quiet --disable-pip-version-check ./python
+echo "flexmech tests: Python package installed at ${SECONDS} s" >&2
 FLEXMECH_BIN="$ROOT/target/debug/flexmech" MPLBACKEND=Agg "$PYENV/bin/python" -m pytest -q python/tests
+echo "flexmech tests: Python tests done at ${SECONDS} s" >&2
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings

@@ -1,5 +1,5 @@
 //! The fuzzing campaign of the model-file path, bounded for the test suite:
-//! mutants of every model in `data/` for about 40 s of wall time, each in
+//! mutants of every model in `data/` for about 20 s of wall time, each in
 //! its own `flexmech` process. No panic, abort, hang, unlocated error or
 //! non-finite completed result may appear (see `flexmech/fuzz/`;
 //! `scripts/fuzz.sh` runs larger campaigns). A fake `flexmech` that
@@ -16,7 +16,7 @@ fn data() -> PathBuf {
 }
 
 /// Wall time of the suite's campaign.
-const BUDGET: Duration = Duration::from_secs(40);
+const BUDGET: Duration = Duration::from_secs(20);
 /// Fewest mutants it must have run (a slow machine still runs this many).
 const FEWEST: usize = 200;
 
