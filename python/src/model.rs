@@ -160,6 +160,36 @@ impl PyModel {
     }
 }
 
+/// The values of a `[[load]]` or `[[distributed_load]]` call.
+struct LoadValues<'a, 'py> {
+    force: Option<&'a Bound<'py, PyAny>>,
+    moment: Option<&'a Bound<'py, PyAny>>,
+    time: Option<&'a Bound<'py, PyAny>>,
+    follower: Option<&'a Bound<'py, PyAny>>,
+    keys: Option<&'a Bound<'py, PyDict>>,
+}
+
+impl PyModel {
+    /// Appends an entry of the array `array` whose `target_key` (node or
+    /// beam) is `target`, with the load's values.
+    fn push_load<'py>(
+        slf: Bound<'py, Self>,
+        (array, target_key, target): (&str, &str, &str),
+        v: LoadValues<'_, 'py>,
+    ) -> PyResult<Bound<'py, Self>> {
+        let prefix = slf.borrow().next_entry(array);
+        let entry = Entry::new(slf.py(), prefix)
+            .text(target_key, target)
+            .value("force", v.force)?
+            .value("moment", v.moment)?
+            .value("time", v.time)?
+            .value("follower", v.follower)?
+            .extra(v.keys)?;
+        slf.borrow_mut().push(array, entry.table);
+        Ok(slf)
+    }
+}
+
 /// Builds a table from named values (None: left out) and extra keys.
 struct Entry<'py> {
     prefix: String,
@@ -596,16 +626,14 @@ impl PyModel {
         follower: Option<&Bound<'py, PyAny>>,
         keys: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, Self>> {
-        let prefix = slf.borrow().next_entry("load");
-        let entry = Entry::new(slf.py(), prefix)
-            .text("node", node)
-            .value("force", force)?
-            .value("moment", moment)?
-            .value("time", time)?
-            .value("follower", follower)?
-            .extra(keys)?;
-        slf.borrow_mut().push("load", entry.table);
-        Ok(slf)
+        let values = LoadValues {
+            force,
+            moment,
+            time,
+            follower,
+            keys,
+        };
+        Self::push_load(slf, ("load", "node", node), values)
     }
 
     /// A `[[distributed_load]]` per unit length on beam `beam`.
@@ -619,16 +647,14 @@ impl PyModel {
         follower: Option<&Bound<'py, PyAny>>,
         keys: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, Self>> {
-        let prefix = slf.borrow().next_entry("distributed_load");
-        let entry = Entry::new(slf.py(), prefix)
-            .text("beam", beam)
-            .value("force", force)?
-            .value("moment", moment)?
-            .value("time", time)?
-            .value("follower", follower)?
-            .extra(keys)?;
-        slf.borrow_mut().push("distributed_load", entry.table);
-        Ok(slf)
+        let values = LoadValues {
+            force,
+            moment,
+            time,
+            follower,
+            keys,
+        };
+        Self::push_load(slf, ("distributed_load", "beam", beam), values)
     }
 
     /// A `[[prescribed]]` released angle of joint `joint`: an expression of

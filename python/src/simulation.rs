@@ -11,9 +11,7 @@ use flexmech::integrators::{NewtonSettings, StepRecord};
 use flexmech::model::build::{build, Built};
 use flexmech::model::{Analysis, Model};
 use flexmech::results::layout;
-use flexmech::results::{
-    read_checkpoint, FileSink, Merit, RunChecks, RunEnd, RunMeta, Sink, SinkError,
-};
+use flexmech::results::{FileSink, Merit, RunChecks, RunEnd, RunMeta, Sink, SinkError};
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
@@ -116,10 +114,6 @@ fn settings(model: &Model) -> Option<(flexmech::model::IntegratorKind, DynamicSe
         },
     ))
 }
-
-/// Distance between a stored and a built initial position below which they
-/// are the same node (relative to the model's size), as for restarts.
-const SAME_NODE: f64 = 1e-12;
 
 impl PySimulation {
     /// Builds `model` and starts its simulation: from t = 0, or from the
@@ -309,48 +303,7 @@ fn restart_state(
     built: &Built,
     path: &Path,
 ) -> PyResult<flexmech::integrators::dynamics::Checkpoint> {
-    let mismatch = |why: String| {
-        run_error(format!(
-            "{}: cannot continue {} with this model: {why}",
-            model.path.display(),
-            path.display()
-        ))
-    };
-    let (checkpoint, initial) = read_checkpoint(path).map_err(run_error)?;
-    let t_end = match model.solver.analysis {
-        Analysis::Dynamic { t_end, .. } => t_end,
-        _ => 0.0,
-    };
-    if checkpoint.time >= t_end {
-        return Err(mismatch(format!(
-            "key `solver.t_end`: the stored run already reaches t = {} >= t_end = {t_end}; set a later t_end",
-            checkpoint.time
-        )));
-    }
-    let here = &built.mechanism.mesh.positions;
-    if here.len() != initial.len() {
-        return Err(mismatch(format!(
-            "the stored run has {} nodes, the model {}",
-            initial.len(),
-            here.len()
-        )));
-    }
-    let scale = here.iter().map(|x| x.norm()).fold(1.0, f64::max);
-    if let Some(i) = here
-        .iter()
-        .zip(&initial)
-        .position(|(a, b)| (a - nalgebra_vector(*b)).norm() > SAME_NODE * scale)
-    {
-        return Err(mismatch(format!(
-            "node {i} starts at {:?} in the stored run and elsewhere in the model: not the same mechanism",
-            initial[i]
-        )));
-    }
-    Ok(checkpoint)
-}
-
-fn nalgebra_vector(v: [f64; 3]) -> flexmech::prelude::Vector3<f64> {
-    flexmech::prelude::Vector3::from(v)
+    flexmech::results::restart_state(model, built, path).map_err(run_error)
 }
 
 /// Rows of `n` numbers as a NumPy array (rows × n).

@@ -106,6 +106,6 @@ pub use mesh::MeshMeta;
 pub use reader::{EnergyDrift, ReadError, ResultReader};
 pub use restart::{read_checkpoint, RestartError};
 pub use resultants::ResultantsMeta;
-pub use run::{restart_model, run, run_model, run_model_to, RunError, RunSummary};
+pub use run::{restart_model, restart_state, run, run_model, run_model_to, RunError, RunSummary};
 pub use sink::{FileSink, Memory, OnStep, RunEnd, Sink, SinkError};
 pub use writer::{rotation_vector, ResultError, ResultWriter, RunMeta};

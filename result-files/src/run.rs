@@ -305,6 +305,26 @@ pub fn restart_model(model: &Model, result: &Path, out_dir: &Path) -> Result<Run
             file.display()
         )));
     }
+    let built = build(model)?;
+    let checkpoint = restart_state(model, &built, result)?;
+    let mut sink = FileSink::new(&file).restarted_from(result, checkpoint.time);
+    with_vtk(model, run_with(model, &mut sink, Some(&checkpoint)))
+}
+
+/// The restart state stored in `result` (its `/restart` group), checked
+/// against `model` built as `built`: a dynamic analysis whose `t_end` lies
+/// beyond the stored time, and the same nodes where the stored run began
+/// (to [`SAME_NODE`] of the mechanism's size). What [`restart_model`] and
+/// a stepped simulation (the Python package's) continue from.
+///
+/// # Errors
+/// An unreadable restart state, or a model that is not the stored run's.
+pub fn restart_state(model: &Model, built: &Built, result: &Path) -> Result<Checkpoint, RunError> {
+    let mismatch = |why: String| RunError::RestartMismatch {
+        model: model.path.clone(),
+        result: result.to_path_buf(),
+        why,
+    };
     let (checkpoint, initial) = read_checkpoint(result)?;
     let Analysis::Dynamic { t_end, .. } = model.solver.analysis else {
         return Err(mismatch(
@@ -320,7 +340,6 @@ pub fn restart_model(model: &Model, result: &Path, out_dir: &Path) -> Result<Run
             checkpoint.time
         )));
     }
-    let built = build(model)?;
     let here = &built.mechanism.mesh.positions;
     if here.len() != initial.len() {
         return Err(mismatch(format!(
@@ -342,8 +361,7 @@ pub fn restart_model(model: &Model, result: &Path, out_dir: &Path) -> Result<Run
             [here[i].x, here[i].y, here[i].z]
         )));
     }
-    let mut sink = FileSink::new(&file).restarted_from(result, checkpoint.time);
-    with_vtk(model, run_with(model, &mut sink, Some(&checkpoint)))
+    Ok(checkpoint)
 }
 
 /// What a run of `model` is, for its sink: labels, nodes, joints, mesh.
