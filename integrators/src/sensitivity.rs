@@ -25,8 +25,7 @@ use nalgebra::Vector3;
 use crate::error::SolveError;
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
-use crate::statics::StaticTerms;
-use crate::system::ReducedSystem;
+use crate::system::{ReducedSystem, StepTerms};
 use flexmech_core::{Configuration, Element, Section};
 
 /// A real number of the mechanism a sensitivity is taken with respect to.
@@ -133,8 +132,8 @@ pub(crate) struct StaticSensitivities {
 
 impl StaticSensitivities {
     /// Sensitivities to `params` of the solve whose system is `sys`.
-    pub(crate) fn new(
-        sys: &ReducedSystem<'_, StaticTerms>,
+    pub(crate) fn new<T: StepTerms>(
+        sys: &ReducedSystem<'_, T>,
         params: &[Parameter],
     ) -> Result<Self, SolveError> {
         for p in params {
@@ -151,9 +150,9 @@ impl StaticSensitivities {
     /// `dx/dp` of every node for every parameter at the converged step to
     /// `lambda`, whose exact tangent `sys` holds (as the converged record
     /// leaves it).
-    pub(crate) fn at(
+    pub(crate) fn at<T: StepTerms>(
         &mut self,
-        sys: &ReducedSystem<'_, StaticTerms>,
+        sys: &ReducedSystem<'_, T>,
         lambda: f64,
     ) -> Result<Vec<Vec<[f64; 3]>>, SolveError> {
         if self.params.is_empty() {
