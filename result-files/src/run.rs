@@ -314,7 +314,7 @@ pub fn restart_model(model: &Model, result: &Path, out_dir: &Path) -> Result<Run
 /// The restart state stored in `result` (its `/restart` group), checked
 /// against `model` built as `built`: a dynamic analysis whose `t_end` lies
 /// beyond the stored time, and the same nodes where the stored run began
-/// (to [`SAME_NODE`] of the mechanism's size). What [`restart_model`] and
+/// (to 1e-12 of the mechanism's size). What [`restart_model`] and
 /// a stepped simulation (the Python package's) continue from.
 ///
 /// # Errors
