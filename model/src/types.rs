@@ -267,6 +267,46 @@ impl Default for SolverSpec {
     }
 }
 
+impl SolverSpec {
+    /// The integrator and the settings a run of a dynamic analysis steps
+    /// with (the command line's, the Python package's stepping); `None` for
+    /// a static one.
+    pub fn dynamic_settings(
+        &self,
+    ) -> Option<(
+        IntegratorKind,
+        flexmech_integrators::dynamics::DynamicSettings,
+    )> {
+        let Analysis::Dynamic {
+            integrator,
+            dt,
+            t_end,
+        } = self.analysis
+        else {
+            return None;
+        };
+        Some((integrator, self.stepping(dt, t_end)))
+    }
+
+    /// The settings of time steps of `dt` to `t_end` with this solver's
+    /// Newton, halvings and mass.
+    pub fn stepping(&self, dt: f64, t_end: f64) -> flexmech_integrators::dynamics::DynamicSettings {
+        let newton = flexmech_integrators::NewtonSettings {
+            tolerance: self.tolerance,
+            max_iterations: self.max_iterations,
+            modified: self.modified_newton,
+            exact_tangent: self.exact_tangent,
+        };
+        flexmech_integrators::dynamics::DynamicSettings {
+            dt,
+            t_end,
+            newton,
+            max_halvings: self.max_halvings,
+            mass: self.mass,
+        }
+    }
+}
+
 /// `[output]`; [`Default`]: every step, no tracked node, no resultants or
 /// ParaView series.
 #[derive(Debug, Clone, PartialEq)]

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use flexmech::integrators::dynamics::{DynamicSettings, Simulation};
-use flexmech::integrators::{NewtonSettings, StepRecord};
+use flexmech::integrators::StepRecord;
 use flexmech::model::build::{build, Built};
 use flexmech::model::{Analysis, Model};
 use flexmech::results::layout;
@@ -90,29 +90,7 @@ pub struct PySimulation {
 
 /// The dynamic settings of `model`, as a run uses them.
 fn settings(model: &Model) -> Option<(flexmech::model::IntegratorKind, DynamicSettings)> {
-    let Analysis::Dynamic {
-        integrator,
-        dt,
-        t_end,
-    } = model.solver.analysis
-    else {
-        return None;
-    };
-    Some((
-        integrator,
-        DynamicSettings {
-            dt,
-            t_end,
-            newton: NewtonSettings {
-                tolerance: model.solver.tolerance,
-                max_iterations: model.solver.max_iterations,
-                modified: model.solver.modified_newton,
-                exact_tangent: model.solver.exact_tangent,
-            },
-            max_halvings: model.solver.max_halvings,
-            mass: model.solver.mass,
-        },
-    ))
+    model.solver.dynamic_settings()
 }
 
 impl PySimulation {

@@ -493,40 +493,23 @@ fn solve(
             integrator,
             dt,
             t_end,
-        } => solve_dynamic(
-            model,
-            built,
-            restart,
-            keeper,
-            start,
-            (integrator, dt, t_end),
-        ),
+        } => {
+            let settings = model.solver.stepping(dt, t_end);
+            solve_dynamic(built, restart, keeper, start, (integrator, settings))
+        }
     }
 }
 
 /// The time steps of a dynamic run, each kept one followed by its restart
 /// state; returns the outcome and the set-up time (before the first step).
 fn solve_dynamic(
-    model: &Model,
     built: &Built,
     restart: Option<&Checkpoint>,
     keeper: &mut Keeper<'_>,
     start: Instant,
-    (integrator, dt, t_end): (IntegratorKind, f64, f64),
+    (integrator, settings): (IntegratorKind, DynamicSettings),
 ) -> (Result<(), SolveError>, f64) {
     let mech = &built.mechanism;
-    let settings = DynamicSettings {
-        dt,
-        t_end,
-        newton: NewtonSettings {
-            tolerance: model.solver.tolerance,
-            max_iterations: model.solver.max_iterations,
-            modified: model.solver.modified_newton,
-            exact_tangent: model.solver.exact_tangent,
-        },
-        max_halvings: model.solver.max_halvings,
-        mass: model.solver.mass,
-    };
     let sim = match restart {
         Some(c) => Simulation::resume(mech, integrator, &settings, c),
         None => Simulation::new(mech, integrator, &settings, &built.motion),
