@@ -13,14 +13,7 @@ use crate::common::data;
 /// positions' size, far below the Newton tolerance's effect (~1e-10).
 const SAME_RUN: f64 = 1e-12;
 
-/// Every time integrator of the model format.
-const INTEGRATORS: [&str; 5] = [
-    "newmark",
-    "generalized-alpha",
-    "momentum",
-    "energy-momentum",
-    "energy-momentum-paper",
-];
+use crate::common::INTEGRATORS;
 
 /// `file`'s model with its first joint rewritten as an expression joint
 /// (`translation`, `parameters`), run with `integrator` to `t_end`.

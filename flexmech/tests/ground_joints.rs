@@ -8,13 +8,7 @@ use flexmech::model::{parse_model, Model};
 use flexmech::results::run_model_to;
 use flexmech::results::ResultReader;
 
-const INTEGRATORS: [&str; 5] = [
-    "newmark",
-    "generalized-alpha",
-    "momentum",
-    "energy-momentum",
-    "energy-momentum-paper",
-];
+use crate::common::INTEGRATORS;
 
 fn model(file: &str, integrator: &str) -> Model {
     let path: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -65,3 +65,12 @@ pub fn drift(series: &[f64], width: usize) -> f64 {
         })
         .fold(0.0, f64::max)
 }
+
+/// Every time integrator of the model format.
+pub const INTEGRATORS: [&str; 5] = [
+    "newmark",
+    "generalized-alpha",
+    "momentum",
+    "energy-momentum",
+    "energy-momentum-paper",
+];
