@@ -106,6 +106,7 @@ fn study() -> Result<StudySpec, Box<dyn std::error::Error>> {
         dataset: "/nodes/beam.end/displacement".into(),
         component: Component::Index(2),
         reduce: Reduce::Final,
+        derivative: Vec::new(),
     });
     Ok(StudySpec::from_fn(
         "cantilever-stiffness",

@@ -93,6 +93,7 @@ fn perturbed(mech: &Mechanism, p: &Parameter, h: f64) -> Mechanism {
                 }
             }
         }
+        Parameter::Loads { .. } => panic!("not used in these tests"),
         Parameter::Load { load, component } => {
             let l = &mut m.loads[*load];
             match component {
@@ -118,6 +119,7 @@ fn value(mech: &Mechanism, p: &Parameter) -> f64 {
                 s.c_m[component - 3]
             }
         }
+        Parameter::Loads { .. } => panic!("not used in these tests"),
         Parameter::Load { load, component } => {
             let l = &mech.loads[*load];
             if *component < 3 {
@@ -129,20 +131,33 @@ fn value(mech: &Mechanism, p: &Parameter) -> f64 {
     }
 }
 
-/// Every node's final position by central differences: `dx/dp`.
-fn central_difference(mech: &Mechanism, p: &Parameter, steps: usize) -> Vec<[f64; 3]> {
-    let last = |h: f64| {
-        solve(&perturbed(mech, p, h), steps, &[])
-            .pop()
-            .unwrap()
-            .positions
-    };
+/// Every node's final position and the final total energy by central
+/// differences: `dx/dp`, `dE/dp`.
+fn central_difference(mech: &Mechanism, p: &Parameter, steps: usize) -> (Vec<[f64; 3]>, f64) {
+    let last = |h: f64| solve(&perturbed(mech, p, h), steps, &[]).pop().unwrap();
     let (plus, minus) = (last(STEP), last(-STEP));
     let dp = 2.0 * STEP * value(mech, p);
-    plus.iter()
-        .zip(&minus)
+    let dx = plus
+        .positions
+        .iter()
+        .zip(&minus.positions)
         .map(|(a, b)| [0, 1, 2].map(|c| (a[c] - b[c]) / dp))
-        .collect()
+        .collect();
+    (dx, (plus.energy.total - minus.energy.total) / dp)
+}
+
+/// [`central_difference`] against the exact `dx/dp` and `dE/dp` of `last`.
+fn assert_agrees(last: &StepRecord, k: usize, fd: (Vec<[f64; 3]>, f64), p: &Parameter) {
+    let exact = &last.sensitivities[k];
+    let e = mismatch(&exact.displacement, &fd.0);
+    assert!(e < AGREE, "{p:?}: {e:e}");
+    let e = (exact.energy - fd.1).abs() / exact.energy.abs().max(fd.1.abs());
+    assert!(
+        e < AGREE,
+        "{p:?}: dE/dp {} vs {} ({e:e})",
+        exact.energy,
+        fd.1
+    );
 }
 
 /// Largest difference between the exact and the difference derivatives,
@@ -177,7 +192,7 @@ fn the_tip_deflection_of_a_linear_cantilever_by_ei_ga_and_the_load() {
         },
     ];
     let last = solve(&built.mechanism, 4, &params).pop().unwrap();
-    let d = |k: usize| last.sensitivities[k][tip][2];
+    let d = |k: usize| last.sensitivities[k].displacement[tip][2];
     let bend = 1.0 - 1.0 / (4.0 * (n * n) as f64);
     let exact = -f * l.powi(3) / (3.0 * ei * ei) * bend;
     assert!((d(0) / exact - 1.0).abs() < 1e-5, "{} vs {exact}", d(0));
@@ -215,8 +230,7 @@ fn sensitivities_equal_central_differences_in_the_nonlinear_range() {
     );
     for (k, p) in params.iter().enumerate() {
         let fd = central_difference(&built.mechanism, p, 10);
-        let e = mismatch(&last.sensitivities[k], &fd);
-        assert!(e < AGREE, "{p:?}: {e:e}");
+        assert_agrees(&last, k, fd, p);
     }
 }
 
@@ -240,7 +254,161 @@ fn sensitivities_through_every_joint_kind_equal_central_differences() {
     let last = solve(&built.mechanism, steps, &params).pop().unwrap();
     for (k, p) in params.iter().enumerate() {
         let fd = central_difference(&built.mechanism, p, steps);
-        let e = mismatch(&last.sensitivities[k], &fd);
-        assert!(e < AGREE, "{p:?}: {e:e}");
+        assert_agrees(&last, k, fd, p);
     }
+}
+
+/// `model` with the value at `key` scaled by `1 + h` (through the model
+/// file's text, so the key's meaning is the file's, not the solver's).
+fn perturbed_model(model: &Model, key: &str, h: f64) -> (Model, f64) {
+    use flexmech::model::key_path::{lookup_mut, KeyPath};
+    let mut table: toml::Table = toml::from_str(&model.to_toml()).unwrap();
+    let value = lookup_mut(&mut table, &KeyPath::parse(key).unwrap()).unwrap();
+    let v = value
+        .as_float()
+        .or(value.as_integer().map(|i| i as f64))
+        .unwrap();
+    *value = toml::Value::Float(v * (1.0 + h));
+    let text = toml::to_string(&table).unwrap();
+    (parse_model(&text, &model.path).unwrap(), v)
+}
+
+/// The last kept step of `model` run into memory.
+fn last_step(model: &Model) -> StepRecord {
+    let mut memory = Memory::default();
+    run(model, &mut memory).unwrap();
+    assert_eq!(memory.status(), "completed");
+    memory.records.pop().unwrap()
+}
+
+#[test]
+fn model_file_sensitivities_equal_central_differences_of_perturbed_files() {
+    // data/statics/sensitivity_frame.toml: an L-frame turned ~0.5 rad, five
+    // keys (two sections by name and by position, a tip force and moment, a
+    // distributed load). The result file's /sensitivity against central
+    // differences of the model run with each key's value scaled by 1 ± 1e-4.
+    let model = load_model(&data("statics/sensitivity_frame.toml")).unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let file = flexmech::results::run_model_to(&model, &out.path().join("frame.h5")).unwrap();
+    let result = crate::common::reader(&file.file);
+    let built = build(&model).unwrap();
+    let nodes = [
+        ("arm.end", built.beam_nodes[1][8]),
+        ("post.end", built.beam_nodes[0][8]),
+    ];
+    let mut quiet = model.clone();
+    quiet.output.sensitivity.clear();
+    for (key, _) in &model.output.sensitivity {
+        let (plus, v) = perturbed_model(&quiet, key, STEP);
+        let (minus, _) = perturbed_model(&quiet, key, -STEP);
+        let (plus, minus) = (last_step(&plus), last_step(&minus));
+        let dp = 2.0 * STEP * v;
+        for (label, node) in nodes {
+            let name = format!("/sensitivity/{key}/nodes/{label}/displacement");
+            let exact = *result.rows3(&name).unwrap().last().unwrap();
+            let fd: [f64; 3] =
+                [0, 1, 2].map(|c| (plus.positions[node][c] - minus.positions[node][c]) / dp);
+            let e = mismatch(&[exact], &[fd]);
+            assert!(e < AGREE, "{name}: {exact:?} vs {fd:?} ({e:e})");
+        }
+        let name = format!("/sensitivity/{key}/energy/total");
+        let exact = *result.values(&name).unwrap().last().unwrap();
+        let fd = (plus.energy.total - minus.energy.total) / dp;
+        let e = (exact - fd).abs() / fd.abs();
+        assert!(e < AGREE, "{name}: {exact} vs {fd} ({e:e})");
+    }
+}
+
+#[test]
+fn sensitivity_keys_that_name_no_differentiable_value_are_refused_where_written() {
+    let path = data("statics/sensitivity_frame.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let start = text.find("sensitivity = [").unwrap();
+    let with = |keys: &str, more: &str| {
+        let t = format!("{}sensitivity = [{keys}]\n{more}", &text[..start]);
+        parse_model(&t, &path).unwrap_err().to_string()
+    };
+    let cases = [
+        ("\"section.rod.EA\"", "no [[section]] entry named \"rod\""),
+        (
+            "\"beam[0].start[0]\"",
+            "not available yet; available: section stiffnesses",
+        ),
+        ("\"section.post.EI\"", "a list (name one component"),
+        ("\"beam[0].elements\"", "an integer, not a real number"),
+        ("\"section.post.name\"", "a string, not a real number"),
+        ("\"load[0].force[3]\"", "has 3 entries"),
+        ("\"load[0].force[2]\", \"load[0].force[2]\"", "listed twice"),
+        ("\"load[0.force\"", "unclosed '['"),
+    ];
+    for (keys, expected) in cases {
+        let message = with(keys, "");
+        assert!(message.contains(expected), "{keys}: {message}");
+        assert!(message.contains("key `output.sensitivity["), "{message}");
+        assert!(message.contains("sensitivity_frame.toml:"), "{message}");
+    }
+    // Analyses not differentiated yet are refused whole.
+    let mass = "\nrhoA = 1.0\nrhoJ = [0.02, 0.01, 0.01]";
+    let dynamic = (text.replace(
+        "EI = [1000.0, 1000.0]",
+        &format!("EI = [1000.0, 1000.0]{mass}"),
+    ))
+    .replace("EI = [400.0, 600.0]", &format!("EI = [400.0, 600.0]{mass}"))
+    .replace(
+        "analysis = \"static\"\nload_steps = 5",
+        "analysis = \"dynamic\"\nintegrator = \"newmark\"\ndt = 0.01\nt_end = 0.1",
+    );
+    let dynamic = parse_model(&dynamic, &path);
+    let message = dynamic
+        .map(|_| String::new())
+        .unwrap_or_else(|e| e.to_string());
+    assert!(message.contains("load-controlled statics"), "{message}");
+}
+
+#[test]
+fn a_study_figure_with_derivatives_agrees_with_its_own_neighbouring_runs() {
+    // The frame without [output] sensitivity: the study asks the runs for
+    // the figure's derivatives. EI[0] of the post at 1000 (1 ∓ 1e-4): the
+    // middle run's d(tip_z)|d(EI) is the central difference of the outer
+    // two runs' tip_z.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(data("statics/sensitivity_frame.toml")).unwrap();
+    let base = &text[..text.find("sensitivity = [").unwrap()];
+    std::fs::write(dir.path().join("frame.toml"), base).unwrap();
+    let ei = [1000.0 * (1.0 - STEP), 1000.0, 1000.0 * (1.0 + STEP)];
+    let study = format!(
+        "name = \"frame-ei\"\nmodel = \"frame.toml\"\n[grid]\n\"section.post.EI[0]\" = \
+         [{:?}, {:?}, {:?}]\n[output]\nfigures = [{{ name = \"tip_z\", dataset = \
+         \"/nodes/arm.end/displacement\", component = \"z\", reduce = \"final\", derivative = \
+         [\"section.post.EI[0]\", \"load[0].force[2]\"] }}]\n",
+        ei[0], ei[1], ei[2]
+    );
+    let file = dir.path().join("study.toml");
+    std::fs::write(&file, study).unwrap();
+    let spec = flexmech::studies::load_study(&file).unwrap();
+    let report = spec.run(dir.path().join("out")).unwrap();
+    let summary = crate::common::reader(&report.dir.join("summary.h5"));
+    let column = |name: &str| summary.values(&format!("/{name}")).unwrap();
+    let (tip, by_ei) = (column("tip_z"), column("d(tip_z)|d(section.post.EI[0])"));
+    let fd = (tip[2] - tip[0]) / (ei[2] - ei[0]);
+    assert!(
+        (by_ei[1] - fd).abs() < AGREE * fd.abs(),
+        "{} vs {fd}",
+        by_ei[1]
+    );
+    // The column is the run file's /sensitivity at the last step.
+    let run = crate::common::reader(&report.dir.join("runs/run-0001.h5"));
+    let stored = run
+        .rows3("/sensitivity/load[0].force[2]/nodes/arm.end/displacement")
+        .unwrap();
+    assert_eq!(
+        column("d(tip_z)|d(load[0].force[2])")[1],
+        stored.last().unwrap()[2]
+    );
+    // The chart over EI draws the tangents from the derivatives.
+    let svg = std::fs::read_to_string(report.dir.join("charts/tip_z.svg")).unwrap();
+    assert!(
+        svg.contains("tangents (exact derivatives)"),
+        "no tangent legend"
+    );
 }

@@ -603,6 +603,19 @@ impl MechanismBuilder {
         Ok(())
     }
 
+    /// The number of dead nodal loads so far: the index in
+    /// [`Mechanism::loads`] of the next one.
+    pub fn load_count(&self) -> usize {
+        self.mech.loads.len()
+    }
+
+    /// Each node of `beam` with its share `∫ Nᵢ ds` of a unit load per unit
+    /// length, in the order [`MechanismBuilder::distributed_load`] adds
+    /// the nodal loads.
+    pub fn distributed_shares(&self, beam: &Beam) -> Result<Vec<(usize, f64)>, BuildError> {
+        self.shares(beam, &Vector3::zeros(), &Vector3::zeros())
+    }
+
     /// Each node's share `Σ w h` of a uniform load per unit length on
     /// `beam` (the weights of gravity), after checking the load's numbers.
     fn shares(

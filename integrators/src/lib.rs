@@ -35,6 +35,6 @@ pub use mechanism::{
     Schedule,
 };
 pub use newton::NewtonSettings;
-pub use record::{Energies, JointRecord, StepRecord};
+pub use record::{Energies, JointRecord, Sensitivity, StepRecord};
 pub use sensitivity::Parameter;
 pub use statics::{solve_static, solve_static_with, StaticOutcome, StaticSettings};

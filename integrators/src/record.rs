@@ -85,7 +85,18 @@ pub struct StepRecord {
     /// tangent (see [`crate::stability`]); non-zero means the equilibrium
     /// is unstable (past a bifurcation or limit point). `None` in dynamics.
     pub negative_pivots: Option<usize>,
-    /// Statics with sensitivities (`statics::solve_static_with`): for each
-    /// parameter, `dx/dp` of every node; empty otherwise.
-    pub sensitivities: Vec<Vec<[f64; 3]>>,
+    /// Statics with sensitivities (`statics::solve_static_with`): one per
+    /// parameter, in the order given; empty otherwise.
+    pub sensitivities: Vec<Sensitivity>,
+}
+
+/// The exact derivatives of one step's results with respect to one
+/// parameter `p` (see [`crate::sensitivity`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Sensitivity {
+    /// `dx/dp` of every node's position.
+    pub displacement: Vec<[f64; 3]>,
+    /// `d(total energy)/dp` ([`Energies::total`]); NaN where the total is
+    /// path-dependent (follower loads).
+    pub energy: f64,
 }

@@ -19,12 +19,26 @@
 //! is the internal force of the same elements, in the same state, with that
 //! stiffness 1 and the others 0; a dead load's component enters `r` as
 //! `−s(λ) e`.
+//!
+//! The total energy `E = U − Σ fₑₓₜ·u` (strain energy and the dead loads'
+//! potential, [`crate::measure::load_potential`]) has the total derivative
+//!
+//! ```text
+//! dE/dp = Σₙ f_int,n · dxₙ/dp − Σₙ fₑₓₜ,n · duₙ/dp + ∂E/∂p
+//! ```
+//!
+//! with `dxₙ/dp` the node's translation and spatial rotation increment per
+//! unit `p` (the work-conjugates of the nodal forces and moments), `duₙ/dp`
+//! its translation and `∂E/∂p` at fixed configuration: the unit-stiffness
+//! elements' strain energy, or `−s(λ) uₙ·e` for a load component. Follower
+//! loads make the total path-dependent; its derivative is then NaN.
 
 use nalgebra::Vector3;
 
 use crate::error::SolveError;
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
+use crate::record::Sensitivity;
 use crate::system::{ReducedSystem, StepTerms};
 use flexmech_core::{Configuration, Element, Section};
 
@@ -47,6 +61,16 @@ pub enum Parameter {
         /// Which component, 0–5.
         component: usize,
     },
+    /// Component `component` of a load spread over several dead nodal
+    /// loads, `(load, w)` with `w` the load's share of a unit value (a
+    /// distributed load per unit length: each node's `∫ Nᵢ ds`).
+    Loads {
+        /// The nodal loads (indices into [`Mechanism::loads`]) and their
+        /// shares.
+        shares: Vec<(usize, f64)>,
+        /// Which component, 0–5.
+        component: usize,
+    },
 }
 
 impl Parameter {
@@ -58,6 +82,12 @@ impl Parameter {
                 component,
             } => *component < 6 && elements.iter().all(|&e| e < mech.mesh.elements.len()),
             Parameter::Load { load, component } => *load < mech.loads.len() && *component < 6,
+            Parameter::Loads { shares, component } => {
+                *component < 6
+                    && shares
+                        .iter()
+                        .all(|&(l, w)| l < mech.loads.len() && w.is_finite())
+            }
         };
         if ok {
             Ok(())
@@ -69,38 +99,59 @@ impl Parameter {
         }
     }
 
+    /// The dead loads this parameter scales, with their shares (empty for
+    /// a stiffness).
+    fn load_shares(&self) -> (Vec<(usize, f64)>, usize) {
+        match self {
+            Parameter::Stiffness { .. } => (Vec::new(), 0),
+            Parameter::Load { load, component } => (vec![(*load, 1.0)], *component),
+            Parameter::Loads { shares, component } => (shares.clone(), *component),
+        }
+    }
+
     /// `∂g/∂p`, the derivative of the nodal residual `g = f_int − f_ext`
-    /// (6 per node) at `config` and load factor `lambda`, into `out`.
-    fn nodal_derivative(
+    /// (6 per node) at `config` and load factor `lambda`, into `out`; returns
+    /// `∂E/∂p`, the total energy's derivative at fixed configuration.
+    pub(crate) fn nodal_derivative(
         &self,
         mech: &Mechanism,
         config: &Configuration,
         lambda: f64,
         out: &mut [f64],
-    ) {
+    ) -> f64 {
         out.iter_mut().for_each(|v| *v = 0.0);
-        match self {
-            Parameter::Stiffness {
-                elements,
-                component,
-            } => {
-                let mut r = Vec::new();
-                for &e in elements {
-                    let unit = with_unit_stiffness(&mech.mesh.elements[e], *component);
-                    r.resize(unit.dofs(), 0.0);
-                    unit.internal_force_into(&config.x, &config.rot, &mut r);
-                    for (k, &n) in unit.nodes().iter().enumerate() {
-                        for c in 0..6 {
-                            out[6 * n + c] += r[6 * k + c];
-                        }
+        if let Parameter::Stiffness {
+            elements,
+            component,
+        } = self
+        {
+            let mut r = Vec::new();
+            let mut energy = 0.0;
+            for &e in elements {
+                let unit = with_unit_stiffness(&mech.mesh.elements[e], *component);
+                r.resize(unit.dofs(), 0.0);
+                unit.internal_force_into(&config.x, &config.rot, &mut r);
+                for (k, &n) in unit.nodes().iter().enumerate() {
+                    for c in 0..6 {
+                        out[6 * n + c] += r[6 * k + c];
                     }
                 }
+                energy += unit.energy(&config.x, &config.rot);
             }
-            Parameter::Load { load, component } => {
-                let l = &mech.loads[*load];
-                out[6 * l.node + component] = -l.scale.at(lambda);
+            return energy;
+        }
+        let (shares, component) = self.load_shares();
+        let mut energy = 0.0;
+        for (load, w) in shares {
+            let l = &mech.loads[load];
+            let f = w * l.scale.at(lambda);
+            out[6 * l.node + component] -= f;
+            if component < 3 {
+                energy -=
+                    f * (config.x[l.node][component] - mech.mesh.positions[l.node][component]);
             }
         }
+        energy
     }
 }
 
@@ -147,39 +198,60 @@ impl StaticSensitivities {
         })
     }
 
-    /// `dx/dp` of every node for every parameter at the converged step to
-    /// `lambda`, whose exact tangent `sys` holds (as the converged record
-    /// leaves it).
+    /// The sensitivities of the converged step to `lambda` for every
+    /// parameter; `sys` holds its exact tangent, its nodal residual and
+    /// external forces (as the converged record leaves them).
     pub(crate) fn at<T: StepTerms>(
         &mut self,
         sys: &ReducedSystem<'_, T>,
         lambda: f64,
-    ) -> Result<Vec<Vec<[f64; 3]>>, SolveError> {
+    ) -> Result<Vec<Sensitivity>, SolveError> {
         if self.params.is_empty() {
             return Ok(Vec::new());
         }
-        self.lu.factor(&sys.asm.values).map_err(|why| {
-            SolveError::InvalidMechanism(format!("sensitivities at λ = {lambda}: {why}"))
-        })?;
-        let n_eq = sys.topo.dofs.n_eq;
-        let nodes = sys.mech.mesh.node_count();
+        let failed =
+            |why| SolveError::InvalidMechanism(format!("sensitivities at λ = {lambda}: {why}"));
+        self.lu.factor(&sys.asm.values).map_err(failed)?;
         let mut out = Vec::with_capacity(self.params.len());
         for p in &self.params {
-            p.nodal_derivative(sys.mech, &sys.end.config, lambda, &mut self.nodal);
-            let mut dq = vec![0.0; n_eq];
+            let partial = p.nodal_derivative(sys.mech, &sys.end.config, lambda, &mut self.nodal);
+            let mut dq = vec![0.0; sys.topo.dofs.n_eq];
             sys.reduce(&self.nodal, &mut dq);
             dq.iter_mut().for_each(|v| *v = -*v);
-            self.lu.solve(&mut dq).map_err(|why| {
-                SolveError::InvalidMechanism(format!("sensitivities at λ = {lambda}: {why}"))
-            })?;
-            let dx = (0..nodes)
-                .map(|n| {
-                    let d = sys.topo.dofs.node_increment(n, &dq);
-                    [d[0], d[1], d[2]]
-                })
-                .collect();
-            out.push(dx);
+            self.lu.solve(&mut dq).map_err(failed)?;
+            out.push(sensitivity_of(sys, &dq, partial));
         }
         Ok(out)
+    }
+}
+
+/// The nodes' `dx/dp` and the total energy's `dE/dp` (module docs) for the
+/// reduced `dq = dq/dp`, with `partial = ∂E/∂p`.
+fn sensitivity_of<T: StepTerms>(
+    sys: &ReducedSystem<'_, T>,
+    dq: &[f64],
+    partial: f64,
+) -> Sensitivity {
+    let mut energy = partial;
+    let displacement = (0..sys.mech.mesh.node_count())
+        .map(|n| {
+            let d = sys.topo.dofs.node_increment(n, dq);
+            for c in 0..6 {
+                // f_int = g + f_ext; the dead loads' potential sees translations only.
+                let f = sys.nodal[6 * n + c] + sys.fext[6 * n + c];
+                energy += f * d[c];
+                if c < 3 {
+                    energy -= sys.fext[6 * n + c] * d[c];
+                }
+            }
+            [d[0], d[1], d[2]]
+        })
+        .collect();
+    if !sys.mech.follower_loads.is_empty() {
+        energy = f64::NAN;
+    }
+    Sensitivity {
+        displacement,
+        energy,
     }
 }

@@ -2,13 +2,14 @@
 //! the beams, number the nodes, apply supports, loads and gravity.
 
 use crate::{
-    Analysis, BeamSpec, IntegratorKind, Model, ModelError, NodeRef, PrescribedSpec, TimeFunction,
+    Analysis, BeamSpec, IntegratorKind, Model, ModelError, NodeRef, PrescribedSpec, SensitivityKey,
+    TimeFunction,
 };
 use flexmech_integrators::builder::{
     Beam, BeamDef, BuildError, Dof, JointDef, JointId, MechanismBuilder, NodeId,
 };
 use flexmech_integrators::dynamics::Motion;
-use flexmech_integrators::{Mechanism, Names, Schedule};
+use flexmech_integrators::{Mechanism, Names, Parameter, Schedule};
 use nalgebra::{Matrix3, Vector3};
 
 /// A mechanism with the numbering that relates it back to the model file.
@@ -30,12 +31,47 @@ pub struct Built {
     /// `(body index, node)` (labelled `body.<body name>`; its rigid joint to
     /// the carrying node is the joint `body.<body name>`, after the model's).
     pub body_nodes: Vec<(usize, usize)>,
+    /// Every `[[load]]` and then every `[[distributed_load]]` of the model
+    /// as the dead nodal loads it became: `(index into Mechanism::loads,
+    /// share of a unit value)` (empty for a follower load).
+    pub load_shares: Vec<Vec<(usize, f64)>>,
 }
 
 impl Built {
     /// Global node number of a model node.
     pub fn node(&self, r: NodeRef) -> usize {
         self.beam_nodes[r.beam][r.node]
+    }
+
+    /// The mechanism's parameter of every `[output] sensitivity` key of
+    /// `model` (the model this was built from), in order: a section's
+    /// stiffness on the elements of every beam of that section; a load's
+    /// component on the dead nodal loads it became, with their shares.
+    pub fn sensitivity_parameters(&self, model: &Model) -> Vec<Parameter> {
+        let loads = model.loads.len();
+        let param = |key: &SensitivityKey| match *key {
+            SensitivityKey::Section { section, component } => Parameter::Stiffness {
+                elements: (model.beams.iter().zip(&self.beam_elements))
+                    .filter(|(b, _)| b.section == section)
+                    .flat_map(|(_, e)| e.clone())
+                    .collect(),
+                component,
+            },
+            SensitivityKey::Load { load, component } => Parameter::Loads {
+                shares: self.load_shares[load].clone(),
+                component,
+            },
+            SensitivityKey::DistributedLoad { load, component } => Parameter::Loads {
+                shares: self.load_shares[loads + load].clone(),
+                component,
+            },
+        };
+        model
+            .output
+            .sensitivity
+            .iter()
+            .map(|(_, k)| param(k))
+            .collect()
     }
 }
 
@@ -156,7 +192,7 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
     let mut b = MechanismBuilder::new();
     let (beam_nodes, beams) = add_beams(model, &mut b)?;
     add_supports(model, &mut b, &beam_nodes)?;
-    add_loads(model, &mut b, &beam_nodes, &beams)?;
+    let load_shares = add_loads(model, &mut b, &beam_nodes, &beams)?;
     let (joints, ground_nodes) = add_joints(model, &mut b, &beam_nodes)?;
     let body_nodes = add_rigid_bodies(model, &mut b, &beam_nodes)?;
     add_prescribed(model, &mut b, &beam_nodes, &joints)?;
@@ -173,6 +209,7 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
         motion: Motion::rest(0),
         ground_nodes,
         body_nodes,
+        load_shares,
     };
     built.motion = initial_motion(model, &built);
     built.mechanism.names = names(model, &built);
@@ -309,37 +346,50 @@ fn add_supports(
 }
 
 /// Applies the concentrated and distributed loads of `model` and its
-/// gravity in `b` (beam node ids `beam_nodes`, meshed beams `beams`).
+/// gravity in `b` (beam node ids `beam_nodes`, meshed beams `beams`);
+/// returns [`Built::load_shares`].
 fn add_loads(
     model: &Model,
     b: &mut MechanismBuilder,
     beam_nodes: &[Vec<NodeId>],
     beams: &[Beam],
-) -> Result<(), ModelError> {
+) -> Result<Vec<Vec<(usize, f64)>>, ModelError> {
     let node = |r: NodeRef| beam_nodes[r.beam][r.node];
+    let mut shares = Vec::new();
     for (i, l) in model.loads.iter().enumerate() {
         let scale = schedule(&l.time, &model.solver.analysis);
+        let first = b.load_count();
         if l.follower {
             b.follower_load(node(l.node), v(l.force), v(l.moment), scale)
         } else {
             b.load(node(l.node), v(l.force), v(l.moment), scale)
         }
         .map_err(|e| refused(model, format!("load[{i}]"), e))?;
+        shares.push(if l.follower {
+            vec![]
+        } else {
+            vec![(first, 1.0)]
+        });
     }
     for (i, l) in model.distributed_loads.iter().enumerate() {
         let scale = schedule(&l.time, &model.solver.analysis);
         let beam = &beams[l.beam];
+        let first = b.load_count();
+        let refuse = |e| refused(model, format!("distributed_load[{i}]"), e);
+        let split = b.distributed_shares(beam).map_err(refuse)?;
         if l.follower {
             b.follower_distributed_load(beam, v(l.force), v(l.moment), scale)
         } else {
             b.distributed_load(beam, v(l.force), v(l.moment), scale)
         }
-        .map_err(|e| refused(model, format!("distributed_load[{i}]"), e))?;
+        .map_err(refuse)?;
+        let dead = split.iter().enumerate().map(|(k, &(_, w))| (first + k, w));
+        shares.push(if l.follower { vec![] } else { dead.collect() });
     }
     b.gravity(v(model.gravity), schedule(&None, &model.solver.analysis))
         .map_err(|e| refused(model, "gravity".into(), e))?;
     add_rust_loads(model, b, beam_nodes);
-    Ok(())
+    Ok(shares)
 }
 
 /// The `[[rust_load]]` functions as load fields of the mechanism: row `k`

@@ -7,7 +7,7 @@
 //! A model loaded from a file always passes (the file checks are stricter:
 //! they also locate the line); [`crate::build`] runs this check first.
 
-use super::{Analysis, Model, ModelError, NodeRef, PrescribedSpec, TimeFunction};
+use super::{Analysis, Model, ModelError, NodeRef, PrescribedSpec, SensitivityKey, TimeFunction};
 
 /// Collects the first violation with its key.
 struct Checker<'a> {
@@ -286,11 +286,54 @@ impl Checker<'_> {
         for (label, r) in &self.model.output.track {
             self.node(&format!("output.track (\"{label}\")"), *r)?;
         }
-        Ok(())
+        self.sensitivity()
+    }
+
+    /// Every sensitivity key names a section or a dead load of the model,
+    /// and the model is one sensitivities are computed for.
+    fn sensitivity(&self) -> Res {
+        let m = self.model;
+        for (i, (text, key)) in m.output.sensitivity.iter().enumerate() {
+            let ok = match *key {
+                SensitivityKey::Section { section, component } => {
+                    section < m.sections.len() && component < 6
+                }
+                SensitivityKey::Load { load, component } => {
+                    m.loads.get(load).is_some_and(|l| !l.follower) && component < 6
+                }
+                SensitivityKey::DistributedLoad { load, component } => {
+                    m.distributed_loads.get(load).is_some_and(|l| !l.follower) && component < 6
+                }
+            };
+            if !ok {
+                return Err(self.fail(
+                    format!("output.sensitivity[{i}]"),
+                    format!(
+                        "\"{text}\" names no section stiffness or dead load component of the \
+                         model ({key:?})"
+                    ),
+                ));
+            }
+        }
+        match crate::validate::analysis_allows_sensitivity(m) {
+            Err(why) if !m.output.sensitivity.is_empty() => {
+                Err(self.fail("output.sensitivity", why))
+            }
+            _ => Ok(()),
+        }
     }
 }
 
 impl Model {
+    /// Asks the run for the exact derivatives of its results by the model
+    /// values at `keys` too (key paths, as in `[output] sensitivity`; keys
+    /// already asked for are kept once). Refused as in a model file: a key
+    /// that names no differentiable value, or a model sensitivities are not
+    /// computed for.
+    pub fn add_sensitivity(&mut self, keys: &[String]) -> Result<(), ModelError> {
+        crate::validate::add_sensitivity(self, keys)
+    }
+
     /// Checks the invariants the model-file checks establish (indices in
     /// range, stiffnesses positive, numbers finite, time tables sorted,
     /// steps positive); the error names the model key and what to change.

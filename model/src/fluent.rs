@@ -232,15 +232,27 @@ impl ModelBuilder {
     }
 
     /// Records the node `node` under `/nodes/<node>` of the result file.
-    pub fn track(mut self, node: &str) -> Self {
+    pub fn track(self, node: &str) -> Self {
+        self.push_output("track", node)
+    }
+
+    /// Writes the exact derivatives of the results with respect to the
+    /// model value at `key` (a key path such as `section.rod.EI[0]` or
+    /// `load[0].force[2]`): `[output] sensitivity` of model files.
+    pub fn sensitivity(self, key: &str) -> Self {
+        self.push_output("sensitivity", key)
+    }
+
+    /// Appends `item` to the list `list` of `[output]`.
+    fn push_output(mut self, list: &str, item: &str) -> Self {
         let output = self
             .root
             .entry("output")
             .or_insert_with(|| Value::Table(Table::new()));
         if let Value::Table(o) = output {
-            let track = o.entry("track").or_insert_with(|| Value::Array(Vec::new()));
-            if let Value::Array(a) = track {
-                a.push(Value::String(node.into()));
+            let entries = o.entry(list).or_insert_with(|| Value::Array(Vec::new()));
+            if let Value::Array(a) = entries {
+                a.push(Value::String(item.into()));
             }
         }
         self

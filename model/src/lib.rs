@@ -24,6 +24,7 @@ pub mod error;
 pub use flexmech_core::expr;
 mod fluent;
 mod initial_check;
+pub mod key_path;
 mod labels;
 mod locate;
 mod raw;

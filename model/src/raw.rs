@@ -243,6 +243,7 @@ pub(crate) struct RawOutput {
     pub track: Option<S<Vec<S<String>>>>,
     pub resultants: Option<S<bool>>,
     pub vtk: Option<S<bool>>,
+    pub sensitivity: Option<S<Vec<S<String>>>>,
 }
 
 /// A string or a list of strings (`fixed`, `nodes`).

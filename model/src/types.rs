@@ -321,6 +321,39 @@ pub struct OutputSpec {
     /// `vtk = true`: after the run, write its ParaView time series next to
     /// the result file (`<name>.pvd`, as `flexmech export --vtk` does).
     pub vtk: bool,
+    /// `sensitivity = [...]`: the key paths as written and the model values
+    /// they name; the run writes the exact derivatives of its results with
+    /// respect to each (`/sensitivity/<key path>`).
+    pub sensitivity: Vec<(String, SensitivityKey)>,
+}
+
+/// A model value a sensitivity is taken with respect to (`[output]
+/// sensitivity`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SensitivityKey {
+    /// Stiffness `component` of section `section` (index into
+    /// [`Model::sections`]): 0–5 are EA, GA₂, GA₃, GJ, EI₂, EI₃.
+    Section {
+        /// The section.
+        section: usize,
+        /// Which stiffness, 0–5.
+        component: usize,
+    },
+    /// Component `component` (0–2 force, 3–5 moment) of `[[load]]` `load`.
+    Load {
+        /// Index into [`Model::loads`].
+        load: usize,
+        /// Which component, 0–5.
+        component: usize,
+    },
+    /// Component `component` (0–2 force, 3–5 moment, per unit length) of
+    /// `[[distributed_load]]` `load`.
+    DistributedLoad {
+        /// Index into [`Model::distributed_loads`].
+        load: usize,
+        /// Which component, 0–5.
+        component: usize,
+    },
 }
 
 impl Default for OutputSpec {
@@ -330,6 +363,7 @@ impl Default for OutputSpec {
             track: Vec::new(),
             resultants: false,
             vtk: false,
+            sensitivity: Vec::new(),
         }
     }
 }

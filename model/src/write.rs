@@ -321,6 +321,11 @@ impl Model {
         t.insert("track".into(), Value::Array(track));
         t.insert("resultants".into(), Value::Boolean(o.resultants));
         t.insert("vtk".into(), Value::Boolean(o.vtk));
+        if !o.sensitivity.is_empty() {
+            let keys = o.sensitivity.iter();
+            let keys = keys.map(|(k, _)| Value::String(k.clone())).collect();
+            t.insert("sensitivity".into(), Value::Array(keys));
+        }
         t
     }
 }

@@ -177,6 +177,10 @@ class Model:
         """``[output]`` keys: ``output(every=10)``."""
     def track(self, *nodes: str) -> Model:
         """Records ``nodes`` under ``/nodes/<label>`` of the result."""
+    def sensitivity(self, *keys: str) -> Model:
+        """Writes the exact derivatives of the results with respect to the
+        model values at ``keys`` (``"section.rod.EI[0]"``,
+        ``"load[0].force[2]"``) under ``/sensitivity/<key>/...``."""
 
 class Simulation:
     """A dynamic model stepped from Python; its state as the rows of the

@@ -800,21 +800,34 @@ impl PyModel {
     /// Records the nodes `nodes` under `/nodes/<label>` of the result.
     #[pyo3(signature = (*nodes))]
     fn track<'py>(slf: Bound<'py, Self>, nodes: Vec<String>) -> PyResult<Bound<'py, Self>> {
-        {
-            let mut m = slf.borrow_mut();
-            m.changed();
-            let output = m
-                .table
-                .entry("output")
-                .or_insert_with(|| Value::Table(Table::new()));
-            if let Value::Table(o) = output {
-                let track = o.entry("track").or_insert_with(|| Value::Array(Vec::new()));
-                if let Value::Array(a) = track {
-                    a.extend(nodes.into_iter().map(Value::String));
-                }
+        slf.borrow_mut().push_output("track", nodes);
+        Ok(slf)
+    }
+
+    /// Writes the exact derivatives of the results with respect to the
+    /// model values at `keys` (key paths, e.g. `"section.rod.EI[0]"`):
+    /// `/sensitivity/<key>/...` of the result.
+    #[pyo3(signature = (*keys))]
+    fn sensitivity<'py>(slf: Bound<'py, Self>, keys: Vec<String>) -> PyResult<Bound<'py, Self>> {
+        slf.borrow_mut().push_output("sensitivity", keys);
+        Ok(slf)
+    }
+}
+
+impl PyModel {
+    /// Appends `items` to the list `list` of `[output]`.
+    fn push_output(&mut self, list: &str, items: Vec<String>) {
+        self.changed();
+        let output = self
+            .table
+            .entry("output")
+            .or_insert_with(|| Value::Table(Table::new()));
+        if let Value::Table(o) = output {
+            let entries = o.entry(list).or_insert_with(|| Value::Array(Vec::new()));
+            if let Value::Array(a) = entries {
+                a.extend(items.into_iter().map(Value::String));
             }
         }
-        Ok(slf)
     }
 }
 

@@ -18,6 +18,7 @@ MODELS = [
     "data/statics/follower_tip_force.toml",  # statics, follower load
     "data/dynamics/body_pendulum.toml",  # a rigid body on an offset
     "data/examples/expression_cam.toml",  # an expression joint: f(psi) in the file
+    "data/statics/sensitivity_frame.toml",  # statics with /sensitivity
 ]
 
 WHIP = "python/tests/models/whip.toml"  # fails part-way

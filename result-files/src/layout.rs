@@ -212,6 +212,27 @@ pub fn joint_path(name: &str, leaf: &str) -> String {
     format!("{JOINTS}/{name}/{leaf}")
 }
 
+/// `/sensitivity`: one group per `[output] sensitivity` key path, named
+/// as written (`/sensitivity/section.rod.EI[0]`).
+pub const SENSITIVITY: &str = "/sensitivity";
+
+/// Path of the group of sensitivity key `key`: `/sensitivity/<key>`.
+pub fn sensitivity_group(key: &str) -> String {
+    format!("{SENSITIVITY}/{key}")
+}
+
+/// T×3: `d(displacement)/dp` of tracked node `label` with respect to the
+/// model value at `key`: `/sensitivity/<key>/nodes/<label>/displacement`.
+pub fn sensitivity_node_path(key: &str, label: &str) -> String {
+    format!("{SENSITIVITY}/{key}{NODES}/{label}/{NODE_DISPLACEMENT}")
+}
+
+/// T: `d(total energy)/dp` with respect to the model value at `key`:
+/// `/sensitivity/<key>/energy/total`.
+pub fn sensitivity_energy_path(key: &str) -> String {
+    format!("{SENSITIVITY}/{key}{ENERGY_TOTAL}")
+}
+
 /// Why `name` cannot be used verbatim as an HDF5 group name, if it cannot.
 ///
 /// Labels such as `arm.end` or `post.3` are fine; `/` separates path

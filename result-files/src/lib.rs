@@ -41,10 +41,13 @@
 //! | `/configuration/quaternion` | T×nodes×4 | every node's triad as (w, x, y, z) |
 //! | `/configuration/velocity` | T×nodes×3 | dynamics: every node's translational velocity |
 //! | `/configuration/angular_velocity` | T×nodes×3 | dynamics: every node's angular velocity `ω = R W` (spatial) |
+//! | `/sensitivity/<key>/nodes/<label>/displacement` | T×3 | `[output] sensitivity`: d(displacement)/dp of a tracked node, exact |
+//! | `/sensitivity/<key>/energy/total` | T | d(total energy)/dp, exact |
 //!
 //! `<label>` and `<name>` are the tracked-node labels and joint names of
 //! [`RunMeta`], used verbatim as group names (`arm.end`, `post.3`); they must
-//! not be empty, be `.`, or contain `/`. Group `/nodes/<label>` has a `u64`
+//! not be empty, be `.`, or contain `/`; `<key>` is an `[output]
+//! sensitivity` key path as written (`section.rod.EI[0]`). Group `/nodes/<label>` has a `u64`
 //! attribute `node_index`, group `/joints/<name>` a `u64` attribute
 //! `joint_index` (extensions).
 //!

@@ -11,7 +11,7 @@ use crate::{
 use flexmech_integrators::arc_length::{solve_arc_length, ArcLengthSettings};
 use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
 use flexmech_integrators::{
-    solve_static, Mechanism, NewtonSettings, SolveError, StaticSettings, StepRecord,
+    solve_static_with, Mechanism, NewtonSettings, SolveError, StaticSettings, StepRecord,
 };
 use flexmech_model::build::{build, Built};
 use flexmech_model::{Analysis, IntegratorKind, Model, ModelError};
@@ -305,6 +305,14 @@ pub fn restart_model(model: &Model, result: &Path, out_dir: &Path) -> Result<Run
             file.display()
         )));
     }
+    if !model.output.sensitivity.is_empty() {
+        return Err(mismatch(
+            "a continued run cannot carry sensitivities (the restart state holds no \
+             derivatives); remove `sensitivity` from [output] to continue it, or run the model \
+             from t = 0"
+                .into(),
+        ));
+    }
     let built = build(model)?;
     let checkpoint = restart_state(model, &built, result)?;
     let mut sink = FileSink::new(&file).restarted_from(result, checkpoint.time);
@@ -411,6 +419,9 @@ fn run_meta(model: &Model, built: &Built) -> RunMeta {
                 .map(|(b, e)| (b.name.clone(), e.clone()))
                 .collect(),
         }),
+        sensitivity: (model.output.sensitivity.iter())
+            .map(|(key, _)| key.clone())
+            .collect(),
     }
 }
 
@@ -467,7 +478,8 @@ fn solve(
                 newton,
                 max_halvings,
             };
-            let outcome = solve_static(mech, &settings, |s| {
+            let params = built.sensitivity_parameters(model);
+            let outcome = solve_static_with(mech, &settings, &params, |s| {
                 keeper.push(s);
             });
             (outcome.map(|_| ()), 0.0)
@@ -495,7 +507,7 @@ fn solve(
             t_end,
         } => {
             let settings = model.solver.stepping(dt, t_end);
-            solve_dynamic(built, restart, keeper, start, (integrator, settings))
+            solve_dynamic(model, built, restart, keeper, start, (integrator, settings))
         }
     }
 }
@@ -503,6 +515,7 @@ fn solve(
 /// The time steps of a dynamic run, each kept one followed by its restart
 /// state; returns the outcome and the set-up time (before the first step).
 fn solve_dynamic(
+    model: &Model,
     built: &Built,
     restart: Option<&Checkpoint>,
     keeper: &mut Keeper<'_>,
@@ -514,7 +527,14 @@ fn solve_dynamic(
         Some(c) => Simulation::resume(mech, integrator, &settings, c),
         None => Simulation::new(mech, integrator, &settings, &built.motion),
     };
+    let params = built.sensitivity_parameters(model);
     let mut sim = match sim {
+        Ok(mut sim) if restart.is_none() && !params.is_empty() => {
+            match sim.differentiate(&params) {
+                Ok(()) => sim,
+                Err(e) => return (Err(e), 0.0),
+            }
+        }
         Ok(sim) => sim,
         Err(e) => return (Err(e), 0.0),
     };

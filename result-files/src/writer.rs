@@ -10,6 +10,9 @@ use hdf5::{Dataset, Extent, File, H5Type, Location};
 
 use super::layout as names;
 
+mod sensitivity;
+use sensitivity::SensitivitySets;
+
 /// Appended steps are held in memory and written together (one resize and
 /// one write per dataset, then one flush of the file) when the oldest held
 /// step is this old...
@@ -67,6 +70,11 @@ pub struct RunMeta {
     /// The stress resultants to write under `/resultants` (omitted when
     /// `None`; see [`super::resultants`]).
     pub resultants: Option<super::resultants::ResultantsMeta>,
+    /// The `[output] sensitivity` key paths as written: `/sensitivity/<key>`
+    /// holds the derivatives of the tracked nodes' displacements and of the
+    /// total energy; every [`StepRecord`] must then carry as many
+    /// [`StepRecord::sensitivities`].
+    pub sensitivity: Vec<String>,
 }
 
 /// Everything that can go wrong while writing a result file.
@@ -916,6 +924,8 @@ struct Datasets {
     configuration: ConfigurationSets,
     /// `[output] resultants = true`: force and moment at every Gauss point.
     resultants: Option<[Series; 2]>,
+    /// `[output] sensitivity`: the derivatives, per key.
+    sensitivity: SensitivitySets,
 }
 
 impl Datasets {
@@ -954,6 +964,7 @@ impl Datasets {
         let resultants = (meta.resultants.as_ref())
             .map(|r| resultant_sets(c, r))
             .transpose()?;
+        let sensitivity = SensitivitySets::create(c, meta)?;
         Ok(Self {
             time,
             energy,
@@ -965,6 +976,7 @@ impl Datasets {
             joints,
             configuration,
             resultants,
+            sensitivity,
         })
     }
 
@@ -1007,6 +1019,7 @@ impl Datasets {
             ])
         }))
         .chain(self.supports.iter().flatten())
+        .chain(self.sensitivity.series())
     }
 
     /// Writes `/time`, the energies and the momenta of `recs` from row `t0`.
@@ -1116,6 +1129,11 @@ fn check_meta(path: &Path, meta: &RunMeta) -> Result<(), ResultError> {
         meta.tracked.iter().map(|(l, _)| l.as_str()),
     )?;
     check_names(path, "joint", meta.joint_names.iter().map(String::as_str))?;
+    check_names(
+        path,
+        "sensitivity key",
+        meta.sensitivity.iter().map(String::as_str),
+    )?;
     if let Some((label, index)) = meta.tracked.iter().find(|(_, i)| *i >= n_nodes) {
         return Err(ResultError::NodeIndex {
             path: path.to_path_buf(),
@@ -1237,6 +1255,11 @@ impl ResultWriter {
             ("positions", n_nodes, step.positions.len()),
             ("quaternions", n_nodes, step.quaternions.len()),
             ("joints", self.sets.joints.len(), step.joints.len()),
+            (
+                "sensitivities",
+                self.sets.sensitivity.keys(),
+                step.sensitivities.len(),
+            ),
         ];
         let supports = self.sets.supports.len();
         let found_supports = if supports == 0 {
@@ -1330,7 +1353,7 @@ impl ResultWriter {
         if let (Some(sets), Some(meta)) = (&s.resultants, &self.resultants) {
             write_resultants(sets, meta, t0, recs, path)?;
         }
-        Ok(())
+        s.sensitivity.write(t0, recs, path)
     }
 
     /// Sets the root attributes `status` (`"completed"` or `"failed:

@@ -49,6 +49,20 @@ impl StudySpec {
         };
         run_study(self, &options)
     }
+
+    /// Every key path the figures ask derivatives by (`derivative = [...]`),
+    /// once each: the runs' models write them (`[output] sensitivity`).
+    pub fn derivative_keys(&self) -> Vec<String> {
+        let mut keys: Vec<String> = Vec::new();
+        for f in &self.figures {
+            for (_, key) in f.derivative_columns() {
+                if !keys.iter().any(|k| k == key) {
+                    keys.push(key.to_owned());
+                }
+            }
+        }
+        keys
+    }
 }
 
 impl Study {

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use super::spec::{Figure, StudySpec};
 use super::summary::Summary;
-use flexmech_plot::charts::{ChartError, LineChart, Series};
+use flexmech_plot::charts::{auto_style, ChartError, Color, Dash, LineChart, Marker, Series};
 
 /// The model tables whose name a key's words leave out (`joint.cam.b` reads
 /// `cam b`: the entry's name says what it is).
@@ -116,27 +116,51 @@ pub fn summary_charts(
     };
 
     let mut written = Vec::new();
-    let first_figure = 2 + spec.grid.len();
-    for (f, figure) in spec.figures.iter().enumerate() {
-        let col = first_figure + f;
+    let mut col = 2 + spec.grid.len();
+    for figure in &spec.figures {
+        let columns = Columns {
+            value: col,
+            derivatives: figure.derivative_columns(),
+        };
+        col += 1 + columns.derivatives.len();
         let title = if spec.titles {
             format!("{}: {}", spec.name, figure.name())
         } else {
             String::new()
         };
         let mut chart = LineChart::new(title, x_label.clone(), figure.axis_label());
-        for (label, rows) in &groups {
-            let mut points: Vec<(f64, f64)> = rows
+        // The derivative by the swept key gives each point's tangent.
+        let slope = (x_key.map(|i| spec.grid[i].key.as_str()))
+            .and_then(|key| columns.derivatives.iter().position(|(_, k)| *k == key))
+            .map(|d| columns.value + 1 + d);
+        for (group, (label, rows)) in groups.iter().enumerate() {
+            let mut points: Vec<(f64, f64, f64)> = rows
                 .iter()
-                .map(|&r| (x_of(r), summary.rows[r][col].number()))
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .map(|&r| {
+                    let cell =
+                        |c: Option<usize>| c.map_or(f64::NAN, |c| summary.rows[r][c].number());
+                    (
+                        x_of(r),
+                        summary.rows[r][columns.value].number(),
+                        cell(slope),
+                    )
+                })
+                .filter(|(x, y, _)| x.is_finite() && y.is_finite())
                 .collect();
             if points.is_empty() {
                 continue;
             }
             points.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let (x, y) = points.into_iter().unzip();
-            chart.series.push(Series::new(label.clone(), x, y));
+            let (x, y) = points.iter().map(|p| (p.0, p.1)).unzip();
+            let mut series = Series::new(label.clone(), x, y);
+            // The groups' styles, whatever tangent lines come between them.
+            let (color, dash) = auto_style(group);
+            (series.color, series.dash) = (Some(color), Some(dash));
+            chart.series.push(series);
+            if slope.is_some() {
+                let first = !chart.series.iter().any(|s| s.label == TANGENT_LABEL);
+                chart.series.extend(tangents(&points, first));
+            }
         }
         let stem = dir.join(figure.name());
         if chart.series.is_empty() {
@@ -154,4 +178,53 @@ pub fn summary_charts(
         written.push(svg);
     }
     Ok(written)
+}
+
+/// A figure's summary columns: its value and its derivatives (column name
+/// and key).
+struct Columns<'a> {
+    value: usize,
+    derivatives: Vec<(String, &'a str)>,
+}
+
+/// The legend entry of the tangent lines.
+const TANGENT_LABEL: &str = "tangents (exact derivatives)";
+/// A tangent line reaches this fraction of the spacing of the swept values
+/// on either side of its point.
+const TANGENT_REACH: f64 = 0.3;
+
+/// Short tangent lines through `points` (`x`, `y`, `dy/dx`; sorted by x),
+/// grey, the first labelled when `labelled`.
+fn tangents(points: &[(f64, f64, f64)], labelled: bool) -> Vec<Series> {
+    let spacing = (points.windows(2))
+        .map(|w| w[1].0 - w[0].0)
+        .filter(|d| *d > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let reach = if spacing.is_finite() {
+        TANGENT_REACH * spacing
+    } else {
+        TANGENT_REACH * points[0].0.abs().max(1.0) * 0.1
+    };
+    let mut out = Vec::new();
+    for &(x, y, slope) in points.iter().filter(|p| p.2.is_finite()) {
+        let label = if labelled && out.is_empty() {
+            TANGENT_LABEL.to_string()
+        } else {
+            String::new()
+        };
+        let mut s = Series::new(
+            label,
+            vec![x - reach, x + reach],
+            vec![y - reach * slope, y + reach * slope],
+        );
+        s.color = Some(Color {
+            r: 110,
+            g: 110,
+            b: 110,
+        });
+        s.marker = Some(Marker::None);
+        s.dash = Some(Dash::Solid);
+        out.push(s);
+    }
+    out
 }

@@ -14,6 +14,15 @@
 //! from 0) or its Euclidean `norm` (the default for T×k); `reduce` is one of
 //! `max`, `min`, `max-abs`, `mean`, `final` (the last stored step) or `initial`.
 //! NaN values are left out of `max`, `min`, `max-abs` and `mean`.
+//!
+//! `derivative = ["section.rod.EI[0]", ...]` adds, per key path, the
+//! figure's exact derivative by that model value as the summary column
+//! `d(<name>)|d(<key>)`: the runs write `/sensitivity/<key>/…` (the study
+//! asks each run for it) and the reduction is differentiated along — the
+//! derivative at the stored step the reduction picks (`final`, `initial`,
+//! `max`, `min`; `max-abs` with the sign of the value there), or the mean of
+//! the derivatives; a `norm` as `u·du/|u|`. Derivatives are written for
+//! `/nodes/<label>/displacement` and `/energy/total`.
 
 use toml::Value;
 
@@ -72,6 +81,29 @@ impl Reduce {
             Reduce::Initial => values.first().copied().unwrap_or(f64::NAN),
         }
     }
+
+    /// The derivative of [`Reduce::apply`] of `values` whose derivatives
+    /// are `derivatives` (one per stored step): the derivative at the step
+    /// the reduction picks, or the mean of the derivatives.
+    pub fn derivative(self, values: &[f64], derivatives: &[f64]) -> f64 {
+        let rows = || (0..values.len()).filter(|&i| !values[i].is_nan());
+        let pick = |key: &dyn Fn(usize) -> f64| rows().max_by(|&a, &b| key(a).total_cmp(&key(b)));
+        let at = match self {
+            Reduce::Max => pick(&|i| values[i]),
+            Reduce::Min => pick(&|i| -values[i]),
+            Reduce::MaxAbs => {
+                let i = pick(&|i| values[i].abs());
+                return i.map_or(f64::NAN, |i| values[i].signum() * derivatives[i]);
+            }
+            Reduce::Mean => {
+                let (sum, n) = rows().fold((0.0, 0usize), |(s, n), i| (s + derivatives[i], n + 1));
+                return if n == 0 { f64::NAN } else { sum / n as f64 };
+            }
+            Reduce::Final => values.len().checked_sub(1),
+            Reduce::Initial => (!values.is_empty()).then_some(0),
+        };
+        at.map_or(f64::NAN, |i| derivatives[i])
+    }
 }
 
 /// Which column of a T×k dataset.
@@ -94,6 +126,8 @@ pub struct DatasetFigure {
     pub component: Component,
     /// The reduction over the stored steps.
     pub reduce: Reduce,
+    /// Key paths of model values to write the figure's derivatives by.
+    pub derivative: Vec<String>,
 }
 
 impl DatasetFigure {
@@ -106,10 +140,10 @@ impl DatasetFigure {
             ));
         };
         for key in t.keys() {
-            if !["name", "dataset", "component", "reduce"].contains(&key.as_str()) {
+            if !["name", "dataset", "component", "reduce", "derivative"].contains(&key.as_str()) {
                 return Err(format!(
                     "unknown key `{key}` in a dataset figure; it takes name, dataset, reduce and \
-                     optionally component"
+                     optionally component and derivative"
                 ));
             }
         }
@@ -162,12 +196,52 @@ impl DatasetFigure {
                 ))
             }
         };
+        let derivative = derivative_keys(t.get("derivative"), &dataset)?;
         Ok(Self {
             name,
             dataset,
             component,
             reduce,
+            derivative,
         })
+    }
+
+    /// The summary column of the derivative by `key`: `d(<name>)|d(<key>)`.
+    pub fn derivative_column(&self, key: &str) -> String {
+        format!("d({})|d({key})", self.name)
+    }
+
+    /// The dataset holding the derivative of [`Self::dataset`] by `key`.
+    fn derivative_dataset(&self, key: &str) -> String {
+        let group = flexmech_results::layout::sensitivity_group(key);
+        format!("{group}{}", self.dataset)
+    }
+
+    /// Its derivatives for the run in `result`, by each of
+    /// [`Self::derivative`], with their column names.
+    pub fn derivative_values(
+        &self,
+        result: &ResultReader,
+    ) -> Result<Vec<(String, f64)>, ReadError> {
+        if self.derivative.is_empty() {
+            return Ok(Vec::new());
+        }
+        let (values, width) = self.rows(result, &self.dataset)?;
+        let mut out = Vec::with_capacity(self.derivative.len());
+        for key in &self.derivative {
+            let (derivatives, _) = self.rows(result, &self.derivative_dataset(key))?;
+            let (column, by) = match (width, self.component) {
+                (0, _) => (values.clone(), derivatives),
+                (k, Component::Index(i)) => (
+                    values.chunks_exact(k).map(|r| r[i]).collect(),
+                    derivatives.chunks_exact(k).map(|r| r[i]).collect(),
+                ),
+                (k, Component::Norm) => norm_and_derivative(&values, &derivatives, k),
+            };
+            let d = self.reduce.derivative(&column, &by);
+            out.push((self.derivative_column(key), d));
+        }
+        Ok(out)
     }
 
     /// A one-line meaning, for descriptions and chart axes.
@@ -181,29 +255,89 @@ impl DatasetFigure {
 
     /// Its value for the run in `result`.
     pub fn value(&self, result: &ResultReader) -> Result<f64, ReadError> {
-        let steps = result.time()?.len();
-        let shape = result.shape(&self.dataset)?;
-        let values = result.values(&self.dataset)?;
-        let column: Vec<f64> = match (shape.as_slice(), self.component) {
-            ([n], _) if *n == steps => values,
-            ([n, k], Component::Norm) if *n == steps && *k > 0 => values
-                .chunks_exact(*k)
+        let (values, width) = self.rows(result, &self.dataset)?;
+        let column: Vec<f64> = match (width, self.component) {
+            (0, _) => values,
+            (k, Component::Norm) => values
+                .chunks_exact(k)
                 .map(|r| r.iter().map(|v| v * v).sum::<f64>().sqrt())
                 .collect(),
-            ([n, k], Component::Index(i)) if *n == steps && i < *k => {
-                values.chunks_exact(*k).map(|r| r[i]).collect()
-            }
-            _ => {
-                return Err(ReadError::Shape {
-                    path: result.path().to_path_buf(),
-                    dataset: self.dataset.clone(),
-                    shape,
-                    expected: "T or T×k with the chosen component (T = stored steps)",
-                })
-            }
+            (k, Component::Index(i)) => values.chunks_exact(k).map(|r| r[i]).collect(),
         };
         Ok(self.reduce.apply(&column))
     }
+
+    /// The values of `dataset` (one row per stored step) and its row width
+    /// (0 for a T dataset), checked against the figure's component.
+    fn rows(&self, result: &ResultReader, dataset: &str) -> Result<(Vec<f64>, usize), ReadError> {
+        let steps = result.time()?.len();
+        let shape = result.shape(dataset)?;
+        match (shape.as_slice(), self.component) {
+            ([n], _) if *n == steps => Ok((result.values(dataset)?, 0)),
+            ([n, k], Component::Norm) if *n == steps && *k > 0 => Ok((result.values(dataset)?, *k)),
+            ([n, k], Component::Index(i)) if *n == steps && i < *k => {
+                Ok((result.values(dataset)?, *k))
+            }
+            _ => Err(ReadError::Shape {
+                path: result.path().to_path_buf(),
+                dataset: dataset.to_owned(),
+                shape,
+                expected: "T or T×k with the chosen component (T = stored steps)",
+            }),
+        }
+    }
+}
+
+/// Each row's norm `|u|` and its derivative `u·du/|u|` (0 where `u` = 0).
+fn norm_and_derivative(values: &[f64], derivatives: &[f64], k: usize) -> (Vec<f64>, Vec<f64>) {
+    values
+        .chunks_exact(k)
+        .zip(derivatives.chunks_exact(k))
+        .map(|(u, du)| {
+            let norm = u.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let dot: f64 = u.iter().zip(du).map(|(a, b)| a * b).sum();
+            (norm, if norm > 0.0 { dot / norm } else { 0.0 })
+        })
+        .unzip()
+}
+
+/// The `derivative` key paths of a figure over `dataset`; the error says
+/// what is wrong.
+fn derivative_keys(value: Option<&Value>, dataset: &str) -> Result<Vec<String>, String> {
+    let Some(value) = value else {
+        return Ok(Vec::new());
+    };
+    let keys: Vec<String> = match value {
+        Value::Array(a) => a
+            .iter()
+            .map(|v| match v {
+                Value::String(s) => Ok(s.clone()),
+                other => Err(format!(
+                    "`derivative` lists key paths as strings, found {other}"
+                )),
+            })
+            .collect::<Result<_, _>>()?,
+        other => {
+            return Err(format!(
+            "`derivative` must be a list of key paths, e.g. derivative = [\"section.rod.EI[0]\"], \
+                 found {other}"
+        ))
+        }
+    };
+    let parts: Vec<&str> = dataset.split('/').collect();
+    let derivable = matches!(parts.as_slice(), ["", "nodes", _, "displacement"])
+        || dataset == flexmech_results::layout::ENERGY_TOTAL;
+    if !keys.is_empty() && !derivable {
+        return Err(format!(
+            "derivatives are written for /nodes/<label>/displacement and /energy/total, not for \
+             {dataset}"
+        ));
+    }
+    for key in &keys {
+        flexmech_model::key_path::KeyPath::parse(key)
+            .map_err(|why| format!("`derivative` key \"{key}\" {why}"))?;
+    }
+    Ok(keys)
 }
 
 #[cfg(test)]

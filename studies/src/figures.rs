@@ -39,14 +39,19 @@ impl RunFigures {
         }
     }
 
+    /// The value of the dataset figure or derivative column `name` (NaN
+    /// when the run has none).
+    pub fn named(&self, name: &str) -> f64 {
+        self.datasets
+            .iter()
+            .find(|(n, _)| n == name)
+            .map_or(f64::NAN, |(_, v)| *v)
+    }
+
     /// The value of `figure`.
     pub fn get(&self, figure: &Figure) -> f64 {
         match figure {
-            Figure::Dataset(d) => self
-                .datasets
-                .iter()
-                .find(|(n, _)| *n == d.name)
-                .map_or(f64::NAN, |(_, v)| *v),
+            Figure::Dataset(d) => self.named(&d.name),
             Figure::EnergyDrift => self.energy_drift,
             Figure::MaxDisplacement => self.max_displacement,
             Figure::FailureTime => self.failure_time,
@@ -118,15 +123,22 @@ pub fn read_figures(file: &Path, figures: &[Figure]) -> Result<RunFigures, Figur
         failure_time,
         wall_time: r.wall_time_s(),
         newton_iterations,
-        datasets: figures
-            .iter()
-            .filter_map(|f| match f {
-                Figure::Dataset(d) => Some(d.value(&r).map(|v| (d.name.clone(), v))),
-                _ => None,
-            })
-            .collect::<Result<_, _>>()?,
+        datasets: dataset_figures(&r, figures)?,
         status,
     })
+}
+
+/// Every [`Figure::Dataset`] of `figures` for the run in `r`, by name,
+/// each followed by its derivatives (by their column names).
+fn dataset_figures(r: &ResultReader, figures: &[Figure]) -> Result<Vec<(String, f64)>, ReadError> {
+    let mut out = Vec::new();
+    for f in figures {
+        if let Figure::Dataset(d) = f {
+            out.push((d.name.clone(), d.value(r)?));
+            out.extend(d.derivative_values(r)?);
+        }
+    }
+    Ok(out)
 }
 
 /// Largest tracked-node displacement over the stored steps.

@@ -100,7 +100,7 @@ pub mod charts;
 pub mod dataset_figure;
 pub mod execute;
 pub mod figures;
-pub mod key_path;
+pub use flexmech_model::key_path;
 pub mod merge;
 mod report;
 mod schedule;

@@ -13,7 +13,7 @@ use std::sync::Arc;
 use toml::{Table, Value};
 
 use super::dataset_figure::DatasetFigure;
-use super::key_path::{base_dir, check_key, KeyPath};
+use super::key_path::{check_key, KeyPath};
 use flexmech_model::{load_model_with, JointRegistry, Model, ModelError};
 
 /// A per-run scalar of the summary table (see the module docs of
@@ -53,6 +53,17 @@ impl Figure {
             Figure::FailureTime => "failure_time",
             Figure::WallTime => "wall_time",
             Figure::NewtonIterations => "newton_iterations",
+        }
+    }
+
+    /// The summary columns of its derivatives (`d(<name>)|d(<key>)`), with
+    /// their keys.
+    pub fn derivative_columns(&self) -> Vec<(String, &str)> {
+        match self {
+            Figure::Dataset(d) => (d.derivative.iter())
+                .map(|k| (d.derivative_column(k), k.as_str()))
+                .collect(),
+            _ => Vec::new(),
         }
     }
 
@@ -872,4 +883,12 @@ impl fmt::Display for Figure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
     }
+}
+
+/// The directory of a study file, for resolving the model path.
+pub(crate) fn base_dir(study: &Path) -> &Path {
+    study
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
 }

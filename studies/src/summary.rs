@@ -120,6 +120,13 @@ pub fn columns(spec: &StudySpec) -> Vec<Column> {
             kind: ColumnKind::Number,
             description: f.description(),
         });
+        for (name, key) in f.derivative_columns() {
+            cols.push(Column {
+                name,
+                kind: ColumnKind::Number,
+                description: format!("exact derivative of {} by the model value {key}", f.name()),
+            });
+        }
     }
     cols
 }
@@ -143,6 +150,9 @@ pub fn row(spec: &StudySpec, cols: &[Column], plan: &RunPlan, figures: &RunFigur
     cells.push(Cell::Text(figures.status.clone()));
     for f in &spec.figures {
         cells.push(Cell::Number(figures.get(f)));
+        for (name, _) in f.derivative_columns() {
+            cells.push(Cell::Number(figures.named(&name)));
+        }
     }
     cells
 }

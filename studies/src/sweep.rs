@@ -170,6 +170,7 @@ pub fn model_for(spec: &StudySpec, plan: &RunPlan) -> Result<Model, SweepError> 
         RunSource::ModelFile { file, table } => {
             let text = model_text(spec, table, plan)?;
             let built = parse_model_with(&text, file, &spec.joints)
+                .and_then(|mut m| m.add_sensitivity(&spec.derivative_keys()).map(|_| m))
                 .and_then(|m| flexmech_model::build(&m).map(|_| m));
             built.map_err(|e| {
                 SweepError::InvalidRun(Box::new(InvalidRun {
@@ -196,7 +197,9 @@ pub fn model_for(spec: &StudySpec, plan: &RunPlan) -> Result<Model, SweepError> 
                 message,
             };
             let mut model = (build.0)(&params).map_err(refuse)?;
-            flexmech_model::build(&model).map_err(|e| refuse(e.to_string()))?;
+            (model.add_sensitivity(&spec.derivative_keys()))
+                .and_then(|_| flexmech_model::build(&model).map(|_| ()))
+                .map_err(|e| refuse(e.to_string()))?;
             let written = model.to_toml();
             model.source_text = format!(
                 "# study `{}`, {} ({overrides}): the model was built by a Rust function; the \

@@ -6,14 +6,18 @@
 
 use super::checkpoint::{CheckpointMismatch, Tape};
 use super::mass_slots::MassSlots;
+use super::newmark_sensitivity::NewmarkSensitivities;
 use super::slave_velocities;
-use super::time_scheme::TimeScheme;
+use super::time_scheme::{SchemeSensitivities, TimeScheme};
 use super::Motion;
 use crate::assembly::Assembler;
 use crate::constraints::{MechanismState, Topology};
 use crate::dofs::DofMap;
+use crate::error::SolveError;
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
+use crate::record::Sensitivity;
+use crate::sensitivity::Parameter;
 use crate::system::{ReducedSystem, Reduction, StepTerms};
 use flexmech_core::rotation::{log, tangent_inverse};
 use flexmech_core::{Configuration, Element, Inertia};
@@ -89,13 +93,13 @@ impl Coefficients {
 /// Velocities, pseudo-accelerations (`a`, `alpha`) and accelerations (`acc`,
 /// `ang_acc`) at the end of a step; the trapezoidal rule keeps `a = acc`.
 #[derive(Debug, Clone)]
-struct Kinematics {
-    v: Vec<Vector3<f64>>,
-    a: Vec<Vector3<f64>>,
-    w: Vec<Vector3<f64>>,
-    alpha: Vec<Vector3<f64>>,
-    acc: Vec<Vector3<f64>>,
-    ang_acc: Vec<Vector3<f64>>,
+pub(super) struct Kinematics {
+    pub(super) v: Vec<Vector3<f64>>,
+    pub(super) a: Vec<Vector3<f64>>,
+    pub(super) w: Vec<Vector3<f64>>,
+    pub(super) alpha: Vec<Vector3<f64>>,
+    pub(super) acc: Vec<Vector3<f64>>,
+    pub(super) ang_acc: Vec<Vector3<f64>>,
 }
 
 /// Translational pseudo-acceleration at `n+1` for the displacement `u` of
@@ -194,16 +198,16 @@ fn inertial_moment_tangent(
 /// forces at `tₙ₊₁`, the inertial forces `M q̈ₙ₊₁` and
 /// `Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁)` with their tangents, joints through `N`.
 pub(crate) struct NewmarkTerms {
-    coefficients: Coefficients,
+    pub(super) coefficients: Coefficients,
     /// The damped elements and their damping times `η`.
-    damped: Vec<(Element, f64)>,
+    pub(super) damped: Vec<(Element, f64)>,
     /// Energy dissipated by damping since t = 0.
     dissipated: f64,
-    inertia: Inertia,
+    pub(super) inertia: Inertia,
     slots: MassSlots,
     /// Velocities and accelerations at the start of the step.
-    prev: Kinematics,
-    dt: f64,
+    pub(super) prev: Kinematics,
+    pub(super) dt: f64,
     /// The drivers' reactions at the end of the last accepted step.
     reactions: Option<(Vec<Vec<f64>>, Vec<f64>)>,
 }
@@ -446,6 +450,22 @@ impl TimeScheme for NewmarkTerms {
         tape.done()
     }
 
+    fn sensitivities(
+        sys: &mut ReducedSystem<'_, Self>,
+        params: &[Parameter],
+    ) -> Result<SchemeSensitivities, SolveError> {
+        NewmarkSensitivities::new(sys, params).map(SchemeSensitivities::Newmark)
+    }
+
+    fn sensitivity_step(
+        sys: &mut ReducedSystem<'_, Self>,
+        sens: &mut SchemeSensitivities,
+        fext_end: &[f64],
+    ) -> Result<Vec<Sensitivity>, SolveError> {
+        let SchemeSensitivities::Newmark(s) = sens;
+        s.step(sys, fext_end)
+    }
+
     /// Newmark's updates of velocities and (pseudo-)accelerations; the drivers' work
     /// by the trapezoidal rule on their reactions at both ends of the step
     /// (the first step uses its end value twice).
@@ -488,7 +508,7 @@ impl TimeScheme for NewmarkTerms {
 /// the trapezoidal rule carries as an O(Δt) velocity offset. If the reduced
 /// mass is singular (massless DOFs) the accelerations start at zero.
 #[allow(clippy::too_many_arguments)]
-fn initial_accelerations(
+pub(super) fn initial_accelerations(
     mech: &Mechanism,
     topo: &Topology,
     inertia: &Inertia,

@@ -26,7 +26,7 @@ use std::ops::ControlFlow;
 use super::checkpoint::{Checkpoint, CheckpointMismatch, Tape};
 use super::midpoint::MidpointTerms;
 use super::newmark_terms::{Coefficients, NewmarkTerms};
-use super::time_scheme::TimeScheme;
+use super::time_scheme::{SchemeSensitivities, TimeScheme};
 use super::{inertia_round_off_floor, DynamicSettings, Motion, Scheme, GROW_AFTER};
 use crate::assembly::Assembler;
 use crate::constraints::{initial_state, MechanismState, Topology};
@@ -35,8 +35,9 @@ use crate::linsolve::SparseLu;
 use crate::measure::{dynamic_record, follower_work};
 use crate::mechanism::Mechanism;
 use crate::newton::NewtonReport;
-use crate::record::StepRecord;
+use crate::record::{Sensitivity, StepRecord};
 use crate::rotation_guard::{as_step_failure, RotationGuard};
+use crate::sensitivity::Parameter;
 use crate::step_control::StepControl;
 use crate::system::ReducedSystem;
 use crate::tolerances::TOLERANCES;
@@ -200,6 +201,24 @@ impl<'m> Simulation<'m> {
         c
     }
 
+    /// Computes the exact sensitivities of every step to `params` from now
+    /// on, into each record's [`StepRecord::sensitivities`] (see
+    /// [`crate::dynamics::newmark_sensitivity`]'s method: one more tangent
+    /// evaluation and factorisation per step, one solve per parameter).
+    /// Only at t = 0, before any step (the derivatives of a state are not
+    /// stored in a checkpoint); with `"newmark"` and `"generalized-alpha"`
+    /// so far, without structural damping.
+    pub fn differentiate(&mut self, params: &[Parameter]) -> Result<(), SolveError> {
+        if self.inner.time() != 0.0 {
+            return Err(SolveError::InvalidMechanism(
+                "sensitivities start at t = 0, before the first step (a continued run cannot \
+                 carry them)"
+                    .into(),
+            ));
+        }
+        self.inner.differentiate(params)
+    }
+
     /// Advances one converged step (halving and retrying as step control
     /// allows) and returns its record; `None` once `t_end` is reached.
     pub fn step(&mut self) -> Result<Option<StepRecord>, SolveError> {
@@ -284,6 +303,7 @@ trait Stepping {
     fn velocities(&self) -> (&[Vector3<f64>], &[Vector3<f64>]);
     fn checkpoint(&self) -> Checkpoint;
     fn restore(&mut self, checkpoint: &Checkpoint) -> Result<(), CheckpointMismatch>;
+    fn differentiate(&mut self, params: &[Parameter]) -> Result<(), SolveError>;
 }
 
 /// The driver of one scheme `S`. Between steps `sys.end` is the current
@@ -306,6 +326,9 @@ struct Stepper<'m, S> {
     dq: Vec<f64>,
     /// External forces at the current time (for the records' potential).
     fext_now: Vec<f64>,
+    /// The exact sensitivities, when asked for, and those of the current
+    /// state.
+    sensitivities: Option<(SchemeSensitivities, Vec<Sensitivity>)>,
 }
 
 impl<'m, S: TimeScheme> Stepper<'m, S> {
@@ -326,6 +349,7 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
             r: vec![0.0; n_eq],
             dq: vec![0.0; n_eq],
             fext_now,
+            sensitivities: None,
         }
     }
 
@@ -375,6 +399,9 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
             // The converged iterate's residual, the last one Newton evaluated.
             sys.record_reactions(&mut rec);
         }
+        if let Some((_, now)) = &self.sensitivities {
+            rec.sensitivities = now.clone();
+        }
         rec
     }
 }
@@ -411,6 +438,10 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
                 sys.end.clone_from(&sys.start);
                 self.control.failed(t + dt, as_step_failure(objection)?)?;
                 continue;
+            }
+            if let Some((sens, now)) = &mut self.sensitivities {
+                let fext_end = sys.fext.clone();
+                *now = S::sensitivity_step(sys, sens, &fext_end)?;
             }
             self.driver_work += S::finish(sys, dt);
             self.follower_work +=
@@ -497,6 +528,17 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
         self.follower_work = c.follower_work;
         self.guard = RotationGuard::new(mech, &self.sys.end);
         mech.external_forces(self.t, &mut self.fext_now);
+        Ok(())
+    }
+
+    fn differentiate(&mut self, params: &[Parameter]) -> Result<(), SolveError> {
+        let sens = S::sensitivities(&mut self.sys, params)?;
+        let nodes = self.sys.mech.mesh.node_count();
+        let zero = Sensitivity {
+            displacement: vec![[0.0; 3]; nodes],
+            energy: 0.0,
+        };
+        self.sensitivities = Some((sens, vec![zero; params.len()]));
         Ok(())
     }
 }

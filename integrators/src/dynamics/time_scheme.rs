@@ -6,12 +6,21 @@
 
 use super::checkpoint::{CheckpointMismatch, Tape};
 use crate::error::NewtonFailure;
+use crate::error::SolveError;
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSettings};
+use crate::record::Sensitivity;
+use crate::sensitivity::Parameter;
 use crate::system::{ReducedSystem, StepTerms};
 use flexmech_core::Inertia;
 use nalgebra::Vector3;
+
+/// A scheme's exact sensitivities while a run steps.
+pub(crate) enum SchemeSensitivities {
+    /// The Newmark family's ([`super::newmark_sensitivity`]).
+    Newmark(super::newmark_sensitivity::NewmarkSensitivities),
+}
 
 /// A time-integration scheme over the shared reduced system.
 pub(crate) trait TimeScheme: StepTerms + Sized {
@@ -64,4 +73,28 @@ pub(crate) trait TimeScheme: StepTerms + Sized {
     /// Reads back what [`TimeScheme::save`] wrote, checking its shapes
     /// against `mech`.
     fn restore(&mut self, mech: &Mechanism, tape: &mut Tape) -> Result<(), CheckpointMismatch>;
+
+    /// Sets up the exact sensitivities to `params` at t = 0. Default: the
+    /// scheme has none yet.
+    fn sensitivities(
+        _sys: &mut ReducedSystem<'_, Self>,
+        _params: &[Parameter],
+    ) -> Result<SchemeSensitivities, SolveError> {
+        Err(SolveError::InvalidMechanism(
+            "sensitivities are computed with integrator \"newmark\" or \"generalized-alpha\" \
+             so far"
+                .into(),
+        ))
+    }
+
+    /// The sensitivities of the step `sys.start → sys.end` just converged,
+    /// before [`TimeScheme::finish`]; `fext_end` the external forces at its
+    /// end.
+    fn sensitivity_step(
+        _sys: &mut ReducedSystem<'_, Self>,
+        _sens: &mut SchemeSensitivities,
+        _fext_end: &[f64],
+    ) -> Result<Vec<Sensitivity>, SolveError> {
+        unreachable!("a scheme without sensitivities sets none up")
+    }
 }

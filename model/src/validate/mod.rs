@@ -18,6 +18,8 @@ pub mod limits;
 mod loading;
 mod rigid_bodies;
 mod rust_loads;
+mod sensitivity;
+pub(crate) use sensitivity::{add_sensitivity, analysis_allows_sensitivity};
 mod solver;
 
 type Res<T> = Result<T, ModelError>;
@@ -405,6 +407,7 @@ pub(crate) fn validate(
         output,
         source_written: String::new(),
     };
+    model.output.sensitivity = cx.sensitivity(raw.output.as_ref(), &model)?;
     model.source_written = model.to_toml();
     Ok(model)
 }

@@ -344,12 +344,7 @@ impl Ctx<'_> {
 
     pub(super) fn output(&self, raw: Option<&S<RawOutput>>, beams: &[BeamSpec]) -> Res<OutputSpec> {
         let Some(entry) = raw else {
-            return Ok(OutputSpec {
-                every: 1,
-                track: Vec::new(),
-                resultants: false,
-                vtk: false,
-            });
+            return Ok(OutputSpec::default());
         };
         let o = entry.get_ref();
         let every = match &o.every {
@@ -372,6 +367,8 @@ impl Ctx<'_> {
             track,
             resultants: o.resultants.as_ref().is_some_and(|r| *r.get_ref()),
             vtk: o.vtk.as_ref().is_some_and(|r| *r.get_ref()),
+            // Checked against the whole model (validate/sensitivity.rs).
+            sensitivity: Vec::new(),
         })
     }
 }

@@ -1,5 +1,5 @@
-//! Grid keys: dotted paths into a model TOML, and the lookups the study
-//! file and the sweep share.
+//! Key paths: dotted paths into a model TOML, as study grids and
+//! `[output] sensitivity` name model values, and their lookups.
 //!
 //! A key is a dotted path into the model TOML. A segment names a table key;
 //! `name[i]` takes entry `i` (from 0) of the array `name`; a segment after an
@@ -8,7 +8,6 @@
 //! (`joint."arm.pin".pitch`).
 
 use std::fmt;
-use std::path::Path;
 
 use toml::{Table, Value};
 
@@ -231,12 +230,4 @@ pub fn lookup_mut<'a>(root: &'a mut Table, path: &KeyPath) -> Result<&'a mut Val
 pub fn check_key(model: &Table, path: &KeyPath) -> Result<(), String> {
     let mut copy = model.clone();
     lookup_mut(&mut copy, path).map(|_| ())
-}
-
-/// The directory of a study file, for resolving the model path.
-pub(crate) fn base_dir(study: &Path) -> &Path {
-    study
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."))
 }

@@ -1,0 +1,229 @@
+//! `[output] sensitivity`: key paths into the model naming the values the
+//! run differentiates its results by, checked against the whole model.
+
+use toml::{Table, Value};
+
+use super::{Ctx, Res};
+use crate::key_path::{lookup_mut, KeyPath, Segment};
+use crate::raw::{RawOutput, S};
+use crate::types::{Analysis, IntegratorKind, Model, SensitivityKey};
+
+/// What the keys may name today, for the messages.
+const AVAILABLE: &str = "section stiffnesses (`section.<name>.EA`, `GA[0]`, `GA[1]`, `GJ`, \
+                         `EI[0]`, `EI[1]`) and dead load components (`load[i].force[c]`, \
+                         `load[i].moment[c]`, `distributed_load[i].force[c]`, \
+                         `distributed_load[i].moment[c]`)";
+
+/// The stiffness of a `[[section]]` field (its words after the section):
+/// the component 0–5 of EA, GA₂, GA₃, GJ, EI₂, EI₃.
+fn stiffness(field: &str) -> Option<usize> {
+    ["EA", "GA[0]", "GA[1]", "GJ", "EI[0]", "EI[1]"]
+        .iter()
+        .position(|f| *f == field)
+}
+
+/// The component 0–5 of a load's `force[c]` or `moment[c]`.
+fn load_component(field: &str) -> Option<usize> {
+    [
+        "force[0]",
+        "force[1]",
+        "force[2]",
+        "moment[0]",
+        "moment[1]",
+        "moment[2]",
+    ]
+    .iter()
+    .position(|f| *f == field)
+}
+
+/// What kind of value `v` is, when it is no real number.
+fn not_real(v: &Value) -> Option<&'static str> {
+    match v {
+        Value::String(_) => Some("a string"),
+        Value::Boolean(_) => Some("a boolean"),
+        Value::Integer(_) => Some("an integer"),
+        Value::Datetime(_) => Some("a date"),
+        Value::Array(_) => Some("a list (name one component, e.g. `[0]`)"),
+        Value::Table(_) => Some("a table (name one of its values)"),
+        Value::Float(_) => None,
+    }
+}
+
+/// Adds the key paths `keys` that `model`'s `[output] sensitivity` does not
+/// hold yet, checked as in a model file (errors name the model's path and
+/// the key, without a line: the text is the model's as written back).
+pub(crate) fn add_sensitivity(model: &mut Model, keys: &[String]) -> Res<()> {
+    let text = model.to_toml();
+    let registry = crate::registry::JointRegistry::builtin();
+    let cx = Ctx {
+        file: &model.path,
+        text: &text,
+        registry: &registry,
+        dynamic: !matches!(model.solver.analysis, Analysis::Static { .. }),
+    };
+    let mut table: Table = toml::from_str(&text).unwrap_or_default();
+    let mut added = Vec::new();
+    for key in keys {
+        if model.output.sensitivity.iter().any(|(k, _)| k == key) {
+            continue;
+        }
+        let at = format!("output.sensitivity (\"{key}\")");
+        let resolved = cx.sensitivity_key(key, &mut table, model);
+        added.push((key.clone(), resolved.map_err(|m| cx.err(&at, None, m))?));
+    }
+    if !added.is_empty() {
+        analysis_allows_sensitivity(model).map_err(|m| cx.err("output.sensitivity", None, m))?;
+    }
+    model.output.sensitivity.extend(added);
+    Ok(())
+}
+
+impl Ctx<'_> {
+    /// The validated `[output] sensitivity` of `model` (its other parts
+    /// validated).
+    pub(super) fn sensitivity(
+        &self,
+        raw: Option<&S<RawOutput>>,
+        model: &Model,
+    ) -> Res<Vec<(String, SensitivityKey)>> {
+        let Some(list) = raw.and_then(|o| o.get_ref().sensitivity.as_ref()) else {
+            return Ok(Vec::new());
+        };
+        let mut table: Table = toml::from_str(self.text).unwrap_or_default();
+        let mut keys: Vec<(String, SensitivityKey)> = Vec::new();
+        for (i, item) in list.get_ref().iter().enumerate() {
+            let at = format!("output.sensitivity[{i}]");
+            let text = item.get_ref();
+            if keys.iter().any(|(k, _)| k == text) {
+                return Err(self.at(at, item, format!("\"{text}\" is listed twice")));
+            }
+            let key = self.sensitivity_key(text, &mut table, model);
+            keys.push((text.clone(), key.map_err(|m| self.at(&at, item, m))?));
+        }
+        if !keys.is_empty() {
+            self.sensitivity_analysis(list, model)?;
+        }
+        Ok(keys)
+    }
+
+    /// The model value `text` names, or why it names none that can be
+    /// differentiated by.
+    fn sensitivity_key(
+        &self,
+        text: &str,
+        table: &mut Table,
+        model: &Model,
+    ) -> Result<SensitivityKey, String> {
+        let path = KeyPath::parse(text).map_err(|why| format!("\"{text}\" {why}"))?;
+        let value = lookup_mut(table, &path).map_err(|why| format!("\"{text}\": {why}"))?;
+        // The table and entry (`section.rod`, `load[0]`), then the field.
+        let (table_name, entry, field) = match path.segments.as_slice() {
+            [Segment::Key(t), entry, rest @ ..] if !rest.is_empty() => {
+                let field = KeyPath {
+                    segments: rest.to_vec(),
+                };
+                (t.as_str(), Some(entry), field.to_string())
+            }
+            _ => ("", None, String::new()),
+        };
+        let index = |count: usize| match entry {
+            Some(Segment::Index(i)) if *i < count => Some(*i),
+            _ => None,
+        };
+        let found = match table_name {
+            "section" => {
+                let section = match entry {
+                    Some(Segment::Key(name)) => model.sections.iter().position(|s| &s.name == name),
+                    _ => index(model.sections.len()),
+                };
+                section
+                    .zip(stiffness(&field))
+                    .map(|(section, component)| SensitivityKey::Section { section, component })
+            }
+            "load" => index(model.loads.len())
+                .zip(load_component(&field))
+                .map(|(load, component)| SensitivityKey::Load { load, component }),
+            "distributed_load" => index(model.distributed_loads.len())
+                .zip(load_component(&field))
+                .map(|(load, component)| SensitivityKey::DistributedLoad { load, component }),
+            _ => None,
+        };
+        if let Some(key) = found {
+            return self.dead(key, model, text);
+        }
+        let why = if matches!(text, "solver.dt" | "solver.t_end") {
+            "the step size and the end time are no parameters of the solution".to_string()
+        } else if let Some(kind) = not_real(value) {
+            format!("it is {kind}, not a real number")
+        } else {
+            "sensitivities to it are not available yet".to_string()
+        };
+        Err(format!(
+            "cannot differentiate by \"{text}\": {why}; available: {AVAILABLE}"
+        ))
+    }
+
+    /// `key`, if it is not a component of a follower load.
+    fn dead(
+        &self,
+        key: SensitivityKey,
+        model: &Model,
+        text: &str,
+    ) -> Result<SensitivityKey, String> {
+        let follower = match key {
+            SensitivityKey::Load { load, .. } => model.loads[load].follower,
+            SensitivityKey::DistributedLoad { load, .. } => model.distributed_loads[load].follower,
+            SensitivityKey::Section { .. } => false,
+        };
+        if follower {
+            Err(format!(
+                "cannot differentiate by \"{text}\": a follower load's components are not \
+                 available yet; available: {AVAILABLE}"
+            ))
+        } else {
+            Ok(key)
+        }
+    }
+
+    /// Refuses the analyses and loads sensitivities are not computed for.
+    fn sensitivity_analysis(&self, list: &S<Vec<S<String>>>, model: &Model) -> Res<()> {
+        analysis_allows_sensitivity(model).map_err(|m| self.at("output.sensitivity", list, m))
+    }
+}
+
+/// Why `model` is no model sensitivities are computed for, if it is not.
+pub(crate) fn analysis_allows_sensitivity(model: &Model) -> Result<(), &'static str> {
+    match model.solver.analysis {
+        Analysis::Static { .. } => {}
+        Analysis::Dynamic {
+            integrator: IntegratorKind::Newmark | IntegratorKind::GeneralizedAlpha { .. },
+            ..
+        } => {
+            if model.sections.iter().any(|s| s.damping > 0.0) {
+                return Err(
+                    "sensitivities of a run with structural damping (`damping` in a \
+                     [[section]]) are not available yet; remove `sensitivity` from [output], \
+                     or the damping",
+                );
+            }
+        }
+        _ => {
+            return Err(
+                "sensitivities are computed for load-controlled statics (`analysis = \
+                 \"static\"`) and for dynamics with integrator \"newmark\" or \
+                 \"generalized-alpha\" so far, not for arc-length runs or the conserving \
+                 schemes; remove `sensitivity` from [output], or change the analysis",
+            )
+        }
+    }
+    let follower = model.loads.iter().any(|l| l.follower)
+        || model.distributed_loads.iter().any(|l| l.follower);
+    if follower {
+        return Err(
+            "sensitivities of a model with follower loads are not available yet (their \
+             work makes the total energy path-dependent); remove `sensitivity` from \
+             [output], or make the loads dead (`follower = false`)",
+        );
+    }
+    Ok(())
+}
