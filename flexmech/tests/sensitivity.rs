@@ -412,3 +412,144 @@ fn a_study_figure_with_derivatives_agrees_with_its_own_neighbouring_runs() {
         "no tangent legend"
     );
 }
+
+/// Dynamics: central differences err by O(h²) of the derivative's own
+/// variation and by the Newton tolerance over h; the bound.
+const AGREE_DYNAMICS: f64 = 1e-4;
+
+/// `file` shortened to `t_end`, Newton to 1e-12, run with `integrator`
+/// (model-file text), asking for the derivatives by `keys`.
+fn dynamic_model(file: &str, t_end: f64, integrator: &str, keys: &[&str]) -> Model {
+    let text = std::fs::read_to_string(data(file)).unwrap();
+    let mut table: toml::Table = toml::from_str(&text).unwrap();
+    let solver = table["solver"].as_table_mut().unwrap();
+    solver.insert("t_end".into(), toml::Value::Float(t_end));
+    solver.insert("tolerance".into(), toml::Value::Float(NEWTON));
+    solver.insert("integrator".into(), toml::Value::String(integrator.into()));
+    if integrator != "generalized-alpha" {
+        solver.remove("rho_inf");
+    }
+    solver.insert("max_halvings".into(), toml::Value::Integer(0));
+    let mut model = parse_model(&toml::to_string(&table).unwrap(), &data(file)).unwrap();
+    let keys: Vec<String> = keys.iter().map(|k| k.to_string()).collect();
+    model.add_sensitivity(&keys).unwrap();
+    model
+}
+
+/// Every kept step's exact derivatives of the tracked nodes and the total
+/// energy against central differences of two perturbed runs: the largest
+/// difference over the largest derivative, per key.
+fn dynamic_mismatch(model: &Model) -> Vec<(String, f64, f64)> {
+    let built = build(model).unwrap();
+    let tracked: Vec<usize> = (model.output.track.iter())
+        .map(|(_, r)| built.node(*r))
+        .collect();
+    let mut memory = Memory::default();
+    run(model, &mut memory).unwrap();
+    assert_eq!(memory.status(), "completed");
+    let mut quiet = model.clone();
+    quiet.output.sensitivity.clear();
+    let mut out = Vec::new();
+    for (k, (key, _)) in model.output.sensitivity.iter().enumerate() {
+        let (plus, v) = perturbed_model(&quiet, key, STEP);
+        let (minus, _) = perturbed_model(&quiet, key, -STEP);
+        let records = |m: &Model| {
+            let mut memory = Memory::default();
+            run(m, &mut memory).unwrap();
+            memory.records
+        };
+        let (plus, minus) = (records(&plus), records(&minus));
+        assert_eq!(plus.len(), memory.records.len(), "{key}: the same steps");
+        let dp = 2.0 * STEP * v;
+        let (mut exact, mut fd) = (Vec::new(), Vec::new());
+        let (mut e_exact, mut e_fd) = (Vec::new(), Vec::new());
+        for ((rec, p), m) in memory.records.iter().zip(&plus).zip(&minus) {
+            for &n in &tracked {
+                exact.push(rec.sensitivities[k].displacement[n]);
+                fd.push([0, 1, 2].map(|c| (p.positions[n][c] - m.positions[n][c]) / dp));
+            }
+            e_exact.push([rec.sensitivities[k].energy, 0.0, 0.0]);
+            e_fd.push([(p.energy.total - m.energy.total) / dp, 0.0, 0.0]);
+        }
+        out.push((
+            key.clone(),
+            mismatch(&exact, &fd),
+            mismatch(&e_exact, &e_fd),
+        ));
+    }
+    out
+}
+
+#[test]
+fn dynamic_sensitivities_of_the_spin_up_equal_central_differences() {
+    // The spin-up's first 2 s (the root driven from rest): d(tip)/d(EI₃),
+    // the in-plane bending stiffness, for both Newmark-family integrators.
+    // (EA moves the tip by ~1e-15 per unit, 1e-11 over the differences'
+    // step: at the runs' round-off, no test of anything.)
+    for integrator in ["newmark", "generalized-alpha"] {
+        let keys = ["section.blade.EI[1]"];
+        let model = dynamic_model("benchmarks/spin_up.toml", 2.0, integrator, &keys);
+        for (key, displacement, energy) in dynamic_mismatch(&model) {
+            assert!(
+                displacement < AGREE_DYNAMICS,
+                "{integrator} {key}: {displacement:e}"
+            );
+            assert!(
+                energy < AGREE_DYNAMICS,
+                "{integrator} {key}: energy {energy:e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn dynamic_sensitivities_of_the_four_bar_equal_central_differences() {
+    // The four-bar's first 1.5 s through its revolutes and the drive:
+    // d(out-of-plane displacement)/d(section stiffness).
+    for integrator in ["newmark", "generalized-alpha"] {
+        let keys = ["section.bar8.EI[0]", "section.bar16.GJ"];
+        let model = dynamic_model("benchmarks/four_bar.toml", 1.5, integrator, &keys);
+        for (key, displacement, energy) in dynamic_mismatch(&model) {
+            assert!(
+                displacement < AGREE_DYNAMICS,
+                "{integrator} {key}: {displacement:e}"
+            );
+            assert!(
+                energy < AGREE_DYNAMICS,
+                "{integrator} {key}: energy {energy:e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn dynamic_sensitivities_by_loads_through_a_joint_equal_central_differences() {
+    // The L-frame of the static tests given mass and released at once under
+    // its loads: its arm swings through the rigid corner joint; derivatives
+    // by the tip force, the distributed load and the arm's torsion.
+    let text = std::fs::read_to_string(data("statics/sensitivity_frame.toml")).unwrap();
+    let mass = "\nrhoA = 2.0\nrhoJ = [0.02, 0.01, 0.01]";
+    let text = (text.replace(
+        "EI = [1000.0, 1000.0]",
+        &format!("EI = [1000.0, 1000.0]{mass}"),
+    ))
+    .replace("EI = [400.0, 600.0]", &format!("EI = [400.0, 600.0]{mass}"))
+    .replace(
+        "analysis = \"static\"\nload_steps = 5",
+        "analysis = \"dynamic\"\nintegrator = \"newmark\"\ndt = 0.005\nt_end = 0.3",
+    );
+    for integrator in ["newmark", "generalized-alpha"] {
+        let text = text.replace("\"newmark\"", &format!("\"{integrator}\""));
+        let model = parse_model(&text, &data("statics/sensitivity_frame.toml")).unwrap();
+        for (key, displacement, energy) in dynamic_mismatch(&model) {
+            assert!(
+                displacement < AGREE_DYNAMICS,
+                "{integrator} {key}: {displacement:e}"
+            );
+            assert!(
+                energy < AGREE_DYNAMICS,
+                "{integrator} {key}: energy {energy:e}"
+            );
+        }
+    }
+}
