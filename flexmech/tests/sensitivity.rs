@@ -93,7 +93,6 @@ fn perturbed(mech: &Mechanism, p: &Parameter, h: f64) -> Mechanism {
                 }
             }
         }
-        Parameter::Loads { .. } => panic!("not used in these tests"),
         Parameter::Load { load, component } => {
             let l = &mut m.loads[*load];
             match component {
@@ -101,6 +100,7 @@ fn perturbed(mech: &Mechanism, p: &Parameter, h: f64) -> Mechanism {
                 _ => l.moment[component - 3] *= 1.0 + h,
             }
         }
+        _ => panic!("not used in these tests"),
     }
     m
 }
@@ -119,7 +119,6 @@ fn value(mech: &Mechanism, p: &Parameter) -> f64 {
                 s.c_m[component - 3]
             }
         }
-        Parameter::Loads { .. } => panic!("not used in these tests"),
         Parameter::Load { load, component } => {
             let l = &mech.loads[*load];
             if *component < 3 {
@@ -128,6 +127,7 @@ fn value(mech: &Mechanism, p: &Parameter) -> f64 {
                 l.moment[component - 3]
             }
         }
+        _ => panic!("not used in these tests"),
     }
 }
 
@@ -480,6 +480,21 @@ fn dynamic_mismatch(model: &Model) -> Vec<(String, f64, f64)> {
     out
 }
 
+/// [`dynamic_mismatch`] of `model` (run with `integrator`) within the
+/// dynamics' bound, displacements and energy.
+fn assert_dynamic_agrees(model: &Model, integrator: &str) {
+    for (key, displacement, energy) in dynamic_mismatch(model) {
+        assert!(
+            displacement < AGREE_DYNAMICS,
+            "{integrator} {key}: {displacement:e}"
+        );
+        assert!(
+            energy < AGREE_DYNAMICS,
+            "{integrator} {key}: energy {energy:e}"
+        );
+    }
+}
+
 #[test]
 fn dynamic_sensitivities_of_the_spin_up_equal_central_differences() {
     // The spin-up's first 2 s (the root driven from rest): d(tip)/d(EI₃),
@@ -489,16 +504,7 @@ fn dynamic_sensitivities_of_the_spin_up_equal_central_differences() {
     for integrator in ["newmark", "generalized-alpha"] {
         let keys = ["section.blade.EI[1]"];
         let model = dynamic_model("benchmarks/spin_up.toml", 2.0, integrator, &keys);
-        for (key, displacement, energy) in dynamic_mismatch(&model) {
-            assert!(
-                displacement < AGREE_DYNAMICS,
-                "{integrator} {key}: {displacement:e}"
-            );
-            assert!(
-                energy < AGREE_DYNAMICS,
-                "{integrator} {key}: energy {energy:e}"
-            );
-        }
+        assert_dynamic_agrees(&model, integrator);
     }
 }
 
@@ -509,25 +515,23 @@ fn dynamic_sensitivities_of_the_four_bar_equal_central_differences() {
     for integrator in ["newmark", "generalized-alpha"] {
         let keys = ["section.bar8.EI[0]", "section.bar16.GJ"];
         let model = dynamic_model("benchmarks/four_bar.toml", 1.5, integrator, &keys);
-        for (key, displacement, energy) in dynamic_mismatch(&model) {
-            assert!(
-                displacement < AGREE_DYNAMICS,
-                "{integrator} {key}: {displacement:e}"
-            );
-            assert!(
-                energy < AGREE_DYNAMICS,
-                "{integrator} {key}: energy {energy:e}"
-            );
-        }
+        assert_dynamic_agrees(&model, integrator);
     }
 }
 
 #[test]
 fn dynamic_sensitivities_by_loads_through_a_joint_equal_central_differences() {
-    // The L-frame of the static tests given mass and released at once under
-    // its loads: its arm swings through the rigid corner joint; derivatives
-    // by the tip force, the distributed load and the arm's torsion.
+    // The L-frame of the static tests given mass and gravity and released
+    // at once under its loads: its arm swings through the rigid corner
+    // joint; derivatives by the tip force, the distributed load, the
+    // sections' stiffnesses, the arm's mass (inertia and weight) and the
+    // post's rotational inertia.
     let text = std::fs::read_to_string(data("statics/sensitivity_frame.toml")).unwrap();
+    let text = text.replacen(
+        "\n[[section]]",
+        "\ngravity = [0.0, 0.0, -9.81]\n\n[[section]]",
+        1,
+    );
     let mass = "\nrhoA = 2.0\nrhoJ = [0.02, 0.01, 0.01]";
     let text = (text.replace(
         "EI = [1000.0, 1000.0]",
@@ -540,16 +544,75 @@ fn dynamic_sensitivities_by_loads_through_a_joint_equal_central_differences() {
     );
     for integrator in ["newmark", "generalized-alpha"] {
         let text = text.replace("\"newmark\"", &format!("\"{integrator}\""));
-        let model = parse_model(&text, &data("statics/sensitivity_frame.toml")).unwrap();
-        for (key, displacement, energy) in dynamic_mismatch(&model) {
-            assert!(
-                displacement < AGREE_DYNAMICS,
-                "{integrator} {key}: {displacement:e}"
-            );
-            assert!(
-                energy < AGREE_DYNAMICS,
-                "{integrator} {key}: energy {energy:e}"
-            );
+        let mut model = parse_model(&text, &data("statics/sensitivity_frame.toml")).unwrap();
+        let masses = [
+            "section.arm.rhoA".to_string(),
+            "section.post.rhoJ[1]".to_string(),
+        ];
+        model.add_sensitivity(&masses).unwrap();
+        assert_dynamic_agrees(&model, integrator);
+    }
+}
+
+#[test]
+fn arc_length_sensitivities_at_the_final_load_factor_equal_central_differences() {
+    // Derivatives at fixed load factor: the path's steps sit at other λ in
+    // a perturbed run, its last at λ = 1 in every run. The frame, and the
+    // truss past its snap (the apex through its revolute).
+    let frame = std::fs::read_to_string(data("statics/sensitivity_frame.toml")).unwrap();
+    let frame = frame.replace(
+        "analysis = \"static\"\n",
+        "analysis = \"static\"\ncontrol = \"arc-length\"\n",
+    );
+    let frame = parse_model(&frame, &data("statics/sensitivity_frame.toml")).unwrap();
+    let mut truss = load_model(&data("statics/snap_through_truss.toml")).unwrap();
+    truss
+        .add_sensitivity(&["section.bar.EA".into(), "load[0].force[1]".into()])
+        .unwrap();
+    truss.solver.tolerance = NEWTON;
+    for model in [frame, truss] {
+        let file = tempfile::tempdir().unwrap();
+        let file = flexmech::results::run_model_to(&model, &file.path().join("r.h5")).unwrap();
+        let result = crate::common::reader(&file.file);
+        assert_eq!(*result.time().unwrap().last().unwrap(), 1.0);
+        let mut quiet = model.clone();
+        quiet.output.sensitivity.clear();
+        for (key, _) in &model.output.sensitivity {
+            let (plus, v) = perturbed_model(&quiet, key, STEP);
+            let (minus, _) = perturbed_model(&quiet, key, -STEP);
+            let (plus, minus) = (last_step(&plus), last_step(&minus));
+            assert_eq!((plus.time, minus.time), (1.0, 1.0));
+            let dp = 2.0 * STEP * v;
+            for (label, r) in &model.output.track {
+                let node = build(&model).unwrap().node(*r);
+                let name = format!("/sensitivity/{key}/nodes/{label}/displacement");
+                let exact = *result.rows3(&name).unwrap().last().unwrap();
+                let fd =
+                    [0, 1, 2].map(|c| (plus.positions[node][c] - minus.positions[node][c]) / dp);
+                let e = mismatch(&[exact], &[fd]);
+                assert!(
+                    e < AGREE,
+                    "{}: {name}: {exact:?} vs {fd:?} ({e:e})",
+                    model.name
+                );
+            }
         }
+    }
+}
+
+#[test]
+fn dynamic_sensitivities_by_initial_velocities_through_every_joint_kind() {
+    // The free chain: ten links joined by every joint kind, thrown with a
+    // rigid velocity field per link. Derivatives by the first link's spin,
+    // a middle link's velocity (its slave's follows through N) and the
+    // links' bending stiffness.
+    for integrator in ["newmark", "generalized-alpha"] {
+        let keys = [
+            "initial_velocity[0].angular[2]",
+            "initial_velocity[4].linear[1]",
+            "section.link.EI[0]",
+        ];
+        let model = dynamic_model("dynamics/free_chain.toml", 0.3, integrator, &keys);
+        assert_dynamic_agrees(&model, integrator);
     }
 }

@@ -29,6 +29,7 @@ use crate::mechanism::Mechanism;
 use crate::newton::{NewtonReport, NewtonSettings, NewtonSystem};
 use crate::record::StepRecord;
 use crate::rotation_guard::RotationGuard;
+use crate::sensitivity::{Parameter, StaticSensitivities};
 use crate::statics::{
     begin_step, converged_record, static_system, step_rejected, StaticOutcome, StaticTerms,
 };
@@ -67,10 +68,26 @@ const BIFURCATION_COSINE: f64 = 0.1;
 pub fn solve_arc_length(
     mech: &Mechanism,
     settings: &ArcLengthSettings,
+    on_step: impl FnMut(&StepRecord),
+) -> Result<StaticOutcome, SolveError> {
+    solve_arc_length_with(mech, settings, &[], on_step)
+}
+
+/// [`solve_arc_length`] with the exact sensitivities of every converged
+/// step to `params` in its record, taken at the step's load factor
+/// (`K dq/dp = −∂r/∂p` at fixed λ, as in
+/// [`crate::statics::solve_static_with`]; the path's load factor is a result
+/// of the arc constraint, the derivatives are those of the equilibrium at
+/// that λ).
+pub fn solve_arc_length_with(
+    mech: &Mechanism,
+    settings: &ArcLengthSettings,
+    params: &[Parameter],
     mut on_step: impl FnMut(&StepRecord),
 ) -> Result<StaticOutcome, SolveError> {
     refuse_unless_proportional(mech, settings)?;
     let (mut sys, mut lu, mut inertia) = static_system(mech)?;
+    let mut sensitivities = StaticSensitivities::new(&sys, params)?;
     let n = sys.topo.dofs.n_eq;
     let nodes = mech.mesh.node_count();
     let mut f_ref = vec![0.0; 6 * nodes];
@@ -135,6 +152,8 @@ pub fn solve_arc_length(
                     &report,
                     None,
                 );
+                let mut step = step;
+                step.sensitivities = sensitivities.at(&sys, lambda)?;
                 on_step(&step);
                 let grew = branch.count(step.negative_pivots);
                 if settings.branch_switch && grew && !branch.switched && !leaving && lambda < 1.0 {

@@ -37,7 +37,7 @@ use nalgebra::Vector3;
 
 use crate::error::SolveError;
 use crate::linsolve::SparseLu;
-use crate::mechanism::Mechanism;
+use crate::mechanism::{nodal_weights, Mechanism};
 use crate::record::Sensitivity;
 use crate::system::{ReducedSystem, StepTerms};
 use flexmech_core::{Configuration, Element, Section};
@@ -71,6 +71,22 @@ pub enum Parameter {
         /// Which component, 0–5.
         component: usize,
     },
+    /// The mass per unit length (`component` 0: ρA) or one rotational
+    /// inertia per unit length (1–3: ρ(I₂+I₃), ρI₂, ρI₃) of the sections of
+    /// the elements `elements`: the inertial forces and (ρA) gravity.
+    Mass {
+        /// The elements whose section carries it.
+        elements: Vec<usize>,
+        /// Which value, 0–3.
+        component: usize,
+    },
+    /// A value of the initial motion (dynamics): `motion` is the
+    /// derivative of the initial nodal velocities (and joint rates) by it;
+    /// the slaves' follow through `N`.
+    InitialMotion {
+        /// `d(initial motion)/dp`.
+        motion: crate::dynamics::Motion,
+    },
 }
 
 impl Parameter {
@@ -88,6 +104,14 @@ impl Parameter {
                         .iter()
                         .all(|&(l, w)| l < mech.loads.len() && w.is_finite())
             }
+            Parameter::InitialMotion { motion } => {
+                let n = mech.mesh.node_count();
+                motion.v.len() == n && motion.w.len() == n
+            }
+            Parameter::Mass {
+                elements,
+                component,
+            } => *component < 4 && elements.iter().all(|&e| e < mech.mesh.elements.len()),
         };
         if ok {
             Ok(())
@@ -103,7 +127,9 @@ impl Parameter {
     /// a stiffness).
     fn load_shares(&self) -> (Vec<(usize, f64)>, usize) {
         match self {
-            Parameter::Stiffness { .. } => (Vec::new(), 0),
+            Parameter::Stiffness { .. }
+            | Parameter::InitialMotion { .. }
+            | Parameter::Mass { .. } => (Vec::new(), 0),
             Parameter::Load { load, component } => (vec![(*load, 1.0)], *component),
             Parameter::Loads { shares, component } => (shares.clone(), *component),
         }
@@ -140,6 +166,13 @@ impl Parameter {
             }
             return energy;
         }
+        if let Parameter::Mass {
+            elements,
+            component,
+        } = self
+        {
+            return unit_gravity(mech, elements, *component, config, lambda, out);
+        }
         let (shares, component) = self.load_shares();
         let mut energy = 0.0;
         for (load, w) in shares {
@@ -153,6 +186,62 @@ impl Parameter {
         }
         energy
     }
+}
+
+/// `∂g/∂p = −∂f_ext/∂p` of a mass parameter: the gravity forces of the
+/// elements `elements` with unit ρA (nothing for a rotational inertia),
+/// into `out`; returns `∂E/∂p`, their potential `−Σ ∂f·u`.
+fn unit_gravity(
+    mech: &Mechanism,
+    elements: &[usize],
+    component: usize,
+    config: &Configuration,
+    t: f64,
+    out: &mut [f64],
+) -> f64 {
+    if component != 0 || mech.gravity == Vector3::zeros() {
+        return 0.0;
+    }
+    let g = mech.gravity * mech.gravity_scale.at(t);
+    let mut energy = 0.0;
+    for &e in elements {
+        let element = &mech.mesh.elements[e];
+        let nodes = element.nodes();
+        for (&n, w) in nodes.iter().zip(nodal_weights(nodes.len())) {
+            let f = g * (w * element.length());
+            let u = config.x[n] - mech.mesh.positions[n];
+            for c in 0..3 {
+                out[6 * n + c] -= f[c];
+            }
+            energy -= f.dot(&u);
+        }
+    }
+    energy
+}
+
+/// The inertia of the elements `elements` with a unit mass parameter
+/// `component` (0: ρA, 1–3: ρJ) and every other element massless:
+/// `∂M/∂p` and `∂J/∂p` of [`Parameter::Mass`].
+pub(crate) fn unit_inertia(
+    mech: &Mechanism,
+    elements: &[usize],
+    component: usize,
+    kind: flexmech_core::MassKind,
+) -> flexmech_core::Inertia {
+    let mut mesh = mech.mesh.clone();
+    for (k, e) in mesh.elements.iter_mut().enumerate() {
+        let unit = elements.contains(&k);
+        let section = match e {
+            Element::Linear(e) => &mut e.section,
+            Element::Quadratic(e) => &mut e.section,
+        };
+        section.rho_a = if unit && component == 0 { 1.0 } else { 0.0 };
+        section.rho_j = Vector3::zeros();
+        if unit && component > 0 {
+            section.rho_j[component - 1] = 1.0;
+        }
+    }
+    flexmech_core::Inertia::new(&mesh, kind)
 }
 
 /// `element` with a section whose stiffness `component` is 1 and every
@@ -189,6 +278,11 @@ impl StaticSensitivities {
     ) -> Result<Self, SolveError> {
         for p in params {
             p.check(sys.mech)?;
+            if let Parameter::InitialMotion { .. } = p {
+                return Err(SolveError::InvalidMechanism(
+                    "a static analysis has no initial motion to differentiate by".into(),
+                ));
+            }
         }
         let lu = SparseLu::new(sys.asm.pattern().clone()).map_err(SolveError::Singular)?;
         Ok(Self {

@@ -43,6 +43,32 @@ impl Built {
         self.beam_nodes[r.beam][r.node]
     }
 
+    /// `d(initial motion)/dp` for component `component` (0–2 `linear`, 3–5
+    /// `angular`) of `[[initial_velocity]]` `field`: on the nodes whose
+    /// velocity it sets (no later field overrides it there), `e_c` or
+    /// `(e_c × (x₀ − origin), e_c)`.
+    fn initial_motion_derivative(&self, model: &Model, field: usize, component: usize) -> Motion {
+        let x0 = &self.mechanism.mesh.positions;
+        let mut motion = Motion::rest(x0.len());
+        let spec = &model.initial_velocities[field];
+        let later = &model.initial_velocities[field + 1..];
+        let e = Vector3::ith(component % 3, 1.0);
+        for r in &spec.nodes {
+            if later.iter().any(|f| f.nodes.contains(r)) {
+                continue;
+            }
+            let n = self.node(*r);
+            if component < 3 {
+                motion.v[n] = e;
+            } else {
+                motion.v[n] = e.cross(&(x0[n] - v(spec.origin)));
+                motion.w[n] = e;
+            }
+        }
+        motion.joint_rates = vec![0.0; model.joints.len()];
+        motion
+    }
+
     /// The mechanism's parameter of every `[output] sensitivity` key of
     /// `model` (the model this was built from), in order: a section's
     /// stiffness on the elements of every beam of that section; a load's
@@ -50,13 +76,22 @@ impl Built {
     pub fn sensitivity_parameters(&self, model: &Model) -> Vec<Parameter> {
         let loads = model.loads.len();
         let param = |key: &SensitivityKey| match *key {
-            SensitivityKey::Section { section, component } => Parameter::Stiffness {
-                elements: (model.beams.iter().zip(&self.beam_elements))
+            SensitivityKey::Section { section, component } => {
+                let elements = (model.beams.iter().zip(&self.beam_elements))
                     .filter(|(b, _)| b.section == section)
                     .flat_map(|(_, e)| e.clone())
-                    .collect(),
-                component,
-            },
+                    .collect();
+                match component {
+                    0..=5 => Parameter::Stiffness {
+                        elements,
+                        component,
+                    },
+                    _ => Parameter::Mass {
+                        elements,
+                        component: component - 6,
+                    },
+                }
+            }
             SensitivityKey::Load { load, component } => Parameter::Loads {
                 shares: self.load_shares[load].clone(),
                 component,
@@ -64,6 +99,9 @@ impl Built {
             SensitivityKey::DistributedLoad { load, component } => Parameter::Loads {
                 shares: self.load_shares[loads + load].clone(),
                 component,
+            },
+            SensitivityKey::InitialVelocity { field, component } => Parameter::InitialMotion {
+                motion: self.initial_motion_derivative(model, field, component),
             },
         };
         model

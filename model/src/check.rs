@@ -296,7 +296,7 @@ impl Checker<'_> {
         for (i, (text, key)) in m.output.sensitivity.iter().enumerate() {
             let ok = match *key {
                 SensitivityKey::Section { section, component } => {
-                    section < m.sections.len() && component < 6
+                    section < m.sections.len() && component < 10
                 }
                 SensitivityKey::Load { load, component } => {
                     m.loads.get(load).is_some_and(|l| !l.follower) && component < 6
@@ -304,13 +304,16 @@ impl Checker<'_> {
                 SensitivityKey::DistributedLoad { load, component } => {
                     m.distributed_loads.get(load).is_some_and(|l| !l.follower) && component < 6
                 }
+                SensitivityKey::InitialVelocity { field, component } => {
+                    field < m.initial_velocities.len() && component < 6
+                }
             };
             if !ok {
                 return Err(self.fail(
                     format!("output.sensitivity[{i}]"),
                     format!(
-                        "\"{text}\" names no section stiffness or dead load component of the \
-                         model ({key:?})"
+                        "\"{text}\" names no section stiffness, dead load component or initial \
+                         velocity of the model ({key:?})"
                     ),
                 ));
             }

@@ -331,8 +331,9 @@ pub struct OutputSpec {
 /// sensitivity`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SensitivityKey {
-    /// Stiffness `component` of section `section` (index into
-    /// [`Model::sections`]): 0–5 are EA, GA₂, GA₃, GJ, EI₂, EI₃.
+    /// Value `component` of section `section` (index into
+    /// [`Model::sections`]): 0–5 are EA, GA₂, GA₃, GJ, EI₂, EI₃, 6 is ρA and
+    /// 7–9 are ρJ (`rhoJ[0..2]`).
     Section {
         /// The section.
         section: usize,
@@ -351,6 +352,14 @@ pub enum SensitivityKey {
     DistributedLoad {
         /// Index into [`Model::distributed_loads`].
         load: usize,
+        /// Which component, 0–5.
+        component: usize,
+    },
+    /// Component `component` (0–2 `linear`, 3–5 `angular`) of
+    /// `[[initial_velocity]]` `field` (dynamics).
+    InitialVelocity {
+        /// Index into [`Model::initial_velocities`].
+        field: usize,
         /// Which component, 0–5.
         component: usize,
     },

@@ -8,7 +8,7 @@ use crate::sink::{FileSink, OutputDirError, RunEnd, Sink, SinkError};
 use crate::{
     layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultantsMeta, RunMeta,
 };
-use flexmech_integrators::arc_length::{solve_arc_length, ArcLengthSettings};
+use flexmech_integrators::arc_length::{solve_arc_length_with, ArcLengthSettings};
 use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
 use flexmech_integrators::{
     solve_static_with, Mechanism, NewtonSettings, SolveError, StaticSettings, StepRecord,
@@ -496,7 +496,8 @@ fn solve(
                 max_steps,
                 branch_switch,
             };
-            let outcome = solve_arc_length(mech, &settings, |s| {
+            let params = built.sensitivity_parameters(model);
+            let outcome = solve_arc_length_with(mech, &settings, &params, |s| {
                 keeper.push(s);
             });
             (outcome.map(|_| ()), 0.0)

@@ -28,13 +28,14 @@ use nalgebra::{Matrix3, Vector3};
 use num_dual::Dual64;
 
 use super::newmark_terms::{initial_accelerations, Coefficients, NewmarkTerms};
+use super::slave_velocities;
 use crate::error::SolveError;
 use crate::linsolve::SparseLu;
 use crate::record::Sensitivity;
-use crate::sensitivity::Parameter;
+use crate::sensitivity::{unit_inertia, Parameter};
 use crate::system::ReducedSystem;
 use flexmech_core::rotation::{log, skew};
-use flexmech_core::Configuration;
+use flexmech_core::{Configuration, Inertia, MassKind};
 
 /// The derivatives of every node's Newmark history by one parameter.
 #[derive(Debug, Clone)]
@@ -107,6 +108,10 @@ fn angular_update<T: flexmech_core::Scalar>(
 /// tangent at each converged step.
 pub(crate) struct NewmarkSensitivities {
     params: Vec<Parameter>,
+    /// Per parameter, `∂M/∂p` and `∂J/∂p` of a mass parameter.
+    units: Vec<Option<Inertia>>,
+    /// The sensitivities of the state at t = 0.
+    pub(crate) initial: Vec<Sensitivity>,
     lu: SparseLu,
     history: Vec<History>,
     nodal: Vec<f64>,
@@ -114,12 +119,14 @@ pub(crate) struct NewmarkSensitivities {
 }
 
 impl NewmarkSensitivities {
-    /// At t = 0 (`sys` as set up, before any step): positions, rotations and
-    /// velocities do not depend on the parameters; the accelerations do,
-    /// through the equations of motion.
+    /// At t = 0 (`sys` as set up, before any step): positions and rotations
+    /// do not depend on the parameters; velocities by an initial velocity's
+    /// value (the slaves' through `N`), the accelerations through the
+    /// equations of motion.
     pub(crate) fn new(
         sys: &mut ReducedSystem<'_, NewmarkTerms>,
         params: &[Parameter],
+        kind: MassKind,
     ) -> Result<Self, SolveError> {
         let mech = sys.mech;
         for p in params {
@@ -134,9 +141,29 @@ impl NewmarkSensitivities {
         let mut lu = SparseLu::new(sys.asm.pattern().clone()).map_err(SolveError::Singular)?;
         let mut nodal = vec![0.0; 6 * nodes];
         let mut history = Vec::with_capacity(params.len());
-        for p in params {
+        let units: Vec<Option<Inertia>> = (params.iter())
+            .map(|p| match p {
+                Parameter::Mass {
+                    elements,
+                    component,
+                } => Some(unit_inertia(mech, elements, *component, kind)),
+                _ => None,
+            })
+            .collect();
+        for (p, unit) in params.iter().zip(&units) {
             let mut h = History::at_rest(nodes);
             p.nodal_derivative(mech, &sys.end.config, 0.0, &mut nodal);
+            if let Some(unit) = unit {
+                // M a₀ + g = 0: ∂M a₀ + M ∂a₀ + ∂g = 0 (rotations at t = 0: I).
+                let prev = &sys.terms.prev;
+                for (i, f) in unit.apply_mass(&prev.acc).iter().enumerate() {
+                    let m = unit.rotational[i] * prev.ang_acc[i];
+                    for c in 0..3 {
+                        nodal[6 * i + c] += f[c];
+                        nodal[6 * i + 3 + c] += m[c];
+                    }
+                }
+            }
             let (a, alpha) = initial_accelerations(
                 mech,
                 &sys.topo,
@@ -147,11 +174,24 @@ impl NewmarkSensitivities {
                 &nodal,
             );
             (h.a, h.acc, h.alpha, h.ang_acc) = (a.clone(), a, alpha.clone(), alpha);
+            if let Parameter::InitialMotion { motion } = p {
+                (h.v, h.w) = slave_velocities(mech, &sys.topo, &sys.end, motion);
+            }
             history.push(h);
         }
+        let (v0, w0) = (&sys.terms.prev.v, &sys.terms.prev.w);
+        let initial = (history.iter().zip(&units))
+            .map(|(h, unit)| Sensitivity {
+                displacement: vec![[0.0; 3]; nodes],
+                energy: kinetic_derivative(&sys.terms.inertia, (v0, w0), h)
+                    + unit.as_ref().map_or(0.0, |u| u.kinetic_energy(v0, w0)),
+            })
+            .collect();
         let n_eq = sys.topo.dofs.n_eq;
         Ok(Self {
             params: params.to_vec(),
+            units,
+            initial,
             lu,
             history,
             nodal,
@@ -183,12 +223,18 @@ impl NewmarkSensitivities {
                 &self.history[k],
                 &mut self.nodal,
             );
+            if let Some(unit) = &self.units[k] {
+                unit_inertial_forces(sys, unit, &mut self.nodal);
+            }
             let mut dq = vec![0.0; sys.topo.dofs.n_eq];
             sys.reduce(&self.nodal, &mut dq);
             dq.iter_mut().for_each(|v| *v = -*v);
             self.lu.solve(&mut dq).map_err(failed)?;
             let (next, v1, w1) = advance(sys, &self.history[k], &dq);
-            let energy = energy_derivative(sys, &next, (&v1, &w1), fext_end, partial);
+            let mass = self.units[k]
+                .as_ref()
+                .map_or(0.0, |u| u.kinetic_energy(&v1, &w1));
+            let energy = energy_derivative(sys, &next, (&v1, &w1), fext_end, partial + mass);
             out.push(Sensitivity {
                 displacement: next.x.iter().map(|d| [d.x, d.y, d.z]).collect(),
                 energy,
@@ -243,6 +289,40 @@ fn history_forces(
     }
 }
 
+/// `∂g/∂p` of a mass parameter at the converged step, added to `g`: the
+/// inertial forces `∂M q̈₁` and `R₁(∂J Ȧ₁ + W₁ × ∂J W₁)` of its unit inertia
+/// `unit`, with the step's accelerations and velocities.
+fn unit_inertial_forces(sys: &ReducedSystem<'_, NewmarkTerms>, unit: &Inertia, g: &mut [f64]) {
+    let terms = &sys.terms;
+    let (k, dt, prev) = (&terms.coefficients, terms.dt, &terms.prev);
+    let (start, end) = (&sys.start.config, &sys.end.config);
+    let c = k.beta * dt * dt;
+    let acc1: Vec<Vector3<f64>> = (0..end.x.len())
+        .map(|j| {
+            let u = end.x[j] - start.x[j];
+            let a1 = (u - prev.v[j] * dt - prev.a[j] * (dt * dt * (0.5 - k.beta))) / c;
+            (a1 * (1.0 - k.alpha_m) + prev.a[j] * k.alpha_m - prev.acc[j] * k.alpha_f)
+                / (1.0 - k.alpha_f)
+        })
+        .collect();
+    for (i, f) in unit.apply_mass(&acc1).iter().enumerate() {
+        for comp in 0..3 {
+            g[6 * i + comp] += f[comp];
+        }
+    }
+    for (i, j0) in unit.rotational.iter().enumerate() {
+        if *j0 == Matrix3::zeros() {
+            continue;
+        }
+        let hist = (prev.w[i], prev.alpha[i], prev.ang_acc[i]);
+        let [_, w1, ang_acc1] = angular_update(k, &start.rot[i], &end.rot[i], hist, dt);
+        let m = end.rot[i] * (j0 * ang_acc1 + w1.cross(&(j0 * w1)));
+        for comp in 0..3 {
+            g[6 * i + 3 + comp] += m[comp];
+        }
+    }
+}
+
 /// The history derivatives at the step's end for the reduced `dq = dq₁/dp`,
 /// with the end velocities `v₁`, `W₁` (real parts, for the energy).
 fn advance(
@@ -289,6 +369,19 @@ fn advance(
     (next, v1, w1s)
 }
 
+/// `dK/dp = Σ (M v)·dv + Σ J₀W·dW` of the kinetic energy at velocities
+/// `v`, `W` with derivatives `h.v`, `h.w` (at fixed mass).
+fn kinetic_derivative(
+    inertia: &Inertia,
+    (v, w): (&[Vector3<f64>], &[Vector3<f64>]),
+    h: &History,
+) -> f64 {
+    let mv = inertia.apply_mass(v);
+    (0..v.len())
+        .map(|i| mv[i].dot(&h.v[i]) + (inertia.rotational[i] * w[i]).dot(&h.w[i]))
+        .sum()
+}
+
 /// `dE/dp` of the record's total energy `K + U − Σ fₑₓₜ·u` at the step's
 /// end: `Σ (M v₁)·dv₁ + Σ J₀W₁·dW₁ + Σ f_int·dx − Σ fₑₓₜ·du + ∂E/∂p`
 /// (`sys.asm.nodal`: the internal forces at the end, from the last
@@ -300,11 +393,8 @@ fn energy_derivative(
     fext: &[f64],
     partial: f64,
 ) -> f64 {
-    let inertia = &sys.terms.inertia;
-    let mv = inertia.apply_mass(v1);
-    let mut de = partial;
+    let mut de = partial + kinetic_derivative(&sys.terms.inertia, (v1, w1), h);
     for i in 0..v1.len() {
-        de += mv[i].dot(&h.v[i]) + (inertia.rotational[i] * w1[i]).dot(&h.w[i]);
         for c in 0..3 {
             de +=
                 sys.asm.nodal[6 * i + c] * h.x[i][c] + sys.asm.nodal[6 * i + 3 + c] * h.theta[i][c];

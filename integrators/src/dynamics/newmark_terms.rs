@@ -453,8 +453,9 @@ impl TimeScheme for NewmarkTerms {
     fn sensitivities(
         sys: &mut ReducedSystem<'_, Self>,
         params: &[Parameter],
+        mass: flexmech_core::MassKind,
     ) -> Result<SchemeSensitivities, SolveError> {
-        NewmarkSensitivities::new(sys, params).map(SchemeSensitivities::Newmark)
+        NewmarkSensitivities::new(sys, params, mass).map(SchemeSensitivities::Newmark)
     }
 
     fn sensitivity_step(

@@ -532,13 +532,9 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
     }
 
     fn differentiate(&mut self, params: &[Parameter]) -> Result<(), SolveError> {
-        let sens = S::sensitivities(&mut self.sys, params)?;
-        let nodes = self.sys.mech.mesh.node_count();
-        let zero = Sensitivity {
-            displacement: vec![[0.0; 3]; nodes],
-            energy: 0.0,
-        };
-        self.sensitivities = Some((sens, vec![zero; params.len()]));
+        let sens = S::sensitivities(&mut self.sys, params, self.settings.mass)?;
+        let initial = sens.initial();
+        self.sensitivities = Some((sens, initial));
         Ok(())
     }
 }

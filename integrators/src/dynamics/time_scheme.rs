@@ -22,6 +22,15 @@ pub(crate) enum SchemeSensitivities {
     Newmark(super::newmark_sensitivity::NewmarkSensitivities),
 }
 
+impl SchemeSensitivities {
+    /// The sensitivities of the state at t = 0.
+    pub(crate) fn initial(&self) -> Vec<Sensitivity> {
+        match self {
+            SchemeSensitivities::Newmark(s) => s.initial.clone(),
+        }
+    }
+}
+
 /// A time-integration scheme over the shared reduced system.
 pub(crate) trait TimeScheme: StepTerms + Sized {
     /// Sets the size of the coming step.
@@ -74,11 +83,12 @@ pub(crate) trait TimeScheme: StepTerms + Sized {
     /// against `mech`.
     fn restore(&mut self, mech: &Mechanism, tape: &mut Tape) -> Result<(), CheckpointMismatch>;
 
-    /// Sets up the exact sensitivities to `params` at t = 0. Default: the
-    /// scheme has none yet.
+    /// Sets up the exact sensitivities to `params` at t = 0 (`mass`: the
+    /// run's mass matrix). Default: the scheme has none yet.
     fn sensitivities(
         _sys: &mut ReducedSystem<'_, Self>,
         _params: &[Parameter],
+        _mass: flexmech_core::MassKind,
     ) -> Result<SchemeSensitivities, SolveError> {
         Err(SolveError::InvalidMechanism(
             "sensitivities are computed with integrator \"newmark\" or \"generalized-alpha\" \

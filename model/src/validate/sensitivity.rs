@@ -9,17 +9,19 @@ use crate::raw::{RawOutput, S};
 use crate::types::{Analysis, IntegratorKind, Model, SensitivityKey};
 
 /// What the keys may name today, for the messages.
-const AVAILABLE: &str = "section stiffnesses (`section.<name>.EA`, `GA[0]`, `GA[1]`, `GJ`, \
-                         `EI[0]`, `EI[1]`) and dead load components (`load[i].force[c]`, \
+const AVAILABLE: &str = "section values (`section.<name>.EA`, `GA[0]`, `GA[1]`, `GJ`, \
+                         `EI[0]`, `EI[1]`, `rhoA`, `rhoJ[0]`, `rhoJ[1]`, `rhoJ[2]`), dead load components (`load[i].force[c]`, \
                          `load[i].moment[c]`, `distributed_load[i].force[c]`, \
                          `distributed_load[i].moment[c]`)";
 
-/// The stiffness of a `[[section]]` field (its words after the section):
-/// the component 0–5 of EA, GA₂, GA₃, GJ, EI₂, EI₃.
+/// The value of a `[[section]]` field (its words after the section): the
+/// component 0–5 of EA, GA₂, GA₃, GJ, EI₂, EI₃, 6 of ρA, 7–9 of ρJ.
 fn stiffness(field: &str) -> Option<usize> {
-    ["EA", "GA[0]", "GA[1]", "GJ", "EI[0]", "EI[1]"]
-        .iter()
-        .position(|f| *f == field)
+    [
+        "EA", "GA[0]", "GA[1]", "GJ", "EI[0]", "EI[1]", "rhoA", "rhoJ[0]", "rhoJ[1]", "rhoJ[2]",
+    ]
+    .iter()
+    .position(|f| *f == field)
 }
 
 /// The component 0–5 of a load's `force[c]` or `moment[c]`.
@@ -31,6 +33,20 @@ fn load_component(field: &str) -> Option<usize> {
         "moment[0]",
         "moment[1]",
         "moment[2]",
+    ]
+    .iter()
+    .position(|f| *f == field)
+}
+
+/// The component 0–5 of an initial velocity's `linear[c]` or `angular[c]`.
+fn velocity_component(field: &str) -> Option<usize> {
+    [
+        "linear[0]",
+        "linear[1]",
+        "linear[2]",
+        "angular[0]",
+        "angular[1]",
+        "angular[2]",
     ]
     .iter()
     .position(|f| *f == field)
@@ -146,6 +162,9 @@ impl Ctx<'_> {
             "distributed_load" => index(model.distributed_loads.len())
                 .zip(load_component(&field))
                 .map(|(load, component)| SensitivityKey::DistributedLoad { load, component }),
+            "initial_velocity" => index(model.initial_velocities.len())
+                .zip(velocity_component(&field))
+                .map(|(field, component)| SensitivityKey::InitialVelocity { field, component }),
             _ => None,
         };
         if let Some(key) = found {
@@ -174,6 +193,15 @@ impl Ctx<'_> {
             SensitivityKey::Load { load, .. } => model.loads[load].follower,
             SensitivityKey::DistributedLoad { load, .. } => model.distributed_loads[load].follower,
             SensitivityKey::Section { .. } => false,
+            SensitivityKey::InitialVelocity { .. } => {
+                if !matches!(model.solver.analysis, Analysis::Dynamic { .. }) {
+                    return Err(format!(
+                        "cannot differentiate by \"{text}\": initial velocities act in dynamic \
+                         analyses only"
+                    ));
+                }
+                false
+            }
         };
         if follower {
             Err(format!(
@@ -194,7 +222,7 @@ impl Ctx<'_> {
 /// Why `model` is no model sensitivities are computed for, if it is not.
 pub(crate) fn analysis_allows_sensitivity(model: &Model) -> Result<(), &'static str> {
     match model.solver.analysis {
-        Analysis::Static { .. } => {}
+        Analysis::Static { .. } | Analysis::ArcLength { .. } => {}
         Analysis::Dynamic {
             integrator: IntegratorKind::Newmark | IntegratorKind::GeneralizedAlpha { .. },
             ..
@@ -209,10 +237,10 @@ pub(crate) fn analysis_allows_sensitivity(model: &Model) -> Result<(), &'static 
         }
         _ => {
             return Err(
-                "sensitivities are computed for load-controlled statics (`analysis = \
-                 \"static\"`) and for dynamics with integrator \"newmark\" or \
-                 \"generalized-alpha\" so far, not for arc-length runs or the conserving \
-                 schemes; remove `sensitivity` from [output], or change the analysis",
+                "sensitivities are computed for statics (load control and arc-length) and for \
+                 dynamics with integrator \"newmark\" or \"generalized-alpha\" so far, not \
+                 with the conserving schemes; remove `sensitivity` from [output], or change the \
+                 integrator",
             )
         }
     }
