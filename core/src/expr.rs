@@ -203,7 +203,28 @@ impl Expression {
 
     /// The value at `t` (any dual number: its derivatives come along).
     pub fn eval<T: Scalar>(&self, t: T) -> T {
-        eval(&self.root, &self.parameters, t)
+        eval(&self.root, &Params::Plain(&self.parameters), t)
+    }
+
+    /// The index of the named parameter `name`, if the expression was
+    /// parsed with one.
+    pub fn parameter(&self, name: &str) -> Option<usize> {
+        self.parameters.iter().position(|(n, _)| n == name)
+    }
+
+    /// The value of parameter `k` ([`Expression::parameter`]).
+    pub fn parameter_value(&self, k: usize) -> f64 {
+        self.parameters[k].1
+    }
+
+    /// The value at `t` with parameter `param` taking `value` (a dual
+    /// number seeded for it: the derivative by the parameter comes along).
+    pub fn eval_seeded<T: Scalar>(&self, t: T, param: usize, value: T) -> T {
+        eval(
+            &self.root,
+            &Params::Seeded(&self.parameters, param, value),
+            t,
+        )
     }
 
     /// The value and its first and second derivatives at `t`, exact (by
@@ -217,12 +238,42 @@ fn truth<T: Scalar>(b: bool) -> T {
     cst(if b { 1.0 } else { 0.0 })
 }
 
-fn eval<T: Scalar>(node: &Node, params: &[(String, f64)], t: T) -> T {
+/// The parameters' values an evaluation takes: as parsed, or with one of
+/// them replaced by a seeded dual number.
+enum Params<'a, T> {
+    Plain(&'a [(String, f64)]),
+    Seeded(&'a [(String, f64)], usize, T),
+}
+
+impl<T: Scalar> Params<'_, T> {
+    fn value(&self, i: usize) -> T {
+        match self {
+            Params::Seeded(_, k, v) if *k == i => *v,
+            Params::Plain(p) | Params::Seeded(p, _, _) => cst(p[i].1),
+        }
+    }
+
+    /// Whether `node` takes the seeded parameter (then it is no constant).
+    fn seeds(&self, node: &Node) -> bool {
+        match self {
+            Params::Plain(_) => false,
+            Params::Seeded(_, k, _) => node.uses_param(*k),
+        }
+    }
+
+    fn values(&self) -> &[(String, f64)] {
+        match self {
+            Params::Plain(p) | Params::Seeded(p, _, _) => p,
+        }
+    }
+}
+
+fn eval<T: Scalar>(node: &Node, params: &Params<'_, T>, t: T) -> T {
     let eval = |node: &Node, t: T| eval(node, params, t);
     match node {
         Node::Number(v) => cst(*v),
         Node::Var => t,
-        Node::Param(i) => cst(params[*i].1),
+        Node::Param(i) => params.value(*i),
         Node::Call1(f, a) => {
             let a = eval(a, t);
             match f {
@@ -249,10 +300,11 @@ fn eval<T: Scalar>(node: &Node, params: &[(String, f64)], t: T) -> T {
                 Fn1::Not => truth(a.value() == 0.0),
             }
         }
-        Node::Call2(Fn2::Pow, a, b) if !b.depends_on_t() => {
+        Node::Call2(Fn2::Pow, a, b) if !b.depends_on_t() && !params.seeds(b) => {
             // A constant exponent: integer powers of negative bases stay
             // defined (t^2 at t < 0), and no logarithm is taken.
-            let (a, n) = (eval(a, t), self::eval::<f64>(b, params, 0.0));
+            let plain = Params::Plain(params.values());
+            let (a, n) = (eval(a, t), self::eval::<f64>(b, &plain, 0.0));
             if n.fract() == 0.0 && n.abs() <= f64::from(i32::MAX) {
                 a.powi(n as i32)
             } else {
@@ -304,6 +356,17 @@ fn eval<T: Scalar>(node: &Node, params: &[(String, f64)], t: T) -> T {
 
 impl Node {
     /// Whether the value changes with `t`.
+    /// Whether parameter `k` appears in it.
+    fn uses_param(&self, k: usize) -> bool {
+        match self {
+            Node::Param(i) => *i == k,
+            Node::Number(_) | Node::Var => false,
+            Node::Call1(_, a) => a.uses_param(k),
+            Node::Call2(_, a, b) => a.uses_param(k) || b.uses_param(k),
+            Node::If(c, a, b) => c.uses_param(k) || a.uses_param(k) || b.uses_param(k),
+        }
+    }
+
     fn depends_on_t(&self) -> bool {
         match self {
             Node::Number(_) | Node::Param(_) => false,

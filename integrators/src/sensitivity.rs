@@ -34,8 +34,10 @@
 //! loads make the total path-dependent; its derivative is then NaN.
 
 use nalgebra::Vector3;
+use std::ops::AddAssign;
 
 use crate::error::SolveError;
+use crate::joint_parameter::JointShift;
 use crate::linsolve::SparseLu;
 use crate::mechanism::{nodal_weights, Mechanism};
 use crate::record::Sensitivity;
@@ -80,6 +82,16 @@ pub enum Parameter {
         /// Which value, 0–3.
         component: usize,
     },
+    /// The real parameter `name` of joint `joint` (index into
+    /// [`Mechanism::joints`]) of a kind that can differentiate by it (an
+    /// expression joint's `parameters`); see [`crate::joint_parameter`] —
+    /// refused where it would move the slave at t = 0.
+    Joint {
+        /// The joint.
+        joint: usize,
+        /// The parameter's name.
+        name: String,
+    },
     /// A value of the initial motion (dynamics): `motion` is the
     /// derivative of the initial nodal velocities (and joint rates) by it;
     /// the slaves' follow through `N`.
@@ -112,6 +124,7 @@ impl Parameter {
                 elements,
                 component,
             } => *component < 4 && elements.iter().all(|&e| e < mech.mesh.elements.len()),
+            Parameter::Joint { joint, .. } => *joint < mech.joints.len(),
         };
         if ok {
             Ok(())
@@ -123,13 +136,28 @@ impl Parameter {
         }
     }
 
+    /// A joint parameter's direct effect at the end state of `sys` (`None`
+    /// for the other parameters).
+    pub(crate) fn shift<T: StepTerms>(
+        &self,
+        sys: &ReducedSystem<'_, T>,
+    ) -> Result<Option<JointShift>, SolveError> {
+        match self {
+            Parameter::Joint { joint, name } => {
+                JointShift::at(sys.mech, &sys.topo, &sys.end, *joint, name).map(Some)
+            }
+            _ => Ok(None),
+        }
+    }
+
     /// The dead loads this parameter scales, with their shares (empty for
     /// a stiffness).
     fn load_shares(&self) -> (Vec<(usize, f64)>, usize) {
         match self {
             Parameter::Stiffness { .. }
             | Parameter::InitialMotion { .. }
-            | Parameter::Mass { .. } => (Vec::new(), 0),
+            | Parameter::Mass { .. }
+            | Parameter::Joint { .. } => (Vec::new(), 0),
             Parameter::Load { load, component } => (vec![(*load, 1.0)], *component),
             Parameter::Loads { shares, component } => (shares.clone(), *component),
         }
@@ -283,6 +311,10 @@ impl StaticSensitivities {
                     "a static analysis has no initial motion to differentiate by".into(),
                 ));
             }
+            if let Parameter::Joint { joint, name } = p {
+                JointShift::at(sys.mech, &sys.topo, &sys.end, *joint, name)?
+                    .check_start(sys.mech, *joint, name)?;
+            }
         }
         let lu = SparseLu::new(sys.asm.pattern().clone()).map_err(SolveError::Singular)?;
         Ok(Self {
@@ -309,11 +341,19 @@ impl StaticSensitivities {
         let mut out = Vec::with_capacity(self.params.len());
         for p in &self.params {
             let partial = p.nodal_derivative(sys.mech, &sys.end.config, lambda, &mut self.nodal);
+            let shift = p.shift(sys)?;
+            let psi = shift.as_ref().and_then(|s| {
+                s.add_stiffness(sys.mech, &sys.end.config, None, &mut self.nodal);
+                s.add_transfer(&sys.nodal, &mut self.nodal)
+            });
             let mut dq = vec![0.0; sys.topo.dofs.n_eq];
             sys.reduce(&self.nodal, &mut dq);
+            if let Some((eq, share)) = psi {
+                dq[eq] += share;
+            }
             dq.iter_mut().for_each(|v| *v = -*v);
             self.lu.solve(&mut dq).map_err(failed)?;
-            out.push(sensitivity_of(sys, &dq, partial));
+            out.push(sensitivity_of(sys, &dq, shift.as_ref(), partial));
         }
         Ok(out)
     }
@@ -324,12 +364,16 @@ impl StaticSensitivities {
 fn sensitivity_of<T: StepTerms>(
     sys: &ReducedSystem<'_, T>,
     dq: &[f64],
+    shift: Option<&JointShift>,
     partial: f64,
 ) -> Sensitivity {
     let mut energy = partial;
     let displacement = (0..sys.mech.mesh.node_count())
         .map(|n| {
-            let d = sys.topo.dofs.node_increment(n, dq);
+            let mut d = sys.topo.dofs.node_increment(n, dq);
+            if let Some(s) = shift {
+                d.fixed_rows_mut::<3>(0).add_assign(&s.of(n));
+            }
             for c in 0..6 {
                 // f_int = g + f_ext; the dead loads' potential sees translations only.
                 let f = sys.nodal[6 * n + c] + sys.fext[6 * n + c];

@@ -40,6 +40,7 @@
 //! kinds, and its `N`, `G`, `Ñ` and tangents follow from `translation`.
 
 use crate::kinematics::{axis_rotation, Angle, AngleAt, JointKinematics};
+use crate::ReleasedState;
 use flexmech_core::rotation::{cayley_mid, skew};
 use flexmech_core::Scalar;
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -53,10 +54,21 @@ pub trait DependentJoint: Send + Sync + Debug {
     fn axis(&self) -> Vector3<f64>;
     /// The released translation `f(ψ)` in the master body frame.
     fn translation<T: Scalar>(&self, psi: T) -> Vector3<T>;
+
+    /// `∂f/∂p` and `∂²f/∂ψ∂p` at `ψ` for the kind's real parameter `name`,
+    /// where the kind can differentiate by it (exact sensitivities by joint
+    /// parameters). Default: `None`, none of its parameters.
+    fn translation_by(&self, _name: &str, _psi: f64) -> Option<[Vector3<f64>; 2]> {
+        None
+    }
 }
 
 impl<J: DependentJoint> JointKinematics for J {
     type Coordinates = Angle;
+
+    fn parameter_derivative(&self, name: &str, state: &ReleasedState) -> Option<[Vector3<f64>; 2]> {
+        self.translation_by(name, state.q[0])
+    }
 
     fn released<T: Scalar>(&self, psi: &AngleAt<T>) -> (Vector3<T>, Matrix3<T>) {
         (

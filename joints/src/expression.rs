@@ -27,6 +27,7 @@ use crate::model_joint::{direction, ModelJoint, ParamError};
 use flexmech_core::expr::{reserved, Expression};
 use flexmech_core::Scalar;
 use nalgebra::Vector3;
+use num_dual::HyperDual64;
 use serde::Deserialize;
 
 /// A dependent joint whose `f(ψ)` is three parsed expressions of `psi`.
@@ -46,6 +47,23 @@ impl DependentJoint for ExpressionJoint {
     fn translation<T: Scalar>(&self, psi: T) -> Vector3<T> {
         let [x, y, z] = &self.translation;
         Vector3::new(x.eval(psi), y.eval(psi), z.eval(psi))
+    }
+
+    /// By a named parameter: the expressions in hyper-dual numbers, `ψ`
+    /// seeded in the first direction and the parameter in the second.
+    fn translation_by(&self, name: &str, psi: f64) -> Option<[Vector3<f64>; 2]> {
+        let k = self.translation[0].parameter(name)?;
+        let value = self.translation[0].parameter_value(k);
+        let psi = HyperDual64::new(psi, 1.0, 0.0, 0.0);
+        let p = HyperDual64::new(value, 0.0, 1.0, 0.0);
+        let f = self
+            .translation
+            .each_ref()
+            .map(|e| e.eval_seeded(psi, k, p));
+        Some([
+            Vector3::from_fn(|i, _| f[i].eps2),
+            Vector3::from_fn(|i, _| f[i].eps1eps2),
+        ])
     }
 }
 

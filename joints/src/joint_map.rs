@@ -119,6 +119,10 @@ pub trait JointMap: Send + Sync + Debug {
     fn has_angle(&self) -> bool {
         self.coordinate_names().first() == Some(&"angle")
     }
+
+    /// `∂r_R/∂p` and `∂²r_R/∂q₁∂p` at `state` for the real parameter `name`
+    /// of the kind, where it can differentiate by it.
+    fn parameter_derivative(&self, name: &str, state: &ReleasedState) -> Option<[Vector3<f64>; 2]>;
 }
 
 /// Slave increment `(Δx, spin)` for the local increment `e` applied after `h`,
@@ -291,6 +295,10 @@ fn released_transfer_in<J: JointKinematics, const N: usize>(
 impl<J: JointKinematics> JointMap for J {
     fn released_count(&self) -> usize {
         released_count::<J>()
+    }
+
+    fn parameter_derivative(&self, name: &str, state: &ReleasedState) -> Option<[Vector3<f64>; 2]> {
+        JointKinematics::parameter_derivative(self, name, state)
     }
 
     fn coordinate_names(&self) -> &'static [&'static str] {

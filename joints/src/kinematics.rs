@@ -271,6 +271,17 @@ pub trait JointKinematics: Send + Sync + Debug {
         <Self::Coordinates as Coordinates>::advance(state, delta)
     }
 
+    /// `∂r_R/∂p` and `∂²r_R/∂q₁∂p` at `state` for the kind's real parameter
+    /// `name` (see [`crate::DependentJoint::translation_by`]). Default:
+    /// `None`.
+    fn parameter_derivative(
+        &self,
+        _name: &str,
+        _state: &ReleasedState,
+    ) -> Option<[Vector3<f64>; 2]> {
+        None
+    }
+
     /// Names of the released coordinates (for messages and outputs).
     fn coordinate_names(&self) -> &'static [&'static str] {
         <Self::Coordinates as Coordinates>::NAMES

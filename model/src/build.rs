@@ -76,6 +76,10 @@ impl Built {
     pub fn sensitivity_parameters(&self, model: &Model) -> Vec<Parameter> {
         let loads = model.loads.len();
         let param = |key: &SensitivityKey| match *key {
+            SensitivityKey::JointParameter { joint, ref name } => Parameter::Joint {
+                joint,
+                name: name.clone(),
+            },
             SensitivityKey::Section { section, component } => {
                 let elements = (model.beams.iter().zip(&self.beam_elements))
                     .filter(|(b, _)| b.section == section)

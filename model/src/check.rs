@@ -295,6 +295,7 @@ impl Checker<'_> {
         let m = self.model;
         for (i, (text, key)) in m.output.sensitivity.iter().enumerate() {
             let ok = match *key {
+                SensitivityKey::JointParameter { joint, .. } => joint < m.joints.len(),
                 SensitivityKey::Section { section, component } => {
                     section < m.sections.len() && component < 10
                 }

@@ -329,7 +329,7 @@ pub struct OutputSpec {
 
 /// A model value a sensitivity is taken with respect to (`[output]
 /// sensitivity`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum SensitivityKey {
     /// Value `component` of section `section` (index into
     /// [`Model::sections`]): 0–5 are EA, GA₂, GA₃, GJ, EI₂, EI₃, 6 is ρA and
@@ -354,6 +354,14 @@ pub enum SensitivityKey {
         load: usize,
         /// Which component, 0–5.
         component: usize,
+    },
+    /// The parameter `name` of joint `joint` (index into [`Model::joints`];
+    /// an expression joint's `parameters`).
+    JointParameter {
+        /// The joint.
+        joint: usize,
+        /// The parameter's name.
+        name: String,
     },
     /// Component `component` (0–2 `linear`, 3–5 `angular`) of
     /// `[[initial_velocity]]` `field` (dynamics).

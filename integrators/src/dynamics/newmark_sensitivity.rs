@@ -30,6 +30,7 @@ use num_dual::Dual64;
 use super::newmark_terms::{initial_accelerations, Coefficients, NewmarkTerms};
 use super::slave_velocities;
 use crate::error::SolveError;
+use crate::joint_parameter::JointShift;
 use crate::linsolve::SparseLu;
 use crate::record::Sensitivity;
 use crate::sensitivity::{unit_inertia, Parameter};
@@ -177,6 +178,9 @@ impl NewmarkSensitivities {
             if let Parameter::InitialMotion { motion } = p {
                 (h.v, h.w) = slave_velocities(mech, &sys.topo, &sys.end, motion);
             }
+            if let Parameter::Joint { joint, name } = p {
+                joint_start(sys, *joint, name, &mut h)?;
+            }
             history.push(h);
         }
         let (v0, w0) = (&sys.terms.prev.v, &sys.terms.prev.w);
@@ -226,11 +230,21 @@ impl NewmarkSensitivities {
             if let Some(unit) = &self.units[k] {
                 unit_inertial_forces(sys, unit, &mut self.nodal);
             }
+            let shift = self.params[k].shift(sys)?;
+            if let Some(s) = &shift {
+                let kc = &sys.terms.coefficients;
+                let dt = sys.terms.dt;
+                let c = (1.0 - kc.alpha_m) / ((1.0 - kc.alpha_f) * kc.beta * dt * dt);
+                let inertia = Some((&sys.terms.inertia, c));
+                s.add_stiffness(sys.mech, &sys.end.config, inertia, &mut self.nodal);
+                // The angle is driven (checked at t = 0): no ψ equation.
+                s.add_transfer(&sys.nodal, &mut self.nodal);
+            }
             let mut dq = vec![0.0; sys.topo.dofs.n_eq];
             sys.reduce(&self.nodal, &mut dq);
             dq.iter_mut().for_each(|v| *v = -*v);
             self.lu.solve(&mut dq).map_err(failed)?;
-            let (next, v1, w1) = advance(sys, &self.history[k], &dq);
+            let (next, v1, w1) = advance(sys, &self.history[k], &dq, shift.as_ref());
             let mass = self.units[k]
                 .as_ref()
                 .map_or(0.0, |u| u.kinetic_energy(&v1, &w1));
@@ -243,6 +257,32 @@ impl NewmarkSensitivities {
         }
         Ok(out)
     }
+}
+
+/// A joint parameter at t = 0: refused where it moves the slave (a model
+/// places it once) or the joint's angle is free (its initial accelerations'
+/// dependence is not derived yet); a driven angle's rate `ψ̇₀` moves the
+/// slave's subtree at `R_m ∂²f/∂ψ∂p ψ̇₀` (the accelerations do not change:
+/// `∂f/∂p(ψ₀) = 0` and the driven angle is no unknown).
+fn joint_start(
+    sys: &ReducedSystem<'_, NewmarkTerms>,
+    joint: usize,
+    name: &str,
+    h: &mut History,
+) -> Result<(), SolveError> {
+    let shift = JointShift::at(sys.mech, &sys.topo, &sys.end, joint, name)?;
+    shift.check_start(sys.mech, joint, name)?;
+    if shift.psi_eq.is_some() {
+        return Err(SolveError::InvalidMechanism(format!(
+            "joint `{}`: sensitivities by a parameter of a joint whose angle is free are              computed in statics; in dynamics drive its angle (`[[prescribed]] joint = ...`)",
+            sys.mech.joints[joint].name
+        )));
+    }
+    let rate = sys.terms.initial_rates.get(joint).copied().unwrap_or(0.0);
+    for &n in &shift.nodes {
+        h.v[n] += shift.slope * rate;
+    }
+    Ok(())
 }
 
 /// `∂g/∂hₙ · dhₙ/dp` at fixed end configuration, added to `g`: the
@@ -329,6 +369,7 @@ fn advance(
     sys: &ReducedSystem<'_, NewmarkTerms>,
     h: &History,
     dq: &[f64],
+    shift: Option<&JointShift>,
 ) -> (History, Vec<Vector3<f64>>, Vec<Vector3<f64>>) {
     let terms = &sys.terms;
     let (k, dt, prev) = (&terms.coefficients, terms.dt, &terms.prev);
@@ -338,8 +379,9 @@ fn advance(
     let (mut v1, mut w1s) = (Vec::with_capacity(nodes), Vec::with_capacity(nodes));
     for i in 0..nodes {
         let d = sys.topo.dofs.node_increment(i, dq);
+        let direct = shift.map_or(Vector3::zeros(), |s| s.of(i));
         let (dx1, dth1) = (
-            d.fixed_rows::<3>(0).into_owned(),
+            d.fixed_rows::<3>(0).into_owned() + direct,
             d.fixed_rows::<3>(3).into_owned(),
         );
         // Translational: the update is linear.

@@ -207,6 +207,8 @@ pub(crate) struct NewmarkTerms {
     slots: MassSlots,
     /// Velocities and accelerations at the start of the step.
     pub(super) prev: Kinematics,
+    /// The joints' initial rates (of their first released coordinate).
+    pub(super) initial_rates: Vec<f64>,
     pub(super) dt: f64,
     /// The drivers' reactions at the end of the last accepted step.
     reactions: Option<(Vec<Vec<f64>>, Vec<f64>)>,
@@ -256,6 +258,7 @@ impl NewmarkTerms {
             },
             dt: f64::NAN,
             reactions: None,
+            initial_rates: initial.joint_rates.clone(),
         }
     }
 }

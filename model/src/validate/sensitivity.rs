@@ -52,6 +52,47 @@ fn velocity_component(field: &str) -> Option<usize> {
     .position(|f| *f == field)
 }
 
+/// The parameter `field` (`parameters.<p>`) of joint `j` at key `text`,
+/// where the joint's kind can differentiate by it and a change of it leaves
+/// the slave where the model places it at t = 0.
+fn joint_parameter(
+    model: &Model,
+    j: usize,
+    field: &str,
+    text: &str,
+) -> Result<SensitivityKey, String> {
+    let spec = &model.joints[j];
+    let refuse = |why: String| format!("cannot differentiate by \"{text}\": {why}");
+    let name = field.strip_prefix("parameters.").unwrap_or(field);
+    let mut q0 = [0.0; flexmech_joints::MAX_RELEASED];
+    q0[0] = spec.angle;
+    let state = flexmech_joints::ReleasedState::new(q0);
+    let Some([f_p, _]) = spec.kind.map().parameter_derivative(name, &state) else {
+        return Err(refuse(format!(
+            "a joint of type {} cannot be differentiated by `{field}` (the parameters of an \
+             expression joint, `joint.<name>.parameters.<p>`, can); write the joint as \
+             `type = \"expression\"` to differentiate by its parameters",
+            spec.kind.type_name()
+        )));
+    };
+    if f_p.norm() > JOINT_START_SHIFT {
+        return Err(refuse(format!(
+            "changing it moves the slave at t = 0 (∂f/∂{name} = [{:?}, {:?}, {:?}] at the \
+             initial angle), and the model places its slave in the file; differentiate by a \
+             parameter that leaves f(ψ₀) unchanged",
+            f_p.x, f_p.y, f_p.z
+        )));
+    }
+    Ok(SensitivityKey::JointParameter {
+        joint: j,
+        name: name.to_owned(),
+    })
+}
+
+/// `|∂f/∂p(ψ₀)|` above which a joint parameter moves the slave at t = 0
+/// (absolute: the model's lengths are of order 1e-3 and above).
+const JOINT_START_SHIFT: f64 = 1e-14;
+
 /// What kind of value `v` is, when it is no real number.
 fn not_real(v: &Value) -> Option<&'static str> {
     match v {
@@ -162,6 +203,16 @@ impl Ctx<'_> {
             "distributed_load" => index(model.distributed_loads.len())
                 .zip(load_component(&field))
                 .map(|(load, component)| SensitivityKey::DistributedLoad { load, component }),
+            "joint" => {
+                let joint = match entry {
+                    Some(Segment::Key(name)) => model.joints.iter().position(|j| &j.name == name),
+                    _ => index(model.joints.len()),
+                };
+                if let Some(j) = joint {
+                    return joint_parameter(model, j, &field, text);
+                }
+                None
+            }
             "initial_velocity" => index(model.initial_velocities.len())
                 .zip(velocity_component(&field))
                 .map(|(field, component)| SensitivityKey::InitialVelocity { field, component }),
@@ -170,6 +221,7 @@ impl Ctx<'_> {
         if let Some(key) = found {
             return self.dead(key, model, text);
         }
+
         let why = if matches!(text, "solver.dt" | "solver.t_end") {
             "the step size and the end time are no parameters of the solution".to_string()
         } else if let Some(kind) = not_real(value) {
@@ -192,7 +244,7 @@ impl Ctx<'_> {
         let follower = match key {
             SensitivityKey::Load { load, .. } => model.loads[load].follower,
             SensitivityKey::DistributedLoad { load, .. } => model.distributed_loads[load].follower,
-            SensitivityKey::Section { .. } => false,
+            SensitivityKey::Section { .. } | SensitivityKey::JointParameter { .. } => false,
             SensitivityKey::InitialVelocity { .. } => {
                 if !matches!(model.solver.analysis, Analysis::Dynamic { .. }) {
                     return Err(format!(
