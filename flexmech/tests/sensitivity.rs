@@ -729,3 +729,19 @@ fn assert_static_agrees(model: &Model) {
         assert!(e < AGREE, "{}: {key}: energy {e:e}", model.name);
     }
 }
+
+#[test]
+fn dynamic_sensitivities_by_a_rigid_bodys_mass_and_inertia() {
+    // The body pendulum: a rod on a hinge carrying an offset bob, swinging
+    // under gravity; derivatives by the bob's mass and its inertia about
+    // the hinge's axis, and the rod's initial spin.
+    for integrator in ["newmark", "generalized-alpha"] {
+        let keys = [
+            "rigid_body.bob.mass",
+            "rigid_body[0].inertia[2][2]",
+            "initial_velocity[0].angular[2]",
+        ];
+        let model = dynamic_model("dynamics/body_pendulum.toml", 0.5, integrator, &keys);
+        assert_dynamic_agrees(&model, integrator);
+    }
+}

@@ -82,6 +82,15 @@ pub enum Parameter {
         /// Which value, 0–3.
         component: usize,
     },
+    /// The mass (`component` 0) or a principal inertia about the centre of
+    /// mass (1–3: about the global axes at t = 0) of rigid body `body`
+    /// (index into [`Mechanism::bodies`]): its inertial forces and weight.
+    BodyMass {
+        /// The body.
+        body: usize,
+        /// Which value, 0–3.
+        component: usize,
+    },
     /// The real parameter `name` of joint `joint` (index into
     /// [`Mechanism::joints`]) of a kind that can differentiate by it (an
     /// expression joint's `parameters`); see [`crate::joint_parameter`] —
@@ -125,6 +134,7 @@ impl Parameter {
                 component,
             } => *component < 4 && elements.iter().all(|&e| e < mech.mesh.elements.len()),
             Parameter::Joint { joint, .. } => *joint < mech.joints.len(),
+            Parameter::BodyMass { body, component } => *body < mech.bodies.len() && *component < 4,
         };
         if ok {
             Ok(())
@@ -157,7 +167,8 @@ impl Parameter {
             Parameter::Stiffness { .. }
             | Parameter::InitialMotion { .. }
             | Parameter::Mass { .. }
-            | Parameter::Joint { .. } => (Vec::new(), 0),
+            | Parameter::Joint { .. }
+            | Parameter::BodyMass { .. } => (Vec::new(), 0),
             Parameter::Load { load, component } => (vec![(*load, 1.0)], *component),
             Parameter::Loads { shares, component } => (shares.clone(), *component),
         }
@@ -200,6 +211,14 @@ impl Parameter {
         } = self
         {
             return unit_gravity(mech, elements, *component, config, lambda, out);
+        }
+        if let Parameter::BodyMass { body, component: 0 } = self {
+            let n = mech.bodies[*body].node;
+            let g = mech.gravity * mech.gravity_scale.at(lambda);
+            for c in 0..3 {
+                out[6 * n + c] -= g[c];
+            }
+            return -g.dot(&(config.x[n] - mech.mesh.positions[n]));
         }
         let (shares, component) = self.load_shares();
         let mut energy = 0.0;
@@ -247,10 +266,35 @@ fn unit_gravity(
     energy
 }
 
+/// `∂M/∂p` and `∂J/∂p` of a mass parameter ([`Parameter::Mass`],
+/// [`Parameter::BodyMass`]; `None` for the others).
+pub(crate) fn mass_derivative(
+    mech: &Mechanism,
+    p: &Parameter,
+    kind: flexmech_core::MassKind,
+) -> Option<flexmech_core::Inertia> {
+    match p {
+        Parameter::Mass {
+            elements,
+            component,
+        } => Some(unit_inertia(mech, elements, *component, kind)),
+        Parameter::BodyMass { body, component } => {
+            let mut unit = unit_inertia(mech, &[], 0, kind);
+            let node = mech.bodies[*body].node;
+            let (m, mut j) = (f64::from(*component == 0), nalgebra::Matrix3::zeros());
+            if *component > 0 {
+                j[(component - 1, component - 1)] = 1.0;
+            }
+            unit.add_body(node, m, &j);
+            Some(unit)
+        }
+        _ => None,
+    }
+}
+
 /// The inertia of the elements `elements` with a unit mass parameter
-/// `component` (0: ρA, 1–3: ρJ) and every other element massless:
-/// `∂M/∂p` and `∂J/∂p` of [`Parameter::Mass`].
-pub(crate) fn unit_inertia(
+/// `component` (0: ρA, 1–3: ρJ) and every other element massless.
+fn unit_inertia(
     mech: &Mechanism,
     elements: &[usize],
     component: usize,

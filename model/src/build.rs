@@ -76,6 +76,7 @@ impl Built {
     pub fn sensitivity_parameters(&self, model: &Model) -> Vec<Parameter> {
         let loads = model.loads.len();
         let param = |key: &SensitivityKey| match *key {
+            SensitivityKey::BodyMass { body, component } => Parameter::BodyMass { body, component },
             SensitivityKey::JointParameter { joint, ref name } => Parameter::Joint {
                 joint,
                 name: name.clone(),

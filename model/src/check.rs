@@ -296,6 +296,9 @@ impl Checker<'_> {
         for (i, (text, key)) in m.output.sensitivity.iter().enumerate() {
             let ok = match *key {
                 SensitivityKey::JointParameter { joint, .. } => joint < m.joints.len(),
+                SensitivityKey::BodyMass { body, component } => {
+                    body < m.rigid_bodies.len() && component < 4
+                }
                 SensitivityKey::Section { section, component } => {
                     section < m.sections.len() && component < 10
                 }

@@ -355,6 +355,14 @@ pub enum SensitivityKey {
         /// Which component, 0–5.
         component: usize,
     },
+    /// The mass (`component` 0) or a principal inertia (1–3, about the
+    /// global axes at t = 0) of `[[rigid_body]]` `body`.
+    BodyMass {
+        /// Index into [`Model::rigid_bodies`].
+        body: usize,
+        /// Which value, 0–3.
+        component: usize,
+    },
     /// The parameter `name` of joint `joint` (index into [`Model::joints`];
     /// an expression joint's `parameters`).
     JointParameter {

@@ -33,7 +33,7 @@ use crate::error::SolveError;
 use crate::joint_parameter::JointShift;
 use crate::linsolve::SparseLu;
 use crate::record::Sensitivity;
-use crate::sensitivity::{unit_inertia, Parameter};
+use crate::sensitivity::{mass_derivative, Parameter};
 use crate::system::ReducedSystem;
 use flexmech_core::rotation::{log, skew};
 use flexmech_core::{Configuration, Inertia, MassKind};
@@ -143,13 +143,7 @@ impl NewmarkSensitivities {
         let mut nodal = vec![0.0; 6 * nodes];
         let mut history = Vec::with_capacity(params.len());
         let units: Vec<Option<Inertia>> = (params.iter())
-            .map(|p| match p {
-                Parameter::Mass {
-                    elements,
-                    component,
-                } => Some(unit_inertia(mech, elements, *component, kind)),
-                _ => None,
-            })
+            .map(|p| mass_derivative(mech, p, kind))
             .collect();
         for (p, unit) in params.iter().zip(&units) {
             let mut h = History::at_rest(nodes);

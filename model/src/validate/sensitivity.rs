@@ -10,9 +10,13 @@ use crate::types::{Analysis, IntegratorKind, Model, SensitivityKey};
 
 /// What the keys may name today, for the messages.
 const AVAILABLE: &str = "section values (`section.<name>.EA`, `GA[0]`, `GA[1]`, `GJ`, \
-                         `EI[0]`, `EI[1]`, `rhoA`, `rhoJ[0]`, `rhoJ[1]`, `rhoJ[2]`), dead load components (`load[i].force[c]`, \
-                         `load[i].moment[c]`, `distributed_load[i].force[c]`, \
-                         `distributed_load[i].moment[c]`)";
+                         `EI[0]`, `EI[1]`, `rhoA`, `rhoJ[0]`, `rhoJ[1]`, `rhoJ[2]`), rigid \
+                         bodies' `rigid_body[i].mass` and principal `inertia[k]`, expression \
+                         joints' `joint.<name>.parameters.<p>`, dead load components \
+                         (`load[i].force[c]`, `load[i].moment[c]`, \
+                         `distributed_load[i].force[c]`, `distributed_load[i].moment[c]`) and, \
+                         in dynamics, initial velocities (`initial_velocity[i].linear[c]`, \
+                         `initial_velocity[i].angular[c]`)";
 
 /// The value of a `[[section]]` field (its words after the section): the
 /// component 0–5 of EA, GA₂, GA₃, GJ, EI₂, EI₃, 6 of ρA, 7–9 of ρJ.
@@ -36,6 +40,17 @@ fn load_component(field: &str) -> Option<usize> {
     ]
     .iter()
     .position(|f| *f == field)
+}
+
+/// The value 0–3 of a rigid body's `mass` (0) or principal inertia
+/// `inertia[k]` / `inertia[k][k]` (1 + k).
+fn body_component(field: &str) -> Option<usize> {
+    match field {
+        "mass" => Some(0),
+        _ => (0..3)
+            .find(|k| field == format!("inertia[{k}]") || field == format!("inertia[{k}][{k}]"))
+            .map(|k| k + 1),
+    }
 }
 
 /// The component 0–5 of an initial velocity's `linear[c]` or `angular[c]`.
@@ -213,6 +228,16 @@ impl Ctx<'_> {
                 }
                 None
             }
+            "rigid_body" => {
+                let body = match entry {
+                    Some(Segment::Key(name)) => {
+                        model.rigid_bodies.iter().position(|b| &b.name == name)
+                    }
+                    _ => index(model.rigid_bodies.len()),
+                };
+                body.zip(body_component(&field))
+                    .map(|(body, component)| SensitivityKey::BodyMass { body, component })
+            }
             "initial_velocity" => index(model.initial_velocities.len())
                 .zip(velocity_component(&field))
                 .map(|(field, component)| SensitivityKey::InitialVelocity { field, component }),
@@ -244,7 +269,9 @@ impl Ctx<'_> {
         let follower = match key {
             SensitivityKey::Load { load, .. } => model.loads[load].follower,
             SensitivityKey::DistributedLoad { load, .. } => model.distributed_loads[load].follower,
-            SensitivityKey::Section { .. } | SensitivityKey::JointParameter { .. } => false,
+            SensitivityKey::Section { .. }
+            | SensitivityKey::JointParameter { .. }
+            | SensitivityKey::BodyMass { .. } => false,
             SensitivityKey::InitialVelocity { .. } => {
                 if !matches!(model.solver.analysis, Analysis::Dynamic { .. }) {
                     return Err(format!(
