@@ -54,6 +54,80 @@ fn distinct(cells: impl Iterator<Item = String>) -> usize {
     seen.len()
 }
 
+/// How the summary's rows are drawn: the x axis and the series.
+struct Layout {
+    /// The swept key on the x axis (`None`: the run index).
+    x_key: Option<usize>,
+    x_label: String,
+    /// Each row's abscissa.
+    x: Vec<f64>,
+    /// The series: a label and its rows.
+    groups: Vec<(String, Vec<usize>)>,
+}
+
+impl Layout {
+    fn of(spec: &StudySpec, summary: &Summary) -> Self {
+        let key_col = |i: usize| 1 + i;
+        let varying: Vec<usize> = (0..spec.grid.len())
+            .filter(|&i| distinct(summary.rows.iter().map(|r| r[key_col(i)].csv_text())) > 1)
+            .collect();
+        let x_key = varying
+            .iter()
+            .copied()
+            .find(|&i| spec.grid[i].is_numeric())
+            .or_else(|| (0..spec.grid.len()).find(|&i| spec.grid[i].is_numeric()));
+        let x_label = match x_key {
+            Some(i) => key_words(&spec.grid[i].key),
+            None => "run index".into(),
+        };
+        let others: Vec<usize> = varying
+            .iter()
+            .copied()
+            .filter(|&i| Some(i) != x_key)
+            .collect();
+        // Legend labels name a key by its last segment (`pitch`) unless two
+        // of the keys share it.
+        let short = |i: usize| -> String {
+            let last = |k: &str| k.rsplit('.').next().unwrap_or(k).to_owned();
+            let mine = last(&spec.grid[i].key);
+            let clash = others
+                .iter()
+                .any(|&j| j != i && last(&spec.grid[j].key) == mine);
+            if clash {
+                key_words(&spec.grid[i].key)
+            } else {
+                mine
+            }
+        };
+        // Group the rows by the values of the other varying keys, in order
+        // of first appearance.
+        let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
+        for (r, cells) in summary.rows.iter().enumerate() {
+            let label = others
+                .iter()
+                .map(|&i| format!("{} = {}", short(i), cells[key_col(i)].csv_text()))
+                .collect::<Vec<_>>()
+                .join(", ");
+            match groups.iter_mut().find(|(l, _)| *l == label) {
+                Some((_, rows)) => rows.push(r),
+                None => groups.push((label, vec![r])),
+            }
+        }
+        let x = (0..summary.rows.len())
+            .map(|r| match x_key {
+                Some(i) => summary.rows[r][key_col(i)].number(),
+                None => r as f64,
+            })
+            .collect();
+        Self {
+            x_key,
+            x_label,
+            x,
+            groups,
+        }
+    }
+}
+
 /// Draws `<dir>/<figure>.png` and `.svg` for each figure of `spec` from
 /// `summary` (whose columns are those of [`super::summary::columns`]) and
 /// returns the files written.
@@ -62,59 +136,7 @@ pub fn summary_charts(
     summary: &Summary,
     dir: &Path,
 ) -> Result<Vec<PathBuf>, ChartError> {
-    let key_col = |i: usize| 1 + i;
-    let varying: Vec<usize> = (0..spec.grid.len())
-        .filter(|&i| distinct(summary.rows.iter().map(|r| r[key_col(i)].csv_text())) > 1)
-        .collect();
-    let x_key = varying
-        .iter()
-        .copied()
-        .find(|&i| spec.grid[i].is_numeric())
-        .or_else(|| (0..spec.grid.len()).find(|&i| spec.grid[i].is_numeric()));
-    let x_label = match x_key {
-        Some(i) => key_words(&spec.grid[i].key),
-        None => "run index".into(),
-    };
-    let others: Vec<usize> = varying
-        .iter()
-        .copied()
-        .filter(|&i| Some(i) != x_key)
-        .collect();
-
-    // Legend labels name a key by its last segment (`pitch`) unless two of
-    // the keys share it.
-    let short = |i: usize| -> String {
-        let last = |k: &str| k.rsplit('.').next().unwrap_or(k).to_owned();
-        let mine = last(&spec.grid[i].key);
-        let clash = others
-            .iter()
-            .any(|&j| j != i && last(&spec.grid[j].key) == mine);
-        if clash {
-            key_words(&spec.grid[i].key)
-        } else {
-            mine
-        }
-    };
-
-    // Group the rows by the values of the other varying keys, in order of
-    // first appearance.
-    let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
-    for (r, cells) in summary.rows.iter().enumerate() {
-        let label = others
-            .iter()
-            .map(|&i| format!("{} = {}", short(i), cells[key_col(i)].csv_text()))
-            .collect::<Vec<_>>()
-            .join(", ");
-        match groups.iter_mut().find(|(l, _)| *l == label) {
-            Some((_, rows)) => rows.push(r),
-            None => groups.push((label, vec![r])),
-        }
-    }
-    let x_of = |r: usize| match x_key {
-        Some(i) => summary.rows[r][key_col(i)].number(),
-        None => r as f64,
-    };
-
+    let layout = Layout::of(spec, summary);
     let mut written = Vec::new();
     let mut col = 2 + spec.grid.len();
     for figure in &spec.figures {
@@ -123,45 +145,7 @@ pub fn summary_charts(
             derivatives: figure.derivative_columns(),
         };
         col += 1 + columns.derivatives.len();
-        let title = if spec.titles {
-            format!("{}: {}", spec.name, figure.name())
-        } else {
-            String::new()
-        };
-        let mut chart = LineChart::new(title, x_label.clone(), figure.axis_label());
-        // The derivative by the swept key gives each point's tangent.
-        let slope = (x_key.map(|i| spec.grid[i].key.as_str()))
-            .and_then(|key| columns.derivatives.iter().position(|(_, k)| *k == key))
-            .map(|d| columns.value + 1 + d);
-        for (group, (label, rows)) in groups.iter().enumerate() {
-            let mut points: Vec<(f64, f64, f64)> = rows
-                .iter()
-                .map(|&r| {
-                    let cell =
-                        |c: Option<usize>| c.map_or(f64::NAN, |c| summary.rows[r][c].number());
-                    (
-                        x_of(r),
-                        summary.rows[r][columns.value].number(),
-                        cell(slope),
-                    )
-                })
-                .filter(|(x, y, _)| x.is_finite() && y.is_finite())
-                .collect();
-            if points.is_empty() {
-                continue;
-            }
-            points.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let (x, y) = points.iter().map(|p| (p.0, p.1)).unzip();
-            let mut series = Series::new(label.clone(), x, y);
-            // The groups' styles, whatever tangent lines come between them.
-            let (color, dash) = auto_style(group);
-            (series.color, series.dash) = (Some(color), Some(dash));
-            chart.series.push(series);
-            if slope.is_some() {
-                let first = !chart.series.iter().any(|s| s.label == TANGENT_LABEL);
-                chart.series.extend(tangents(&points, first));
-            }
-        }
+        let chart = figure_chart(spec, summary, &layout, figure, &columns);
         let stem = dir.join(figure.name());
         if chart.series.is_empty() {
             // Leave no chart of an earlier run of the study behind.
@@ -170,14 +154,58 @@ pub fn summary_charts(
             }
             continue;
         }
-        // Drifts span decades: a logarithmic axis when every value allows it.
-        chart.log_y = *figure == Figure::EnergyDrift
-            && chart.series.iter().flat_map(|s| &s.y).all(|&y| y > 0.0);
         let (png, svg) = chart.render(&stem)?;
         written.push(png);
         written.push(svg);
     }
     Ok(written)
+}
+
+/// The chart of `figure` (summary columns `columns`): one series per group,
+/// the tangents from its derivative by the swept key when it has one.
+fn figure_chart(
+    spec: &StudySpec,
+    summary: &Summary,
+    layout: &Layout,
+    figure: &Figure,
+    columns: &Columns<'_>,
+) -> LineChart {
+    let title = if spec.titles {
+        format!("{}: {}", spec.name, figure.name())
+    } else {
+        String::new()
+    };
+    let mut chart = LineChart::new(title, layout.x_label.clone(), figure.axis_label());
+    // The derivative by the swept key gives each point's tangent.
+    let slope = (layout.x_key.map(|i| spec.grid[i].key.as_str()))
+        .and_then(|key| columns.derivatives.iter().position(|(_, k)| *k == key))
+        .map(|d| columns.value + 1 + d);
+    for (group, (label, rows)) in layout.groups.iter().enumerate() {
+        let cell = |r: usize, c: Option<usize>| c.map_or(f64::NAN, |c| summary.rows[r][c].number());
+        let mut points: Vec<(f64, f64, f64)> = rows
+            .iter()
+            .map(|&r| (layout.x[r], cell(r, Some(columns.value)), cell(r, slope)))
+            .filter(|(x, y, _)| x.is_finite() && y.is_finite())
+            .collect();
+        if points.is_empty() {
+            continue;
+        }
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (x, y) = points.iter().map(|p| (p.0, p.1)).unzip();
+        let mut series = Series::new(label.clone(), x, y);
+        // The groups' styles, whatever tangent lines come between them.
+        let (color, dash) = auto_style(group);
+        (series.color, series.dash) = (Some(color), Some(dash));
+        chart.series.push(series);
+        if slope.is_some() {
+            let first = !chart.series.iter().any(|s| s.label == TANGENT_LABEL);
+            chart.series.extend(tangents(&points, first));
+        }
+    }
+    // Drifts span decades: a logarithmic axis when every value allows it.
+    chart.log_y =
+        *figure == Figure::EnergyDrift && chart.series.iter().flat_map(|s| &s.y).all(|&y| y > 0.0);
+    chart
 }
 
 /// A figure's summary columns: its value and its derivatives (column name
