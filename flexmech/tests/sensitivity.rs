@@ -332,7 +332,7 @@ fn sensitivity_keys_that_name_no_differentiable_value_are_refused_where_written(
         ("\"section.rod.EA\"", "no [[section]] entry named \"rod\""),
         (
             "\"beam[0].start[0]\"",
-            "not available yet; available: section stiffnesses",
+            "not available yet; available: section values",
         ),
         ("\"section.post.EI\"", "a list (name one component"),
         ("\"beam[0].elements\"", "an integer, not a real number"),
