@@ -347,7 +347,7 @@ fn sensitivity_keys_that_name_no_differentiable_value_are_refused_where_written(
         assert!(message.contains("key `output.sensitivity["), "{message}");
         assert!(message.contains("sensitivity_frame.toml:"), "{message}");
     }
-    // Analyses not differentiated yet are refused whole.
+    // Integrators not differentiated yet are refused whole.
     let mass = "\nrhoA = 1.0\nrhoJ = [0.02, 0.01, 0.01]";
     let dynamic = (text.replace(
         "EI = [1000.0, 1000.0]",
@@ -356,13 +356,17 @@ fn sensitivity_keys_that_name_no_differentiable_value_are_refused_where_written(
     .replace("EI = [400.0, 600.0]", &format!("EI = [400.0, 600.0]{mass}"))
     .replace(
         "analysis = \"static\"\nload_steps = 5",
-        "analysis = \"dynamic\"\nintegrator = \"newmark\"\ndt = 0.01\nt_end = 0.1",
+        "analysis = \"dynamic\"\nintegrator = \"momentum\"\ndt = 0.01\nt_end = 0.1",
     );
     let dynamic = parse_model(&dynamic, &path);
     let message = dynamic
         .map(|_| String::new())
         .unwrap_or_else(|e| e.to_string());
-    assert!(message.contains("load-controlled statics"), "{message}");
+    assert!(
+        message.contains("not with the conserving schemes"),
+        "{message}"
+    );
+    assert!(message.contains("key `output.sensitivity`"), "{message}");
 }
 
 #[test]
