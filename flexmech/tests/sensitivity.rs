@@ -348,16 +348,7 @@ fn sensitivity_keys_that_name_no_differentiable_value_are_refused_where_written(
         assert!(message.contains("sensitivity_frame.toml:"), "{message}");
     }
     // Integrators not differentiated yet are refused whole.
-    let mass = "\nrhoA = 1.0\nrhoJ = [0.02, 0.01, 0.01]";
-    let dynamic = (text.replace(
-        "EI = [1000.0, 1000.0]",
-        &format!("EI = [1000.0, 1000.0]{mass}"),
-    ))
-    .replace("EI = [400.0, 600.0]", &format!("EI = [400.0, 600.0]{mass}"))
-    .replace(
-        "analysis = \"static\"\nload_steps = 5",
-        "analysis = \"dynamic\"\nintegrator = \"momentum\"\ndt = 0.01\nt_end = 0.1",
-    );
+    let dynamic = frame_in_dynamics("momentum", false);
     let dynamic = parse_model(&dynamic, &path);
     let message = dynamic
         .map(|_| String::new())
@@ -523,6 +514,25 @@ fn dynamic_sensitivities_of_the_four_bar_equal_central_differences() {
     }
 }
 
+/// The L-frame of data/statics given mass (and, with `gravity`, weight)
+/// and run in dynamics with `integrator` for 0.3 s.
+fn frame_in_dynamics(integrator: &str, gravity: bool) -> String {
+    let mut text = std::fs::read_to_string(data("statics/sensitivity_frame.toml")).unwrap();
+    if gravity {
+        let weight = "\ngravity = [0.0, 0.0, -9.81]\n\n[[section]]";
+        text = text.replacen("\n[[section]]", weight, 1);
+    }
+    let mass = "\nrhoA = 2.0\nrhoJ = [0.02, 0.01, 0.01]";
+    let solver =
+        format!("analysis = \"dynamic\"\nintegrator = \"{integrator}\"\ndt = 0.005\nt_end = 0.3");
+    (text.replace(
+        "EI = [1000.0, 1000.0]",
+        &format!("EI = [1000.0, 1000.0]{mass}"),
+    ))
+    .replace("EI = [400.0, 600.0]", &format!("EI = [400.0, 600.0]{mass}"))
+    .replace("analysis = \"static\"\nload_steps = 5", &solver)
+}
+
 #[test]
 fn dynamic_sensitivities_by_loads_through_a_joint_equal_central_differences() {
     // The L-frame of the static tests given mass and gravity and released
@@ -530,24 +540,8 @@ fn dynamic_sensitivities_by_loads_through_a_joint_equal_central_differences() {
     // joint; derivatives by the tip force, the distributed load, the
     // sections' stiffnesses, the arm's mass (inertia and weight) and the
     // post's rotational inertia.
-    let text = std::fs::read_to_string(data("statics/sensitivity_frame.toml")).unwrap();
-    let text = text.replacen(
-        "\n[[section]]",
-        "\ngravity = [0.0, 0.0, -9.81]\n\n[[section]]",
-        1,
-    );
-    let mass = "\nrhoA = 2.0\nrhoJ = [0.02, 0.01, 0.01]";
-    let text = (text.replace(
-        "EI = [1000.0, 1000.0]",
-        &format!("EI = [1000.0, 1000.0]{mass}"),
-    ))
-    .replace("EI = [400.0, 600.0]", &format!("EI = [400.0, 600.0]{mass}"))
-    .replace(
-        "analysis = \"static\"\nload_steps = 5",
-        "analysis = \"dynamic\"\nintegrator = \"newmark\"\ndt = 0.005\nt_end = 0.3",
-    );
     for integrator in ["newmark", "generalized-alpha"] {
-        let text = text.replace("\"newmark\"", &format!("\"{integrator}\""));
+        let text = frame_in_dynamics(integrator, true);
         let mut model = parse_model(&text, &data("statics/sensitivity_frame.toml")).unwrap();
         let masses = [
             "section.arm.rhoA".to_string(),
