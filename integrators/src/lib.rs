@@ -14,7 +14,7 @@ pub mod dynamics;
 mod element_split;
 pub mod error;
 pub mod free_motion;
-mod joint_parameter;
+pub mod joint_parameter;
 pub mod linsolve;
 pub mod measure;
 pub mod mechanism;

@@ -27,7 +27,7 @@ pub mod midpoint;
 pub mod midpoint_kernels;
 pub mod momentum;
 pub mod newmark;
-mod newmark_sensitivity;
+pub mod newmark_sensitivity;
 mod newmark_terms;
 pub mod simulation;
 mod time_scheme;
