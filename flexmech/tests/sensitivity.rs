@@ -475,6 +475,18 @@ fn dynamic_mismatch(model: &Model) -> Vec<(String, f64, f64)> {
     out
 }
 
+/// The integrators that compute sensitivities.
+const NEWMARK_FAMILY: [&str; 2] = ["newmark", "generalized-alpha"];
+
+/// `file` shortened to `t_end` and differentiated by `keys`, with each of
+/// [`NEWMARK_FAMILY`], within the dynamics' bound.
+fn both_integrators_agree(file: &str, t_end: f64, keys: &[&str]) {
+    for integrator in NEWMARK_FAMILY {
+        let model = dynamic_model(file, t_end, integrator, keys);
+        assert_dynamic_agrees(&model, integrator);
+    }
+}
+
 /// [`dynamic_mismatch`] of `model` (run with `integrator`) within the
 /// dynamics' bound, displacements and energy.
 fn assert_dynamic_agrees(model: &Model, integrator: &str) {
@@ -496,22 +508,18 @@ fn dynamic_sensitivities_of_the_spin_up_equal_central_differences() {
     // the in-plane bending stiffness, for both Newmark-family integrators.
     // (EA moves the tip by ~1e-15 per unit, 1e-11 over the differences'
     // step: at the runs' round-off, no test of anything.)
-    for integrator in ["newmark", "generalized-alpha"] {
-        let keys = ["section.blade.EI[1]"];
-        let model = dynamic_model("benchmarks/spin_up.toml", 2.0, integrator, &keys);
-        assert_dynamic_agrees(&model, integrator);
-    }
+    both_integrators_agree("benchmarks/spin_up.toml", 2.0, &["section.blade.EI[1]"]);
 }
 
 #[test]
 fn dynamic_sensitivities_of_the_four_bar_equal_central_differences() {
     // The four-bar's first 1.5 s through its revolutes and the drive:
     // d(out-of-plane displacement)/d(section stiffness).
-    for integrator in ["newmark", "generalized-alpha"] {
-        let keys = ["section.bar8.EI[0]", "section.bar16.GJ"];
-        let model = dynamic_model("benchmarks/four_bar.toml", 1.5, integrator, &keys);
-        assert_dynamic_agrees(&model, integrator);
-    }
+    both_integrators_agree(
+        "benchmarks/four_bar.toml",
+        1.5,
+        &["section.bar8.EI[0]", "section.bar16.GJ"],
+    );
 }
 
 /// The L-frame of data/statics given mass (and, with `gravity`, weight)
@@ -540,7 +548,7 @@ fn dynamic_sensitivities_by_loads_through_a_joint_equal_central_differences() {
     // joint; derivatives by the tip force, the distributed load, the
     // sections' stiffnesses, the arm's mass (inertia and weight) and the
     // post's rotational inertia.
-    for integrator in ["newmark", "generalized-alpha"] {
+    for integrator in NEWMARK_FAMILY {
         let text = frame_in_dynamics(integrator, true);
         let mut model = parse_model(&text, &data("statics/sensitivity_frame.toml")).unwrap();
         let masses = [
@@ -604,15 +612,15 @@ fn dynamic_sensitivities_by_initial_velocities_through_every_joint_kind() {
     // rigid velocity field per link. Derivatives by the first link's spin,
     // a middle link's velocity (its slave's follows through N) and the
     // links' bending stiffness.
-    for integrator in ["newmark", "generalized-alpha"] {
-        let keys = [
+    both_integrators_agree(
+        "dynamics/free_chain.toml",
+        0.3,
+        &[
             "initial_velocity[0].angular[2]",
             "initial_velocity[4].linear[1]",
             "section.link.EI[0]",
-        ];
-        let model = dynamic_model("dynamics/free_chain.toml", 0.3, integrator, &keys);
-        assert_dynamic_agrees(&model, integrator);
-    }
+        ],
+    );
 }
 
 #[test]
@@ -621,11 +629,11 @@ fn sensitivities_by_an_expression_joints_parameters_equal_central_differences() 
     // at −a x whatever b is), its angle driven through a quarter turn under
     // gravity: d/db in dynamics with both Newmark-family integrators, and in
     // statics (the angle driven by the load factor).
-    for integrator in ["newmark", "generalized-alpha"] {
-        let keys = ["joint.cam.parameters.b", "section.arm.EI[0]"];
-        let model = dynamic_model("examples/expression_cam.toml", 0.5, integrator, &keys);
-        assert_dynamic_agrees(&model, integrator);
-    }
+    both_integrators_agree(
+        "examples/expression_cam.toml",
+        0.5,
+        &["joint.cam.parameters.b", "section.arm.EI[0]"],
+    );
     let path = data("examples/expression_cam.toml");
     let text = std::fs::read_to_string(&path).unwrap();
     let solver = text.find("[solver]").unwrap();
@@ -733,13 +741,13 @@ fn dynamic_sensitivities_by_a_rigid_bodys_mass_and_inertia() {
     // The body pendulum: a rod on a hinge carrying an offset bob, swinging
     // under gravity; derivatives by the bob's mass and its inertia about
     // the hinge's axis, and the rod's initial spin.
-    for integrator in ["newmark", "generalized-alpha"] {
-        let keys = [
+    both_integrators_agree(
+        "dynamics/body_pendulum.toml",
+        0.5,
+        &[
             "rigid_body.bob.mass",
             "rigid_body[0].inertia[2][2]",
             "initial_velocity[0].angular[2]",
-        ];
-        let model = dynamic_model("dynamics/body_pendulum.toml", 0.5, integrator, &keys);
-        assert_dynamic_agrees(&model, integrator);
-    }
+        ],
+    );
 }
