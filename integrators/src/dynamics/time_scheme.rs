@@ -105,6 +105,8 @@ pub(crate) trait TimeScheme: StepTerms + Sized {
         _sens: &mut SchemeSensitivities,
         _fext_end: &[f64],
     ) -> Result<Vec<Sensitivity>, SolveError> {
-        unreachable!("a scheme without sensitivities sets none up")
+        Err(SolveError::InvalidMechanism(
+            "this integrator computes no sensitivities".into(),
+        ))
     }
 }
