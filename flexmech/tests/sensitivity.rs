@@ -751,3 +751,22 @@ fn dynamic_sensitivities_by_a_rigid_bodys_mass_and_inertia() {
         ],
     );
 }
+
+#[test]
+fn a_figures_derivative_key_the_model_cannot_take_is_refused_as_the_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = data("statics/sensitivity_frame.toml");
+    let study = format!(
+        "name = \"bad-derivative\"\nmodel = \"{}\"\n[grid]\n\"section.post.EI[0]\" = [1000.0]\n\
+         [output]\nfigures = [{{ name = \"tip\", dataset = \"/nodes/arm.end/displacement\", \
+         reduce = \"final\", derivative = [\"section.post.EI[3]\"] }}]\n",
+        model.display()
+    );
+    let file = dir.path().join("study.toml");
+    std::fs::write(&file, study).unwrap();
+    let spec = flexmech::studies::load_study(&file).unwrap();
+    let message = spec.run(dir.path().join("out")).unwrap_err().to_string();
+    assert!(message.contains("a figure's `derivative`"), "{message}");
+    assert!(message.contains("section.post.EI[3]"), "{message}");
+    assert!(!message.contains("[grid]"), "{message}");
+}

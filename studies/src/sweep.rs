@@ -2,13 +2,13 @@
 //! model-file text of each run (the base model with the run's values put at
 //! their keys, [`super::key_path`]).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use toml::{Table, Value};
 
 use super::key_path::lookup_mut;
 use super::spec::{RunParams, RunSource, StudySpec};
-use flexmech_model::{parse_model_with, Model};
+use flexmech_model::{parse_model_with, Model, ModelError};
 
 /// One run of a study: its position in grid order and its values.
 #[derive(Debug, Clone, PartialEq)]
@@ -113,6 +113,21 @@ pub enum SweepError {
         /// What the function said.
         message: String,
     },
+    /// A figure's `derivative` key names no value the run's model can be
+    /// differentiated by.
+    #[error(
+        "{}: {run}: a figure's `derivative` (in [output] figures) cannot be taken: {message}; \
+         change the figure's derivative keys",
+        .study.display()
+    )]
+    Derivative {
+        /// The study file.
+        study: PathBuf,
+        /// The run id.
+        run: String,
+        /// Why, in the model's words.
+        message: String,
+    },
     /// The overridden model could not be written back as TOML.
     #[error("{}: {run}: cannot write the overridden model as TOML: {message}", .study.display())]
     Serialize {
@@ -169,19 +184,11 @@ pub fn model_for(spec: &StudySpec, plan: &RunPlan) -> Result<Model, SweepError> 
     match &spec.source {
         RunSource::ModelFile { file, table } => {
             let text = model_text(spec, table, plan)?;
-            let built = parse_model_with(&text, file, &spec.joints)
-                .and_then(|mut m| m.add_sensitivity(&spec.derivative_keys()).map(|_| m))
-                .and_then(|m| flexmech_model::build(&m).map(|_| m));
-            built.map_err(|e| {
-                SweepError::InvalidRun(Box::new(InvalidRun {
-                    study: spec.file.clone(),
-                    run: plan.id.clone(),
-                    overrides: describe_values(spec, plan),
-                    model: file.clone(),
-                    key: e.key().to_owned(),
-                    message: e.message().to_owned(),
-                }))
-            })
+            let mut model = parse_model_with(&text, file, &spec.joints)
+                .map_err(|e| invalid_run(spec, plan, file, &e))?;
+            derivatives(spec, plan, &mut model)?;
+            let built = flexmech_model::build(&model).map(|_| model);
+            built.map_err(|e| invalid_run(spec, plan, file, &e))
         }
         RunSource::Function(build) => {
             let params = RunParams {
@@ -197,9 +204,8 @@ pub fn model_for(spec: &StudySpec, plan: &RunPlan) -> Result<Model, SweepError> 
                 message,
             };
             let mut model = (build.0)(&params).map_err(refuse)?;
-            (model.add_sensitivity(&spec.derivative_keys()))
-                .and_then(|_| flexmech_model::build(&model).map(|_| ()))
-                .map_err(|e| refuse(e.to_string()))?;
+            derivatives(spec, plan, &mut model)?;
+            flexmech_model::build(&model).map_err(|e| refuse(e.to_string()))?;
             let written = model.to_toml();
             model.source_text = format!(
                 "# study `{}`, {} ({overrides}): the model was built by a Rust function; the \
@@ -210,4 +216,27 @@ pub fn model_for(spec: &StudySpec, plan: &RunPlan) -> Result<Model, SweepError> 
             Ok(model)
         }
     }
+}
+
+/// Asks `model` (run `plan`'s) for the derivatives the figures want.
+fn derivatives(spec: &StudySpec, plan: &RunPlan, model: &mut Model) -> Result<(), SweepError> {
+    model
+        .add_sensitivity(&spec.derivative_keys())
+        .map_err(|e| SweepError::Derivative {
+            study: spec.file.clone(),
+            run: plan.id.clone(),
+            message: e.message().to_owned(),
+        })
+}
+
+/// The base `file` with run `plan`'s values refused by the model checks.
+fn invalid_run(spec: &StudySpec, plan: &RunPlan, file: &Path, e: &ModelError) -> SweepError {
+    SweepError::InvalidRun(Box::new(InvalidRun {
+        study: spec.file.clone(),
+        run: plan.id.clone(),
+        overrides: describe_values(spec, plan),
+        model: file.to_path_buf(),
+        key: e.key().to_owned(),
+        message: e.message().to_owned(),
+    }))
 }

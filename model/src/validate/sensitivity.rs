@@ -249,6 +249,8 @@ impl Ctx<'_> {
 
         let why = if matches!(text, "solver.dt" | "solver.t_end") {
             "the step size and the end time are no parameters of the solution".to_string()
+        } else if matches!(table_name, "solver" | "output") {
+            "it is a setting of the solver or the output, no parameter of the solution".to_string()
         } else if let Some(kind) = not_real(value) {
             format!("it is {kind}, not a real number")
         } else {
