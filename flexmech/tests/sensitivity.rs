@@ -644,14 +644,31 @@ fn sensitivities_by_an_expression_joints_parameters_equal_central_differences() 
     )
     .replace("pi*(t - sin(2*pi*t)/(2*pi))", "pi/2*lambda");
     assert_static_agrees(&parse_model(&statics, &path).unwrap());
-    // `a` moves the follower at t = 0: refused where it is written.
-    let refused = statics.replace("parameters.b\"]", "parameters.a\"]");
-    let message = parse_model(&refused, &path).unwrap_err().to_string();
-    assert!(message.contains("moves the slave at t = 0"), "{message}");
+    // `a` moves the follower at t = 0, and with it the arm it carries: the
+    // arm re-placed along −x. Held by a support as well, the arm could not
+    // move rigidly: refused, naming the support.
+    let by_a = statics.replace("parameters.b\"]", "parameters.a\"]");
+    let by_a = parse_model(&by_a, &path).unwrap();
+    for (displacement, energy) in replaced_mismatch(&by_a, &["arm"], |_| [-1.0, 0.0, 0.0]) {
+        assert!(
+            displacement < AGREE && energy < AGREE,
+            "{displacement:e} {energy:e}"
+        );
+    }
+    let held = statics.replace("parameters.b\"]", "parameters.a\"]")
+        + "[[support]]\nnode = \"arm.end\"\nfixed = [\"uz\"]\n";
+    let mut memory = Memory::default();
+    let message = run(&parse_model(&held, &path).unwrap(), &mut memory)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("moves the slave at t = 0") && message.contains("support of `arm.end`"),
+        "{message}"
+    );
 }
 
 #[test]
-fn sensitivities_by_the_parameter_of_a_free_expression_joint_in_statics() {
+fn sensitivities_by_the_parameter_of_a_free_joint_in_statics_and_dynamics() {
     // A screw written as an expression, f(ψ) = (0, 0, c ψ), between a
     // clamped post and an arm whose far end is held sideways: the twist
     // of the joint is found by equilibrium (its ψ is an unknown), so the
@@ -704,6 +721,70 @@ track = ["arm.end", "arm.start"]
 sensitivity = ["joint.screw.parameters.c", "section.rod.GJ"]
 "#;
     assert_static_agrees(&parse_model(text, std::path::Path::new("free_screw.toml")).unwrap());
+    // The same in dynamics as the built-in screw, the load applied at once
+    // to the arm given mass, with the pitch (through the free angle's
+    // equation and its initial acceleration) and the rack-and-pinion's
+    // radius (which re-places the arm at t = 0 along t_r × t = −y).
+    let dynamic = |joint: &str, key: &str, integrator: &str| {
+        let text = text
+            .replace(
+                "start = [0.0, 0.0, 1.0]\nend = [1.0, 0.0, 1.0]",
+                if joint.contains("rack") {
+                    // The pinion's centre sits b (t_r × t) = −0.1 y off the rack.
+                    "start = [0.0, -0.1, 1.0]\nend = [1.0, -0.1, 1.0]"
+                } else {
+                    "start = [0.0, 0.0, 1.0]\nend = [1.0, 0.0, 1.0]"
+                },
+            )
+            .replace(
+                "[[support]]\nnode = \"arm.end\"\nfixed = [\"uy\"]\n",
+                // The radius re-places the arm, which a support would hold.
+                if joint.contains("rack") {
+                    ""
+                } else {
+                    "[[support]]\nnode = \"arm.end\"\nfixed = [\"uy\"]\n"
+                },
+            )
+            .replace(
+                "GJ = 800.0",
+                "GJ = 800.0\nrhoA = 2.0\nrhoJ = [0.02, 0.01, 0.01]",
+            )
+            .replace("type = \"expression\"", joint)
+            .replace(
+                "translation = [\"0\", \"0\", \"c*psi\"]\nparameters = { c = 0.3 }\n",
+                "",
+            )
+            .replace("force = [0.0, 40.0, -30.0]", "force = [0.0, 4.0, -3.0]")
+            .replace(
+                "analysis = \"static\"\nload_steps = 4",
+                &format!(
+                    "analysis = \"dynamic\"\nintegrator = \"{integrator}\"\ndt = 0.01\n\
+                     t_end = 0.3\nmax_halvings = 0"
+                ),
+            )
+            .replace("[\"joint.screw.parameters.c\", \"section.rod.GJ\"]", key);
+        parse_model(&text, std::path::Path::new("free_screw.toml")).unwrap()
+    };
+    for integrator in NEWMARK_FAMILY {
+        let screw = dynamic(
+            "type = \"screw\"\npitch = 0.3",
+            "[\"joint.screw.pitch\"]",
+            integrator,
+        );
+        for (d, e) in replaced_mismatch(&screw, &["arm"], |_| [0.0; 3]) {
+            assert!(d < AGREE_DYNAMICS, "{integrator}: {d:e}");
+            assert!(e < AGREE_DYNAMICS, "{integrator}: energy {e:e}");
+        }
+        let rack = dynamic(
+            "type = \"rack_pinion\"\nradius = 0.1\nslide = [1.0, 0.0, 0.0]",
+            "[\"joint.screw.radius\"]",
+            integrator,
+        );
+        for (d, e) in replaced_mismatch(&rack, &["arm"], |_| [0.0, -1.0, 0.0]) {
+            assert!(d < AGREE_DYNAMICS, "{integrator}: {d:e}");
+            assert!(e < AGREE_DYNAMICS, "{integrator}: energy {e:e}");
+        }
+    }
 }
 
 /// The last step's exact derivatives of the tracked nodes against central
@@ -769,4 +850,139 @@ fn a_figures_derivative_key_the_model_cannot_take_is_refused_as_the_figures() {
     assert!(message.contains("a figure's `derivative`"), "{message}");
     assert!(message.contains("section.post.EI[3]"), "{message}");
     assert!(!message.contains("[grid]"), "{message}");
+}
+
+/// `model` with the value at `key` scaled by `1 + h` and the beams
+/// `carried` translated by `direction` times the value's change: the model a
+/// researcher writes by hand to change a value that moves a joint's slave
+/// at t = 0 (e.g. a cam's offset moves the follower and the arm on it).
+fn replaced_model(
+    model: &Model,
+    key: &str,
+    h: f64,
+    carried: &[&str],
+    direction: [f64; 3],
+) -> Model {
+    let (moved, v) = perturbed_model(model, key, h);
+    let mut table: toml::Table = toml::from_str(&moved.to_toml()).unwrap();
+    for beam in table["beam"].as_array_mut().unwrap() {
+        let beam = beam.as_table_mut().unwrap();
+        if !carried.contains(&beam["name"].as_str().unwrap()) {
+            continue;
+        }
+        for end in ["start", "end"] {
+            for (c, x) in beam[end].as_array_mut().unwrap().iter_mut().enumerate() {
+                *x = toml::Value::Float(x.as_float().unwrap() + direction[c] * v * h);
+            }
+        }
+    }
+    parse_model(&toml::to_string(&table).unwrap(), &model.path).unwrap()
+}
+
+/// Every kept step's exact displacement derivatives of the tracked nodes
+/// against central differences of [`replaced_model`]'s displacements (each
+/// run's positions less its own initial ones), and the energy's: the
+/// largest differences over the largest derivatives. `direction` gives each
+/// key's `dX/dp` of the carried beams (zero for a key that moves no slave).
+fn replaced_mismatch(
+    model: &Model,
+    carried: &[&str],
+    direction: impl Fn(&str) -> [f64; 3],
+) -> Vec<(f64, f64)> {
+    let built = build(model).unwrap();
+    let tracked: Vec<usize> = (model.output.track.iter())
+        .map(|(_, r)| built.node(*r))
+        .collect();
+    let records = |m: &Model| {
+        let mut memory = Memory::default();
+        run(m, &mut memory).unwrap();
+        assert_eq!(memory.status(), "completed");
+        let x0 = build(m).unwrap().mechanism.mesh.positions;
+        (memory.records, x0)
+    };
+    let (exact, _) = records(model);
+    let mut quiet = model.clone();
+    quiet.output.sensitivity.clear();
+    let mut out = Vec::new();
+    for (k, (key, _)) in model.output.sensitivity.iter().enumerate() {
+        let run_at = |h| records(&replaced_model(&quiet, key, h, carried, direction(key)));
+        let ((plus, x_plus), (minus, x_minus)) = (run_at(STEP), run_at(-STEP));
+        assert_eq!(plus.len(), exact.len(), "{key}: the same steps");
+        let (_, v) = perturbed_model(&quiet, key, 0.0);
+        let dp = 2.0 * STEP * v;
+        let (mut d_exact, mut d_fd, mut e_exact, mut e_fd) = (vec![], vec![], vec![], vec![]);
+        for ((rec, p), m) in exact.iter().zip(&plus).zip(&minus) {
+            for &n in &tracked {
+                d_exact.push(rec.sensitivities[k].displacement[n]);
+                d_fd.push([0, 1, 2].map(|c| {
+                    let (up, down) = (
+                        p.positions[n][c] - x_plus[n][c],
+                        m.positions[n][c] - x_minus[n][c],
+                    );
+                    (up - down) / dp
+                }));
+            }
+            e_exact.push([rec.sensitivities[k].energy, 0.0, 0.0]);
+            e_fd.push([(p.energy.total - m.energy.total) / dp, 0.0, 0.0]);
+        }
+        out.push((mismatch(&d_exact, &d_fd), mismatch(&e_exact, &e_fd)));
+    }
+    out
+}
+
+#[test]
+fn the_driven_cams_lift_by_its_offset_and_radius_in_dynamics() {
+    // The paper's eccentric cam (data/paper/cam.toml) spun up from rest for
+    // 0.4 s: d/d(offset a) — which moves the follower at t = 0, so the arm
+    // riding on it is re-placed with it along −t_r = −x — and d/d(radius R),
+    // which does not (f(ψ₀) = −a t_r), with both Newmark-family integrators.
+    for integrator in NEWMARK_FAMILY {
+        let model = dynamic_model(
+            "paper/cam.toml",
+            0.4,
+            integrator,
+            &["joint.cam.offset", "joint.cam.radius"],
+        );
+        for (k, (displacement, energy)) in replaced_mismatch(&model, &["arm"], offset_moves_x)
+            .into_iter()
+            .enumerate()
+        {
+            assert!(
+                displacement < AGREE_DYNAMICS,
+                "{integrator} {k}: {displacement:e}"
+            );
+            assert!(
+                energy < AGREE_DYNAMICS,
+                "{integrator} {k}: energy {energy:e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_driven_cam_in_statics_by_its_offset_and_radius() {
+    // data/statics/cam_driven.toml (two turns of a driven cam with a dead
+    // tip load on the arm it carries), shortened to 10 steps: d/d(offset)
+    // with the arm re-placed along −x, d/d(radius), within the statics' bound.
+    let path = data("statics/cam_driven.toml");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("load_steps = 80", "load_steps = 10")
+        .replace("tolerance = 1e-10", "tolerance = 1e-12");
+    let text = format!("{text}sensitivity = [\"joint.drive.offset\", \"joint.drive.radius\"]\n");
+    let model = parse_model(&text, &path).unwrap();
+    for (displacement, energy) in replaced_mismatch(&model, &["arm"], offset_moves_x) {
+        assert!(displacement < AGREE, "{displacement:e}");
+        assert!(energy < AGREE, "energy {energy:e}");
+    }
+}
+
+/// The cams' `dX/dp` of the carried arm: `−t_r = −x` by the offset, none by
+/// the radius (`f(ψ₀) = −a t_r` at ψ₀ = 0).
+fn offset_moves_x(key: &str) -> [f64; 3] {
+    if key.ends_with("offset") {
+        [-1.0, 0.0, 0.0]
+    } else {
+        [0.0; 3]
+    }
 }

@@ -16,6 +16,18 @@
 //! with `F` the force on the slave and the nodes placed from it. `∂g/∂x · δ`
 //! is the elements' exact tangent (and, in dynamics, the inertia's) applied
 //! to the shift; the nodes' positions change by `T dq/dp + δ`.
+//!
+//! A parameter with `∂f/∂p(ψ₀) ≠ 0` also moves the slave at t = 0, where
+//! the model places it. The derivative is then that of the model whose
+//! **carried body** — the slave and every node joined to it by elements and
+//! other joints, this joint cut — is re-placed rigidly with it by
+//! `δ₀ = R_m ∂f/∂p(ψ₀)` ([`StartShift`]): what a researcher does by hand to
+//! change a cam's offset (move the follower's beams with it). A rigid
+//! translation leaves the carried elements' strains, masses and dead loads
+//! as they were, so the body's positions start at `dx₀/dp = δ₀` and its
+//! displacements are `dx/dp − δ₀`. A carried body that also reaches the
+//! master, a support or a prescribed motion cannot move rigidly; such a
+//! parameter is refused.
 
 use nalgebra::Vector3;
 
@@ -70,27 +82,6 @@ impl JointShift {
         })
     }
 
-    /// Refuses a parameter that moves the slave at the start: a model file
-    /// places its slaves once, at t = 0, so such a change has no run to
-    /// differentiate.
-    pub(crate) fn check_start(
-        &self,
-        mech: &Mechanism,
-        joint: usize,
-        name: &str,
-    ) -> Result<(), SolveError> {
-        if self.delta.norm() > START_SHIFT * mech.size_at(&mech.mesh.positions).max(1.0) {
-            return Err(SolveError::InvalidMechanism(format!(
-                "joint `{}`: changing `{name}` moves the slave at t = 0 (∂f/∂{name} = {:?} at \
-                 the initial angle), which a model cannot follow (its slave is placed in the \
-                 file); differentiate by a parameter that leaves f(ψ₀) unchanged",
-                mech.joints[joint].name,
-                [self.delta.x, self.delta.y, self.delta.z]
-            )));
-        }
-        Ok(())
-    }
-
     /// Adds `∂g/∂x · δ` of the elements at `config` to the nodal `g`
     /// (and `c M δ` when `inertia` gives the mass and `∂q̈/∂x`).
     pub(crate) fn add_stiffness(
@@ -140,11 +131,21 @@ impl JointShift {
         let force: Vector3<f64> = (self.nodes.iter())
             .map(|&n| Vector3::new(g[6 * n], g[6 * n + 1], g[6 * n + 2]))
             .sum();
-        let moment = self.delta.cross(&force);
+        self.add_transfer_of(&force, out)
+    }
+
+    /// [`Self::add_transfer`] for the total translational force `force` on
+    /// the moved nodes.
+    pub(crate) fn add_transfer_of(
+        &self,
+        force: &Vector3<f64>,
+        out: &mut [f64],
+    ) -> Option<(usize, f64)> {
+        let moment = self.delta.cross(force);
         for c in 0..3 {
             out[6 * self.master + 3 + c] += moment[c];
         }
-        self.psi_eq.map(|eq| (eq, self.slope.dot(&force)))
+        self.psi_eq.map(|eq| (eq, self.slope.dot(force)))
     }
 
     /// The shift of node `n` (zero off the moved nodes).
@@ -168,4 +169,112 @@ fn placed_from(mech: &Mechanism, topo: &Topology, slave: usize) -> Vec<usize> {
         }
     }
     nodes
+}
+
+/// The rigid re-placement at t = 0 of the body a joint parameter carries
+/// (module docs): the carried nodes and `δ₀ = R_m ∂f/∂p(ψ₀)` (none when the
+/// parameter leaves the slave where it is).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct StartShift {
+    nodes: Vec<usize>,
+    delta: Vector3<f64>,
+}
+
+impl StartShift {
+    /// The re-placement by parameter `name` of joint `joint` at the initial
+    /// `state`; refused where the carried body is held otherwise.
+    pub(crate) fn new(
+        mech: &Mechanism,
+        topo: &Topology,
+        state: &MechanismState,
+        joint: usize,
+        name: &str,
+    ) -> Result<Self, SolveError> {
+        let shift = JointShift::at(mech, topo, state, joint, name)?;
+        if shift.delta.norm() <= START_SHIFT * mech.size_at(&mech.mesh.positions).max(1.0) {
+            return Ok(Self::default());
+        }
+        Ok(Self {
+            nodes: carried_body(mech, joint, name)?,
+            delta: shift.delta,
+        })
+    }
+
+    /// `dX/dp` of node `n`'s initial position.
+    pub(crate) fn of(&self, n: usize) -> Vector3<f64> {
+        if self.nodes.contains(&n) {
+            self.delta
+        } else {
+            Vector3::zeros()
+        }
+    }
+
+    /// The carried nodes (none without a shift).
+    pub(crate) fn nodes(&self) -> &[usize] {
+        &self.nodes
+    }
+
+    /// `Σ f·δ₀` over the carried nodes' translations of the nodal `f`.
+    pub(crate) fn work(&self, f: &[f64]) -> f64 {
+        (self.nodes.iter())
+            .map(|&n| Vector3::new(f[6 * n], f[6 * n + 1], f[6 * n + 2]).dot(&self.delta))
+            .sum()
+    }
+}
+
+/// The body joint `joint` carries: the nodes reached from its slave through
+/// elements and the other joints. Refused with `name` where it reaches the
+/// master, a support or a prescribed motion (it could not move rigidly).
+fn carried_body(mech: &Mechanism, joint: usize, name: &str) -> Result<Vec<usize>, SolveError> {
+    let n = mech.mesh.node_count();
+    let mut links: Vec<Vec<usize>> = vec![Vec::new(); n];
+    let mut link = |a: usize, b: usize| {
+        links[a].push(b);
+        links[b].push(a);
+    };
+    for e in &mech.mesh.elements {
+        let nodes = e.nodes();
+        for w in nodes.windows(2) {
+            link(w[0], w[1]);
+        }
+    }
+    for (k, j) in mech.joints.iter().enumerate() {
+        if k != joint {
+            link(j.master, j.slave);
+        }
+    }
+    let j = &mech.joints[joint];
+    let (mut body, mut next) = (vec![j.slave], 0);
+    while next < body.len() {
+        for &m in &links[body[next]] {
+            if !body.contains(&m) {
+                body.push(m);
+            }
+        }
+        next += 1;
+    }
+    let held = (body.iter().copied()).find_map(|m| {
+        let label = || match mech.names.nodes.get(m) {
+            Some(l) if !l.is_empty() => l.clone(),
+            _ => format!("node {m}"),
+        };
+        if m == j.master {
+            Some(format!("the joint's master `{}`", label()))
+        } else if mech.fixed[m].iter().any(|&f| f) {
+            Some(format!("the support of `{}`", label()))
+        } else if mech.prescribed.iter().any(|p| p.node == m) {
+            Some(format!("the prescribed motion of `{}`", label()))
+        } else {
+            None
+        }
+    });
+    match held {
+        None => Ok(body),
+        Some(what) => Err(SolveError::InvalidMechanism(format!(
+            "joint `{}`: changing `{name}` moves the slave at t = 0, and the body it carries \
+             would move rigidly with it, but that body is also held by {what}: differentiate \
+             by a parameter that leaves f(ψ₀) unchanged, or free the body",
+            j.name
+        ))),
+    }
 }

@@ -37,7 +37,7 @@ use nalgebra::Vector3;
 use std::ops::AddAssign;
 
 use crate::error::SolveError;
-use crate::joint_parameter::JointShift;
+use crate::joint_parameter::{JointShift, StartShift};
 use crate::linsolve::SparseLu;
 use crate::mechanism::{nodal_weights, Mechanism};
 use crate::record::Sensitivity;
@@ -157,6 +157,20 @@ impl Parameter {
                 JointShift::at(sys.mech, &sys.topo, &sys.end, *joint, name).map(Some)
             }
             _ => Ok(None),
+        }
+    }
+
+    /// Its re-placement of a carried body at the start state of `sys`
+    /// ([`StartShift`]; none but for joint parameters).
+    pub(crate) fn start_shift<T: StepTerms>(
+        &self,
+        sys: &ReducedSystem<'_, T>,
+    ) -> Result<StartShift, SolveError> {
+        match self {
+            Parameter::Joint { joint, name } => {
+                StartShift::new(sys.mech, &sys.topo, &sys.end, *joint, name)
+            }
+            _ => Ok(StartShift::default()),
         }
     }
 
@@ -338,6 +352,8 @@ fn with_unit_stiffness(element: &Element, component: usize) -> Element {
 /// factorisation of the converged tangent.
 pub(crate) struct StaticSensitivities {
     params: Vec<Parameter>,
+    /// Per parameter, its re-placement of a carried body at the start.
+    starts: Vec<StartShift>,
     lu: SparseLu,
     nodal: Vec<f64>,
 }
@@ -348,6 +364,7 @@ impl StaticSensitivities {
         sys: &ReducedSystem<'_, T>,
         params: &[Parameter],
     ) -> Result<Self, SolveError> {
+        let mut starts = Vec::with_capacity(params.len());
         for p in params {
             p.check(sys.mech)?;
             if let Parameter::InitialMotion { .. } = p {
@@ -355,14 +372,12 @@ impl StaticSensitivities {
                     "a static analysis has no initial motion to differentiate by".into(),
                 ));
             }
-            if let Parameter::Joint { joint, name } = p {
-                JointShift::at(sys.mech, &sys.topo, &sys.end, *joint, name)?
-                    .check_start(sys.mech, *joint, name)?;
-            }
+            starts.push(p.start_shift(sys)?);
         }
         let lu = SparseLu::new(sys.asm.pattern().clone()).map_err(SolveError::Singular)?;
         Ok(Self {
             params: params.to_vec(),
+            starts,
             lu,
             nodal: vec![0.0; 6 * sys.mech.mesh.node_count()],
         })
@@ -383,7 +398,7 @@ impl StaticSensitivities {
             |why| SolveError::InvalidMechanism(format!("sensitivities at λ = {lambda}: {why}"));
         self.lu.factor(&sys.asm.values).map_err(failed)?;
         let mut out = Vec::with_capacity(self.params.len());
-        for p in &self.params {
+        for (p, start) in self.params.iter().zip(&self.starts) {
             let partial = p.nodal_derivative(sys.mech, &sys.end.config, lambda, &mut self.nodal);
             let shift = p.shift(sys)?;
             let psi = shift.as_ref().and_then(|s| {
@@ -397,18 +412,21 @@ impl StaticSensitivities {
             }
             dq.iter_mut().for_each(|v| *v = -*v);
             self.lu.solve(&mut dq).map_err(failed)?;
-            out.push(sensitivity_of(sys, &dq, shift.as_ref(), partial));
+            let partial = partial + start.work(&sys.fext);
+            out.push(sensitivity_of(sys, &dq, shift.as_ref(), start, partial));
         }
         Ok(out)
     }
 }
 
-/// The nodes' `dx/dp` and the total energy's `dE/dp` (module docs) for the
-/// reduced `dq = dq/dp`, with `partial = ∂E/∂p`.
+/// The nodes' `d(x − X)/dp` and the total energy's `dE/dp` (module docs)
+/// for the reduced `dq = dq/dp`, with `partial = ∂E/∂p` (`start`: the
+/// initial positions' `dX/dp`).
 fn sensitivity_of<T: StepTerms>(
     sys: &ReducedSystem<'_, T>,
     dq: &[f64],
     shift: Option<&JointShift>,
+    start: &StartShift,
     partial: f64,
 ) -> Sensitivity {
     let mut energy = partial;
@@ -426,6 +444,7 @@ fn sensitivity_of<T: StepTerms>(
                     energy -= sys.fext[6 * n + c] * d[c];
                 }
             }
+            let d = d.fixed_rows::<3>(0) - start.of(n);
             [d[0], d[1], d[2]]
         })
         .collect();

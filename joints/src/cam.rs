@@ -2,7 +2,7 @@
 //! along `t_r` by `f(ψ) = (R cos ψ − R − a) t_r`; `a` and `2R + a` are the
 //! smallest and largest released displacements.
 
-use crate::dependent::DependentJoint;
+use crate::dependent::{parameter_slopes, DependentJoint};
 use crate::model_joint::{direction, perpendicular_slide, positive, ModelJoint, ParamError};
 use flexmech_core::{cst, Scalar};
 use nalgebra::Vector3;
@@ -27,8 +27,28 @@ impl DependentJoint for Cam {
     }
 
     fn translation<T: Scalar>(&self, psi: T) -> Vector3<T> {
-        let r = cst::<T>(self.radius);
-        self.slide.map(cst::<T>) * (r * psi.cos() - r - cst::<T>(self.offset))
+        self.lift(psi, cst(self.radius), cst(self.offset))
+    }
+
+    /// By `radius` or `offset` (exact, hyper-dual).
+    fn translation_by(&self, name: &str, psi: f64) -> Option<[Vector3<f64>; 2]> {
+        let (r, a) = (cst(self.radius), cst(self.offset));
+        match name {
+            "radius" => Some(parameter_slopes(psi, self.radius, |psi, r| {
+                self.lift(psi, r, a)
+            })),
+            "offset" => Some(parameter_slopes(psi, self.offset, |psi, a| {
+                self.lift(psi, r, a)
+            })),
+            _ => None,
+        }
+    }
+}
+
+impl Cam {
+    /// `f(ψ) = (R cos ψ − R − a) t_r` for the eccentricity `R` and offset `a`.
+    fn lift<T: Scalar>(&self, psi: T, r: T, a: T) -> Vector3<T> {
+        self.slide.map(cst::<T>) * (r * psi.cos() - r - a)
     }
 }
 

@@ -44,7 +44,7 @@ use crate::ReleasedState;
 use flexmech_core::rotation::{cayley_mid, skew};
 use flexmech_core::Scalar;
 use nalgebra::{Matrix3, SMatrix, Vector3};
-use num_dual::{Dual2_64, Dual64};
+use num_dual::{Dual2_64, Dual64, HyperDual64};
 use std::fmt::Debug;
 
 /// A joint with one released rotation `ψ` about the axis `t` (master body
@@ -61,6 +61,22 @@ pub trait DependentJoint: Send + Sync + Debug {
     fn translation_by(&self, _name: &str, _psi: f64) -> Option<[Vector3<f64>; 2]> {
         None
     }
+}
+
+/// `[∂f/∂p, ∂²f/∂ψ∂p]` at `(ψ, p)` of a translation `f(ψ; p)` written
+/// once for any scalar: `f` is evaluated in hyper-dual numbers with `ψ`
+/// seeded in the first direction and `p` in the second, so both come exact
+/// (the kinds' [`DependentJoint::translation_by`]).
+pub fn parameter_slopes(
+    psi: f64,
+    p: f64,
+    f: impl Fn(HyperDual64, HyperDual64) -> Vector3<HyperDual64>,
+) -> [Vector3<f64>; 2] {
+    let v = f(
+        HyperDual64::new(psi, 1.0, 0.0, 0.0),
+        HyperDual64::new(p, 0.0, 1.0, 0.0),
+    );
+    [v.map(|x| x.eps2), v.map(|x| x.eps1eps2)]
 }
 
 impl<J: DependentJoint> JointKinematics for J {

@@ -22,12 +22,11 @@
 
 use std::collections::BTreeMap;
 
-use crate::dependent::DependentJoint;
+use crate::dependent::{parameter_slopes, DependentJoint};
 use crate::model_joint::{direction, ModelJoint, ParamError};
 use flexmech_core::expr::{reserved, Expression};
 use flexmech_core::Scalar;
 use nalgebra::Vector3;
-use num_dual::HyperDual64;
 use serde::Deserialize;
 
 /// A dependent joint whose `f(ψ)` is three parsed expressions of `psi`.
@@ -54,16 +53,13 @@ impl DependentJoint for ExpressionJoint {
     fn translation_by(&self, name: &str, psi: f64) -> Option<[Vector3<f64>; 2]> {
         let k = self.translation[0].parameter(name)?;
         let value = self.translation[0].parameter_value(k);
-        let psi = HyperDual64::new(psi, 1.0, 0.0, 0.0);
-        let p = HyperDual64::new(value, 0.0, 1.0, 0.0);
-        let f = self
-            .translation
-            .each_ref()
-            .map(|e| e.eval_seeded(psi, k, p));
-        Some([
-            Vector3::from_fn(|i, _| f[i].eps2),
-            Vector3::from_fn(|i, _| f[i].eps1eps2),
-        ])
+        Some(parameter_slopes(psi, value, |psi, p| {
+            let [x, y, z] = self
+                .translation
+                .each_ref()
+                .map(|e| e.eval_seeded(psi, k, p));
+            Vector3::new(x, y, z)
+        }))
     }
 }
 

@@ -32,7 +32,7 @@ pub mod spherical;
 
 pub use cam::Cam;
 pub use cylindrical::Cylindrical;
-pub use dependent::{DependentJoint, DependentJointMaps};
+pub use dependent::{parameter_slopes, DependentJoint, DependentJointMaps};
 pub use expression::ExpressionJoint;
 pub use incremental::JointStep;
 pub use joint_map::JointMap;

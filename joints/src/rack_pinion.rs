@@ -3,7 +3,7 @@
 //! `f(ψ) = b (t_r × t) + b ψ t_r` — the constant term places the pinion's
 //! center at distance `b` from the rack.
 
-use crate::dependent::DependentJoint;
+use crate::dependent::{parameter_slopes, DependentJoint};
 use crate::model_joint::{direction, perpendicular_slide, positive, ModelJoint, ParamError};
 use flexmech_core::{cst, Scalar};
 use nalgebra::Vector3;
@@ -26,7 +26,18 @@ impl DependentJoint for RackPinion {
     }
 
     fn translation<T: Scalar>(&self, psi: T) -> Vector3<T> {
-        let b = cst::<T>(self.radius);
+        self.rolled(psi, cst(self.radius))
+    }
+
+    /// By `radius` (exact, hyper-dual).
+    fn translation_by(&self, name: &str, psi: f64) -> Option<[Vector3<f64>; 2]> {
+        (name == "radius").then(|| parameter_slopes(psi, self.radius, |psi, b| self.rolled(psi, b)))
+    }
+}
+
+impl RackPinion {
+    /// `f(ψ) = b (t_r × t) + b ψ t_r` for the radius `b`.
+    fn rolled<T: Scalar>(&self, psi: T, b: T) -> Vector3<T> {
         self.slide.cross(&self.axis).map(cst::<T>) * b + self.slide.map(cst::<T>) * (b * psi)
     }
 }

@@ -1,7 +1,7 @@
 //! Screw joint (paper eq. 12 with `t_r = t`): the slave advances along the
 //! axis by the pitch times the angle, `f(ψ) = c ψ t` (`c`: advance per radian).
 
-use crate::dependent::DependentJoint;
+use crate::dependent::{parameter_slopes, DependentJoint};
 use crate::model_joint::{direction, ModelJoint, ParamError};
 use flexmech_core::{cst, Scalar};
 use nalgebra::Vector3;
@@ -22,7 +22,19 @@ impl DependentJoint for Screw {
     }
 
     fn translation<T: Scalar>(&self, psi: T) -> Vector3<T> {
-        self.axis.map(cst::<T>) * (psi * cst::<T>(self.pitch))
+        self.advance(psi, cst(self.pitch))
+    }
+
+    /// By `pitch` (exact, hyper-dual).
+    fn translation_by(&self, name: &str, psi: f64) -> Option<[Vector3<f64>; 2]> {
+        (name == "pitch").then(|| parameter_slopes(psi, self.pitch, |psi, c| self.advance(psi, c)))
+    }
+}
+
+impl Screw {
+    /// `f(ψ) = c ψ t` for the pitch `c`.
+    fn advance<T: Scalar>(&self, psi: T, pitch: T) -> Vector3<T> {
+        self.axis.map(cst::<T>) * (psi * pitch)
     }
 }
 

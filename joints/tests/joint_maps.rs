@@ -1449,3 +1449,59 @@ fn incremental_transfer_derivative_matches_differences() {
         },
     );
 }
+
+#[test]
+fn parameter_slopes_match_the_closed_forms() {
+    // ∂f/∂p and ∂²f/∂ψ∂p of the built-in kinds' real parameters, by hyper-dual
+    // AD, against the derivatives of paper eqs 12–14 written by hand.
+    property(
+        "9. ∂f/∂p, ∂²f/∂ψ∂p of screw, rack-and-pinion, cam, rel. 1 + |ψ|",
+        CASES,
+        (params(), released()),
+        |(p, q), w| {
+            let psi = q.psi;
+            let screw = Screw {
+                axis: p.axis,
+                pitch: p.pitch,
+            };
+            let rack = RackPinion {
+                axis: p.axis,
+                slide: p.perp,
+                radius: p.pinion,
+            };
+            let cam = Cam {
+                axis: p.axis,
+                slide: p.perp,
+                radius: p.cam_r,
+                offset: p.cam_a,
+            };
+            let t_r = p.perp;
+            let cases: [(&dyn Fn() -> Option<[Vector3<f64>; 2]>, [Vector3<f64>; 2]); 4] = [
+                (
+                    &|| screw.translation_by("pitch", psi),
+                    [p.axis * psi, p.axis],
+                ),
+                (
+                    &|| rack.translation_by("radius", psi),
+                    [t_r.cross(&p.axis) + t_r * psi, t_r],
+                ),
+                (
+                    &|| cam.translation_by("radius", psi),
+                    [t_r * (psi.cos() - 1.0), -t_r * psi.sin()],
+                ),
+                (
+                    &|| cam.translation_by("offset", psi),
+                    [-t_r, Vector3::zeros()],
+                ),
+            ];
+            let scale = 1.0 + psi.abs();
+            for (k, (ad, [f_p, f_psi_p])) in cases.into_iter().enumerate() {
+                let [a, b] = ad().ok_or_else(|| TestCaseError::fail("no slope"))?;
+                let err = (a - f_p).norm().max((b - f_psi_p).norm());
+                w.bounded(&format!("kind {k}"), err, scale, 16.0 * EPS * scale)?;
+            }
+            prop_assert!(cam.translation_by("axis", psi).is_none());
+            Ok(())
+        },
+    );
+}

@@ -22,6 +22,7 @@ pub mod checkpoint;
 pub mod energy_momentum;
 pub mod energy_momentum_paper;
 pub mod generalized_alpha;
+mod joint_start;
 mod mass_slots;
 pub mod midpoint;
 pub mod midpoint_kernels;

@@ -27,10 +27,11 @@
 use nalgebra::{Matrix3, Vector3};
 use num_dual::Dual64;
 
+use super::joint_start::JointStart;
 use super::newmark_terms::{initial_accelerations, Coefficients, NewmarkTerms};
 use super::slave_velocities;
 use crate::error::SolveError;
-use crate::joint_parameter::JointShift;
+use crate::joint_parameter::{JointShift, StartShift};
 use crate::linsolve::SparseLu;
 use crate::record::Sensitivity;
 use crate::sensitivity::{mass_derivative, Parameter};
@@ -111,6 +112,8 @@ pub(crate) struct NewmarkSensitivities {
     params: Vec<Parameter>,
     /// Per parameter, `∂M/∂p` and `∂J/∂p` of a mass parameter.
     units: Vec<Option<Inertia>>,
+    /// Per parameter, its re-placement of a carried body at t = 0.
+    starts: Vec<StartShift>,
     /// The sensitivities of the state at t = 0.
     pub(crate) initial: Vec<Sensitivity>,
     lu: SparseLu,
@@ -142,6 +145,7 @@ impl NewmarkSensitivities {
         let mut lu = SparseLu::new(sys.asm.pattern().clone()).map_err(SolveError::Singular)?;
         let mut nodal = vec![0.0; 6 * nodes];
         let mut history = Vec::with_capacity(params.len());
+        let mut starts = Vec::with_capacity(params.len());
         let units: Vec<Option<Inertia>> = (params.iter())
             .map(|p| mass_derivative(mech, p, kind))
             .collect();
@@ -159,7 +163,14 @@ impl NewmarkSensitivities {
                     }
                 }
             }
-            let (a, alpha) = initial_accelerations(
+            let joint = match p {
+                Parameter::Joint { joint, name } => {
+                    Some(JointStart::new(sys, &mut lu, *joint, name)?)
+                }
+                _ => None,
+            };
+            let extra = joint.as_ref().and_then(|j| j.add_forces(sys, &mut nodal));
+            let (a, alpha, _) = initial_accelerations(
                 mech,
                 &sys.topo,
                 &sys.terms.inertia,
@@ -167,15 +178,18 @@ impl NewmarkSensitivities {
                 &mut lu,
                 &sys.end,
                 &nodal,
+                extra,
             );
             (h.a, h.acc, h.alpha, h.ang_acc) = (a.clone(), a, alpha.clone(), alpha);
             if let Parameter::InitialMotion { motion } = p {
                 (h.v, h.w) = slave_velocities(mech, &sys.topo, &sys.end, motion);
             }
-            if let Parameter::Joint { joint, name } = p {
-                joint_start(sys, *joint, name, &mut h)?;
+            let start = p.start_shift(sys)?;
+            if let Some(joint) = &joint {
+                joint_history(sys, joint, &start, &mut h)?;
             }
             history.push(h);
+            starts.push(start);
         }
         let (v0, w0) = (&sys.terms.prev.v, &sys.terms.prev.w);
         let initial = (history.iter().zip(&units))
@@ -189,6 +203,7 @@ impl NewmarkSensitivities {
         Ok(Self {
             params: params.to_vec(),
             units,
+            starts,
             initial,
             lu,
             history,
@@ -225,26 +240,36 @@ impl NewmarkSensitivities {
                 unit_inertial_forces(sys, unit, &mut self.nodal);
             }
             let shift = self.params[k].shift(sys)?;
-            if let Some(s) = &shift {
+            let psi = shift.as_ref().and_then(|s| {
                 let kc = &sys.terms.coefficients;
                 let dt = sys.terms.dt;
                 let c = (1.0 - kc.alpha_m) / ((1.0 - kc.alpha_f) * kc.beta * dt * dt);
                 let inertia = Some((&sys.terms.inertia, c));
                 s.add_stiffness(sys.mech, &sys.end.config, inertia, &mut self.nodal);
-                // The angle is driven (checked at t = 0): no ψ equation.
-                s.add_transfer(&sys.nodal, &mut self.nodal);
-            }
+                s.add_transfer(&sys.nodal, &mut self.nodal)
+            });
             let mut dq = vec![0.0; sys.topo.dofs.n_eq];
             sys.reduce(&self.nodal, &mut dq);
+            if let Some((eq, share)) = psi {
+                dq[eq] += share;
+            }
             dq.iter_mut().for_each(|v| *v = -*v);
             self.lu.solve(&mut dq).map_err(failed)?;
             let (next, v1, w1) = advance(sys, &self.history[k], &dq, shift.as_ref());
             let mass = self.units[k]
                 .as_ref()
                 .map_or(0.0, |u| u.kinetic_energy(&v1, &w1));
-            let energy = energy_derivative(sys, &next, (&v1, &w1), fext_end, partial + mass);
+            let start = &self.starts[k];
+            let partial = partial + mass + start.work(fext_end);
+            let energy = energy_derivative(sys, &next, (&v1, &w1), fext_end, partial);
+            let displacement = (next.x.iter().enumerate())
+                .map(|(n, d)| {
+                    let d = d - start.of(n);
+                    [d.x, d.y, d.z]
+                })
+                .collect();
             out.push(Sensitivity {
-                displacement: next.x.iter().map(|d| [d.x, d.y, d.z]).collect(),
+                displacement,
                 energy,
             });
             self.history[k] = next;
@@ -253,29 +278,32 @@ impl NewmarkSensitivities {
     }
 }
 
-/// A joint parameter at t = 0: refused where it moves the slave (a model
-/// places it once) or the joint's angle is free (its initial accelerations'
-/// dependence is not derived yet); a driven angle's rate `ψ̇₀` moves the
-/// slave's subtree at `R_m ∂²f/∂ψ∂p ψ̇₀` (the accelerations do not change:
-/// `∂f/∂p(ψ₀) = 0` and the driven angle is no unknown).
-fn joint_start(
+/// A joint parameter's history at t = 0 beyond its initial accelerations:
+/// the carried body's positions `dX/dp` ([`StartShift`]) and the subtree's
+/// velocity terms ([`JointStart`]). A carried body given an initial spin is
+/// refused: its velocity field `v₀ + ω × (x − origin)` depends on where the
+/// body is, which the re-placement does not say.
+fn joint_history(
     sys: &ReducedSystem<'_, NewmarkTerms>,
-    joint: usize,
-    name: &str,
+    joint: &JointStart,
+    start: &StartShift,
     h: &mut History,
 ) -> Result<(), SolveError> {
-    let shift = JointShift::at(sys.mech, &sys.topo, &sys.end, joint, name)?;
-    shift.check_start(sys.mech, joint, name)?;
-    if shift.psi_eq.is_some() {
+    let spinning = (start.nodes().iter())
+        .find(|n| !joint.nodes().contains(n) && sys.terms.prev.w[**n] != Vector3::zeros());
+    if let Some(&n) = spinning {
         return Err(SolveError::InvalidMechanism(format!(
-            "joint `{}`: sensitivities by a parameter of a joint whose angle is free are              computed in statics; in dynamics drive its angle (`[[prescribed]] joint = ...`)",
-            sys.mech.joints[joint].name
+            "the body a joint parameter re-places at t = 0 (with node {n}) starts with an \
+             angular velocity, whose velocity field depends on the body's position: \
+             differentiate by this parameter from a start without spin"
         )));
     }
-    let rate = sys.terms.initial_rates.get(joint).copied().unwrap_or(0.0);
-    for &n in &shift.nodes {
-        h.v[n] += shift.slope * rate;
+    for (n, x) in h.x.iter_mut().enumerate() {
+        *x = start.of(n);
     }
+    let mut a = h.a.clone();
+    joint.add_motion(&mut h.v, &mut a);
+    (h.a, h.acc) = (a.clone(), a);
     Ok(())
 }
 

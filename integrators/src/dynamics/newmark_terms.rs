@@ -236,7 +236,8 @@ impl NewmarkTerms {
         asm.assemble(&mech.mesh, &topo.dofs, &state.config);
         let residual: Vec<f64> = asm.nodal.iter().zip(&fext).map(|(a, b)| a - b).collect();
         let (v, w) = slave_velocities(mech, topo, state, initial);
-        let (a, alpha) = initial_accelerations(mech, topo, &inertia, asm, lu, state, &residual);
+        let (a, alpha, _) =
+            initial_accelerations(mech, topo, &inertia, asm, lu, state, &residual, None);
         let damped = mech
             .damped_elements()
             .into_iter()
@@ -511,6 +512,8 @@ impl TimeScheme for NewmarkTerms {
 /// a system that starts spinning begins with a small acceleration error that
 /// the trapezoidal rule carries as an O(Δt) velocity offset. If the reduced
 /// mass is singular (massless DOFs) the accelerations start at zero.
+/// `extra`: an equation and a value added to `Tᵀ r` (a joint parameter's
+/// share of a free angle's equation); the reduced `q̈` is returned too.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn initial_accelerations(
     mech: &Mechanism,
@@ -520,9 +523,14 @@ pub(super) fn initial_accelerations(
     lu: &mut SparseLu,
     state: &MechanismState,
     residual: &[f64],
-) -> (Vec<Vector3<f64>>, Vec<Vector3<f64>>) {
+    extra: Option<(usize, f64)>,
+) -> (Vec<Vector3<f64>>, Vec<Vector3<f64>>, Vec<f64>) {
     let nodes = mech.mesh.node_count();
-    let zero = (vec![Vector3::zeros(); nodes], vec![Vector3::zeros(); nodes]);
+    let zero = (
+        vec![Vector3::zeros(); nodes],
+        vec![Vector3::zeros(); nodes],
+        vec![0.0; topo.dofs.n_eq],
+    );
     asm.values.iter_mut().for_each(|v| *v = 0.0);
     for &(i, j, m) in &inertia.mass {
         asm.add_node_block(&topo.dofs, (i, 0), (j, 0), &(Matrix3::identity() * m));
@@ -533,6 +541,9 @@ pub(super) fn initial_accelerations(
     }
     let mut q = vec![0.0; topo.dofs.n_eq];
     topo.dofs.reduce(residual, &mut q);
+    if let Some((eq, value)) = extra {
+        q[eq] += value;
+    }
     q.iter_mut().for_each(|v| *v = -*v);
     if lu.factor(&asm.values).is_err() || lu.solve(&mut q).is_err() {
         return zero;
@@ -544,7 +555,7 @@ pub(super) fn initial_accelerations(
         a.push(p.fixed_rows::<3>(0).into_owned());
         alpha.push(state.config.rot[i].transpose() * p.fixed_rows::<3>(3));
     }
-    (a, alpha)
+    (a, alpha, q)
 }
 
 /// The drivers' work over a step by the trapezoidal rule: the mean of the

@@ -11,8 +11,9 @@ use crate::types::{Analysis, IntegratorKind, Model, SensitivityKey};
 /// What the keys may name today, for the messages.
 const AVAILABLE: &str = "section values (`section.<name>.EA`, `GA[0]`, `GA[1]`, `GJ`, \
                          `EI[0]`, `EI[1]`, `rhoA`, `rhoJ[0]`, `rhoJ[1]`, `rhoJ[2]`), rigid \
-                         bodies' `rigid_body[i].mass` and principal `inertia[k]`, expression \
-                         joints' `joint.<name>.parameters.<p>`, dead load components \
+                         bodies' `rigid_body[i].mass` and principal `inertia[k]`, joints' \
+                         `joint.<name>.pitch` (screw), `.radius` (rack_pinion, cam), \
+                         `.offset` (cam) and `joint.<name>.parameters.<p>` (expression), dead load components \
                          (`load[i].force[c]`, `load[i].moment[c]`, \
                          `distributed_load[i].force[c]`, `distributed_load[i].moment[c]`) and, \
                          in dynamics, initial velocities (`initial_velocity[i].linear[c]`, \
@@ -67,9 +68,10 @@ fn velocity_component(field: &str) -> Option<usize> {
     .position(|f| *f == field)
 }
 
-/// The parameter `field` (`parameters.<p>`) of joint `j` at key `text`,
-/// where the joint's kind can differentiate by it and a change of it leaves
-/// the slave where the model places it at t = 0.
+/// The parameter `field` (`parameters.<p>`, or a built-in kind's value
+/// such as `offset`) of joint `j` at key `text`, where the joint's kind can
+/// differentiate by it. A value that moves the slave at t = 0 re-places
+/// the body the joint carries with it (checked when the run starts).
 fn joint_parameter(
     model: &Model,
     j: usize,
@@ -82,20 +84,11 @@ fn joint_parameter(
     let mut q0 = [0.0; flexmech_joints::MAX_RELEASED];
     q0[0] = spec.angle;
     let state = flexmech_joints::ReleasedState::new(q0);
-    let Some([f_p, _]) = spec.kind.map().parameter_derivative(name, &state) else {
+    if spec.kind.map().parameter_derivative(name, &state).is_none() {
         return Err(refuse(format!(
-            "a joint of type {} cannot be differentiated by `{field}` (the parameters of an \
-             expression joint, `joint.<name>.parameters.<p>`, can); write the joint as \
-             `type = \"expression\"` to differentiate by its parameters",
+            "a joint of type {} cannot be differentiated by `{field}` ({JOINT_VALUES}); write \
+             the joint as `type = \"expression\"` to differentiate by its parameters",
             spec.kind.type_name()
-        )));
-    };
-    if f_p.norm() > JOINT_START_SHIFT {
-        return Err(refuse(format!(
-            "changing it moves the slave at t = 0 (∂f/∂{name} = [{:?}, {:?}, {:?}] at the \
-             initial angle), and the model places its slave in the file; differentiate by a \
-             parameter that leaves f(ψ₀) unchanged",
-            f_p.x, f_p.y, f_p.z
         )));
     }
     Ok(SensitivityKey::JointParameter {
@@ -104,9 +97,10 @@ fn joint_parameter(
     })
 }
 
-/// `|∂f/∂p(ψ₀)|` above which a joint parameter moves the slave at t = 0
-/// (absolute: the model's lengths are of order 1e-3 and above).
-const JOINT_START_SHIFT: f64 = 1e-14;
+/// The joint values that can be differentiated by, for the messages.
+const JOINT_VALUES: &str = "joints can be differentiated by `pitch` of a screw, `radius` of a \
+                            rack_pinion, `radius` and `offset` of a cam and the parameters of \
+                            an expression joint, `joint.<name>.parameters.<p>`";
 
 /// What kind of value `v` is, when it is no real number.
 fn not_real(v: &Value) -> Option<&'static str> {
