@@ -332,7 +332,7 @@ fn unit_inertia(
 
 /// `element` with a section whose stiffness `component` is 1 and every
 /// other stiffness 0.
-fn with_unit_stiffness(element: &Element, component: usize) -> Element {
+pub(crate) fn with_unit_stiffness(element: &Element, component: usize) -> Element {
     let mut stiffness = [0.0; 6];
     stiffness[component] = 1.0;
     let section = |s: &Section| Section {

@@ -26,16 +26,20 @@ use super::bordered::{self, Bordered};
 use super::checkpoint::{CheckpointMismatch, Tape};
 use super::mass_slots::MassSlots;
 use super::midpoint_kernels::{correction_size, element_force, element_kernel, CorrectionTally};
-use super::time_scheme::TimeScheme;
+use super::midpoint_sensitivity::MidpointSensitivities;
+use super::time_scheme::{SchemeSensitivities, TimeScheme};
 pub use super::Scheme;
 use super::{increment_work, slave_velocities, Motion};
 use crate::assembly::Assembler;
 use crate::constraints::{MechanismState, Topology};
 use crate::dofs::DofMap;
 use crate::error::NewtonFailure;
+use crate::error::SolveError;
 use crate::linsolve::SparseLu;
 use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSettings};
+use crate::record::Sensitivity;
+use crate::sensitivity::Parameter;
 use crate::system::{ReducedSystem, Reduction, StepTerms};
 use flexmech_core::rotation::{cayley_inverse, log};
 use flexmech_core::{Configuration, Inertia};
@@ -114,20 +118,20 @@ fn inertial_moment_at<T: flexmech_core::Scalar>(
 /// force between the step's ends, the inertial forces `M(vₙ₊₁ − vₙ)/Δt` and
 /// `(πₙ₊₁ − πₙ)/Δt` with their tangents, joints through `Ñ`; loads at `tₙ₊½`.
 pub(crate) struct MidpointTerms {
-    inertia: Inertia,
+    pub(super) inertia: Inertia,
     slots: MassSlots,
-    scheme: Scheme,
+    pub(super) scheme: Scheme,
     /// The paper's energy–momentum β (0 for the other schemes).
     beta: f64,
-    dt: f64,
+    pub(super) dt: f64,
     /// Velocities at the start of the step.
-    v_n: Vec<Vector3<f64>>,
-    w_n: Vec<Vector3<f64>>,
+    pub(super) v_n: Vec<Vector3<f64>>,
+    pub(super) w_n: Vec<Vector3<f64>>,
     /// Rates of each joint's released coordinates over the last step.
     rates: Vec<Vec<f64>>,
     /// Whether the energy–momentum scheme's exact tangent is asked for
     /// (see [`NewtonSystem::set_exact_tangent`](crate::newton::NewtonSystem::set_exact_tangent)).
-    exact_tangent: bool,
+    pub(super) exact_tangent: bool,
     /// The energy–momentum scheme's correction sizes at the last residual
     /// evaluation.
     tally: CorrectionTally,
@@ -294,6 +298,27 @@ impl TimeScheme for MidpointTerms {
 
     fn mass(&self) -> &Inertia {
         &self.inertia
+    }
+
+    fn sensitivities(
+        sys: &mut ReducedSystem<'_, Self>,
+        params: &[Parameter],
+        mass: flexmech_core::MassKind,
+    ) -> Result<SchemeSensitivities, SolveError> {
+        MidpointSensitivities::new(sys, params, mass).map(SchemeSensitivities::Midpoint)
+    }
+
+    fn sensitivity_step(
+        sys: &mut ReducedSystem<'_, Self>,
+        sens: &mut SchemeSensitivities,
+        fext_end: &[f64],
+    ) -> Result<Vec<Sensitivity>, SolveError> {
+        match sens {
+            SchemeSensitivities::Midpoint(s) => s.step(sys, fext_end),
+            _ => Err(SolveError::InvalidMechanism(
+                "sensitivities set up for another scheme".into(),
+            )),
+        }
     }
 
     /// Plain Newton (the energy–momentum scheme's record carries the size

@@ -26,6 +26,7 @@ mod joint_start;
 mod mass_slots;
 pub mod midpoint;
 pub mod midpoint_kernels;
+mod midpoint_sensitivity;
 pub mod momentum;
 pub mod newmark;
 pub mod newmark_sensitivity;

@@ -70,12 +70,12 @@ impl History {
 }
 
 /// `v + ε dv`.
-fn dual(v: &Vector3<f64>, dv: &Vector3<f64>) -> Vector3<Dual64> {
+pub(super) fn dual(v: &Vector3<f64>, dv: &Vector3<f64>) -> Vector3<Dual64> {
     Vector3::from_fn(|i, _| Dual64::new(v[i], dv[i]))
 }
 
 /// `exp(ε θ̂) R = R + ε θ̂ R` (exact in first order).
-fn dual_rotation(r: &Matrix3<f64>, theta: &Vector3<f64>) -> Matrix3<Dual64> {
+pub(super) fn dual_rotation(r: &Matrix3<f64>, theta: &Vector3<f64>) -> Matrix3<Dual64> {
     let d = skew(theta) * r;
     Matrix3::from_fn(|i, j| Dual64::new(r[(i, j)], d[(i, j)]))
 }
@@ -195,7 +195,7 @@ impl NewmarkSensitivities {
         let initial = (history.iter().zip(&units))
             .map(|(h, unit)| Sensitivity {
                 displacement: vec![[0.0; 3]; nodes],
-                energy: kinetic_derivative(&sys.terms.inertia, (v0, w0), h)
+                energy: kinetic_derivative(&sys.terms.inertia, (v0, w0), (&h.v, &h.w))
                     + unit.as_ref().map_or(0.0, |u| u.kinetic_energy(v0, w0)),
             })
             .collect();
@@ -434,15 +434,15 @@ fn advance(
 }
 
 /// `dK/dp = Σ (M v)·dv + Σ J₀W·dW` of the kinetic energy at velocities
-/// `v`, `W` with derivatives `h.v`, `h.w` (at fixed mass).
-fn kinetic_derivative(
+/// `v`, `W` with derivatives `dv`, `dW` (at fixed mass).
+pub(super) fn kinetic_derivative(
     inertia: &Inertia,
     (v, w): (&[Vector3<f64>], &[Vector3<f64>]),
-    h: &History,
+    (dv, dw): (&[Vector3<f64>], &[Vector3<f64>]),
 ) -> f64 {
     let mv = inertia.apply_mass(v);
     (0..v.len())
-        .map(|i| mv[i].dot(&h.v[i]) + (inertia.rotational[i] * w[i]).dot(&h.w[i]))
+        .map(|i| mv[i].dot(&dv[i]) + (inertia.rotational[i] * w[i]).dot(&dw[i]))
         .sum()
 }
 
@@ -457,7 +457,7 @@ fn energy_derivative(
     fext: &[f64],
     partial: f64,
 ) -> f64 {
-    let mut de = partial + kinetic_derivative(&sys.terms.inertia, (v1, w1), h);
+    let mut de = partial + kinetic_derivative(&sys.terms.inertia, (v1, w1), (&h.v, &h.w));
     for i in 0..v1.len() {
         for c in 0..3 {
             de +=

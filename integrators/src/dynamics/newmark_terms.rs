@@ -467,8 +467,12 @@ impl TimeScheme for NewmarkTerms {
         sens: &mut SchemeSensitivities,
         fext_end: &[f64],
     ) -> Result<Vec<Sensitivity>, SolveError> {
-        let SchemeSensitivities::Newmark(s) = sens;
-        s.step(sys, fext_end)
+        match sens {
+            SchemeSensitivities::Newmark(s) => s.step(sys, fext_end),
+            _ => Err(SolveError::InvalidMechanism(
+                "sensitivities set up for another scheme".into(),
+            )),
+        }
     }
 
     /// Newmark's updates of velocities and (pseudo-)accelerations; the drivers' work

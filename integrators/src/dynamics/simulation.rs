@@ -440,7 +440,10 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
                 continue;
             }
             if let Some((sens, now)) = &mut self.sensitivities {
-                let fext_end = sys.fext.clone();
+                // The loads at the step's end (a midpoint scheme's `sys.fext`
+                // are at tₙ₊½).
+                let mut fext_end = vec![0.0; sys.fext.len()];
+                mech.external_forces(t + dt, &mut fext_end);
                 *now = S::sensitivity_step(sys, sens, &fext_end)?;
             }
             self.driver_work += S::finish(sys, dt);

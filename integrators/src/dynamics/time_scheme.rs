@@ -20,6 +20,8 @@ use nalgebra::Vector3;
 pub(crate) enum SchemeSensitivities {
     /// The Newmark family's ([`super::newmark_sensitivity`]).
     Newmark(super::newmark_sensitivity::NewmarkSensitivities),
+    /// The midpoint schemes' ([`super::midpoint_sensitivity`]).
+    Midpoint(super::midpoint_sensitivity::MidpointSensitivities),
 }
 
 impl SchemeSensitivities {
@@ -27,6 +29,7 @@ impl SchemeSensitivities {
     pub(crate) fn initial(&self) -> Vec<Sensitivity> {
         match self {
             SchemeSensitivities::Newmark(s) => s.initial.clone(),
+            SchemeSensitivities::Midpoint(s) => s.initial.clone(),
         }
     }
 }
