@@ -324,6 +324,60 @@ impl Topology {
         }
     }
 
+    /// The derivative of the conserving schemes' reduced residual `Σ Ñᵀ g`
+    /// along the step's start state with `g` held (exact sensitivities):
+    /// for each joint, `∂(Ñⱼᵀ g_s)/∂start · d` of its accumulated slave
+    /// residual `g_s`, with the master's start pose moved by `d`'s
+    /// `(dx, θ)` of that node (`x ← x + dx`, `R ← exp(θ̂)R`) and the released
+    /// start state by `released[j]`. The master part is added to the nodal
+    /// `out` at the master (to be folded and reduced with the rest), the
+    /// released part returned as `(equation, value)`. `Err(j)`: joint `j`'s
+    /// kind does not provide the derivative.
+    #[allow(clippy::too_many_arguments)]
+    pub fn incremental_start_terms(
+        &self,
+        mech: &Mechanism,
+        (start, end): (&MechanismState, &MechanismState),
+        g: &[f64],
+        (dx, theta): (&[Vector3<f64>], &[Vector3<f64>]),
+        released: &[[f64; flexmech_joints::MAX_RELEASED]],
+        out: &mut [f64],
+    ) -> Result<Vec<(usize, f64)>, usize> {
+        let mut extra = Vec::new();
+        let mut missing = None;
+        self.fold_slaves(mech, Some(start), end, g, |j, gs, _| {
+            let m = mech.joints[j].master;
+            let from = [
+                dx[m].x, dx[m].y, dx[m].z, theta[m].x, theta[m].y, theta[m].z,
+            ];
+            let t = mech.joints[j].map.incremental_transfer_start(
+                [
+                    (&start.config.x[m], &start.config.rot[m]),
+                    (&end.config.x[m], &end.config.rot[m]),
+                ],
+                [&start.released[j], &end.released[j]],
+                gs,
+                (&from, &released[j]),
+            );
+            let Some(t) = t else {
+                missing = Some(j);
+                return;
+            };
+            for c in 0..6 {
+                out[6 * m + c] += t[c];
+            }
+            for (c, eq) in self.released_eqs[j].iter().enumerate() {
+                if let Some(e) = eq {
+                    extra.push((*e, t[6 + c]));
+                }
+            }
+        });
+        match missing {
+            Some(j) => Err(j),
+            None => Ok(extra),
+        }
+    }
+
     /// Folds every slave's nodal residual into its master's, deepest slaves
     /// first — through `Nᵀ` at `end`, or through the step's `Ñᵀ` when `start`
     /// is given (the conserving schemes) — calling `each(j, g_s, t)` with

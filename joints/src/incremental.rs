@@ -61,14 +61,51 @@ impl<T: Scalar> JointStep<T> {
         seed: &[T; 6],
         inc: &[T; MAX_RELEASED],
     ) -> Self {
+        let b = joint.step_map(released[0], released[1], inc);
+        let from = ([T::zero(); 6], [T::zero(); MAX_RELEASED]);
+        Self::with_map(joint, master, released, (&from.0, &from.1), (seed, inc), b)
+    }
+
+    /// [`Self::of`] with the step's start seeded too: the master's start pose
+    /// `(x₀ + δx₀, exp(δφ̂₀) R₀)` with `from.0 = (δx₀, δφ₀)` and the released
+    /// start state `start ⊕ from.1` — the derivative of `Ñ` along the start
+    /// state (exact sensitivities through the conserving schemes). `None`
+    /// where the kind's coordinates do not provide `B` from a seeded start.
+    pub fn of_from<J: JointKinematics + ?Sized>(
+        joint: &J,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+        from: (&[T; 6], &[T; MAX_RELEASED]),
+        seed: &[T; 6],
+        inc: &[T; MAX_RELEASED],
+    ) -> Option<Self> {
+        let b = joint.step_map_from(released[0], released[1], from.1, inc)?;
+        Some(Self::with_map(
+            joint,
+            master,
+            released,
+            from,
+            (seed, inc),
+            b,
+        ))
+    }
+
+    /// `Ñ` from the seeded ends and the step's `B`.
+    fn with_map<J: JointKinematics + ?Sized>(
+        joint: &J,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+        from: (&[T; 6], &[T; MAX_RELEASED]),
+        (seed, inc): (&[T; 6], &[T; MAX_RELEASED]),
+        b: SMatrix<T, 6, MAX_RELEASED>,
+    ) -> Self {
         let [(x0, r0), (x1, r1)] = master;
-        let zero = [T::zero(); MAX_RELEASED];
-        let x0 = x0.map(cst::<T>);
-        let r0 = r0.map(cst::<T>);
+        let x0 = x0.map(cst::<T>) + Vector3::new(from.0[0], from.0[1], from.0[2]);
+        let r0 = exp(&Vector3::new(from.0[3], from.0[4], from.0[5])) * r0.map(cst::<T>);
         let x1 = x1.map(cst::<T>) + Vector3::new(seed[0], seed[1], seed[2]);
         let r1 = exp(&Vector3::new(seed[3], seed[4], seed[5])) * r1.map(cst::<T>);
         let theta_m = cayley_inverse(&(r1 * r0.transpose()));
-        let (rr0, l0) = released_at(joint, released[0], &zero);
+        let (rr0, l0) = released_at(joint, released[0], from.1);
         let (rr1, l1) = released_at(joint, released[1], inc);
         let (xs0, xs1) = (x0 + r0 * rr0, x1 + r1 * rr1);
         let half = cst::<T>(0.5);
@@ -83,7 +120,7 @@ impl<T: Scalar> JointStep<T> {
             offset,
             lever,
             a,
-            b: joint.step_map(released[0], released[1], inc),
+            b,
         }
     }
 

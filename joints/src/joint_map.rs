@@ -30,7 +30,7 @@ use crate::kinematics::{
 use flexmech_core::rotation::exp;
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Const, Matrix3, SMatrix, SVector, Vector3, Vector6, U1};
-use num_dual::{DualSVec64, HyperDualSVec64};
+use num_dual::{Dual64, DualSVec64, HyperDualSVec64};
 use std::fmt::Debug;
 
 /// The joint operations the solvers use: object-safe, blanket-implemented for
@@ -105,6 +105,20 @@ pub trait JointMap: Send + Sync + Debug {
         released: [&ReleasedState; 2],
         g: &Vector6<f64>,
     ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>);
+
+    /// The derivative of `Ñᵀ g` (slave residual `g` held, the step's end
+    /// held) along the step's start state: the master's start pose moved by
+    /// `from.0 = (δx, δφ)` (`x ← x + δx`, `R ← exp(δφ̂)R`) and the released
+    /// start state by the increments `from.1` — for exact sensitivities
+    /// through the conserving schemes. `None` where the kind's coordinates
+    /// do not provide it ([`crate::Coordinates::step_map_from`]).
+    fn incremental_transfer_start(
+        &self,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+        g: &Vector6<f64>,
+        from: (&[f64; 6], &[f64; MAX_RELEASED]),
+    ) -> Option<SVector<f64, LOCAL>>;
 
     /// `B` with `(u_R, θ_R) = B τ` over a step (see [`JointKinematics::step_map`]).
     fn step_map(&self, start: &ReleasedState, end: &ReleasedState)
@@ -464,6 +478,31 @@ impl<J: JointKinematics> JointMap for J {
             k.column_mut(c).fill(0.0);
         }
         (value, k)
+    }
+
+    fn incremental_transfer_start(
+        &self,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+        g: &Vector6<f64>,
+        from: (&[f64; 6], &[f64; MAX_RELEASED]),
+    ) -> Option<SVector<f64, LOCAL>> {
+        let seeded = |v: &f64| Dual64::new(0.0, *v);
+        let from = (from.0.each_ref().map(seeded), from.1.each_ref().map(seeded));
+        let zero = Dual64::from(0.0);
+        let step = JointStep::of_from(
+            self,
+            master,
+            released,
+            (&from.0, &from.1),
+            &[zero; 6],
+            &[zero; MAX_RELEASED],
+        )?;
+        let mut t = step.transfer(&g.map(Dual64::from)).map(|v| v.eps);
+        for c in 6 + released_count::<J>()..LOCAL {
+            t[c] = 0.0;
+        }
+        Some(t)
     }
 
     fn step_map(

@@ -117,11 +117,40 @@ pub trait Coordinates: Send + Sync + 'static {
         additive_step_map(joint, start, end, inc)
     }
 
+    /// `B` for a step whose start is `start ⊕ from` (`from` seeded for the
+    /// derivative along the start state: exact sensitivities through the
+    /// conserving schemes); `None`, the default, where the coordinates do
+    /// not provide it.
+    fn step_map_from<J: JointKinematics + ?Sized, T: Scalar>(
+        _joint: &J,
+        _start: &ReleasedState,
+        _end: &ReleasedState,
+        _from: &[T; MAX_RELEASED],
+        _inc: &[T; MAX_RELEASED],
+    ) -> Option<SMatrix<T, 6, MAX_RELEASED>> {
+        None
+    }
+
     /// The angle reported as `/joints/<name>/angle`: the first coordinate
     /// when it is the angle, else none.
     fn reported_angle(state: &ReleasedState) -> Option<f64> {
         (Self::NAMES.first() == Some(&"angle")).then_some(state.q[0])
     }
+}
+
+/// [`Coordinates::step_map_from`] of additive coordinates.
+macro_rules! additive_from {
+    () => {
+        fn step_map_from<J: JointKinematics + ?Sized, T: Scalar>(
+            joint: &J,
+            start: &ReleasedState,
+            end: &ReleasedState,
+            from: &[T; MAX_RELEASED],
+            inc: &[T; MAX_RELEASED],
+        ) -> Option<SMatrix<T, 6, MAX_RELEASED>> {
+            Some(additive_step_map_from(joint, start, end, from, inc))
+        }
+    };
 }
 
 /// A released rotation angle ψ about a fixed axis, with its value at t = 0.
@@ -150,6 +179,7 @@ impl Coordinates for NoCoordinates {
     const NAMES: &'static [&'static str] = &[];
     type At<T: Scalar> = ();
     fn at<T: Scalar>(_: &ReleasedState, _: Increments<'_, T>) {}
+    additive_from!();
 }
 
 /// One released angle ψ (revolute, screw, rack-and-pinion, cam, lobe).
@@ -166,6 +196,7 @@ impl Coordinates for Angle {
             initial: state.q0[0],
         }
     }
+    additive_from!();
 }
 
 /// One released translation `s` (prismatic).
@@ -179,6 +210,7 @@ impl Coordinates for Slide {
     fn at<T: Scalar>(state: &ReleasedState, inc: Increments<'_, T>) -> T {
         inc.coordinate(state, 0)
     }
+    additive_from!();
 }
 
 /// A released angle and a released translation (cylindrical).
@@ -198,6 +230,7 @@ impl Coordinates for AngleSlide {
             inc.coordinate(state, 1),
         )
     }
+    additive_from!();
 }
 
 /// A released rotation of three axes (spherical), kept as a matrix and
@@ -232,6 +265,17 @@ impl Coordinates for BallRotation {
         b.fixed_view_mut::<3, 3>(3, 0)
             .copy_from(&Matrix3::identity());
         b
+    }
+
+    /// `B = [0; I]` whatever the start.
+    fn step_map_from<J: JointKinematics + ?Sized, T: Scalar>(
+        joint: &J,
+        start: &ReleasedState,
+        end: &ReleasedState,
+        _from: &[T; MAX_RELEASED],
+        inc: &[T; MAX_RELEASED],
+    ) -> Option<SMatrix<T, 6, MAX_RELEASED>> {
+        Some(Self::step_map(joint, start, end, inc))
     }
 
     /// The magnitude of the released rotation.
@@ -304,6 +348,17 @@ pub trait JointKinematics: Send + Sync + Debug {
         <Self::Coordinates as Coordinates>::step_map(self, start, end, inc)
     }
 
+    /// `B` for a step from `start ⊕ from` (see [`Coordinates::step_map_from`]).
+    fn step_map_from<T: Scalar>(
+        &self,
+        start: &ReleasedState,
+        end: &ReleasedState,
+        from: &[T; MAX_RELEASED],
+        inc: &[T; MAX_RELEASED],
+    ) -> Option<SMatrix<T, 6, MAX_RELEASED>> {
+        <Self::Coordinates as Coordinates>::step_map_from(self, start, end, from, inc)
+    }
+
     /// The released rotation angle reported as `/joints/<name>/angle`, or
     /// `None` for a kind without one (the dataset is then absent).
     fn reported_angle(&self, state: &ReleasedState) -> Option<f64> {
@@ -357,35 +412,53 @@ pub fn additive_step_map<J: JointKinematics + ?Sized, T: Scalar>(
     end: &ReleasedState,
     inc: &[T; MAX_RELEASED],
 ) -> SMatrix<T, 6, MAX_RELEASED> {
+    additive_step_map_from(joint, start, end, &[T::zero(); MAX_RELEASED], inc)
+}
+
+/// [`additive_step_map`] for a step from `start ⊕ from` (`from` seeded for
+/// the derivative along the start state). A Taylor column (increment below
+/// `1e-6`) follows its own coordinate's `from` to first order, through `τₖ`
+/// and the base point (`F′ + F″ δ`); it leaves out `F‴ τₖ δ/6`, below `1e-6`
+/// relative, and other coordinates' `from` (as [`additive_step_map`] leaves
+/// out their end values).
+pub fn additive_step_map_from<J: JointKinematics + ?Sized, T: Scalar>(
+    joint: &J,
+    start: &ReleasedState,
+    end: &ReleasedState,
+    from: &[T; MAX_RELEASED],
+    inc: &[T; MAX_RELEASED],
+) -> SMatrix<T, 6, MAX_RELEASED> {
     type H = HyperDualSVec64<1, 1>;
-    let (r_n, l_n) = released_at(joint, start, &[0.0; MAX_RELEASED]);
-    let tau: [T; MAX_RELEASED] = std::array::from_fn(|k| cst::<T>(end.q[k] - start.q[k]) + inc[k]);
+    let (r_n, l_n) = released_at(joint, start, from);
+    let tau: [T; MAX_RELEASED] =
+        std::array::from_fn(|k| cst::<T>(end.q[k] - start.q[k]) + inc[k] - from[k]);
     // F at the path point with the first `upto` coordinates at their end values.
     let f = |upto: usize| -> Vector6<T> {
         let d: [T; MAX_RELEASED] =
-            std::array::from_fn(|i| if i < upto { tau[i] } else { T::zero() });
+            std::array::from_fn(|i| if i < upto { from[i] + tau[i] } else { from[i] });
         let (r, l) = released_at(joint, start, &d);
-        stack(
-            &(r - r_n.map(cst::<T>)),
-            &cayley_inverse(&(l * l_n.map(cst::<T>).transpose())),
-        )
+        stack(&(r - r_n), &cayley_inverse(&(l * l_n.transpose())))
     };
     let mut b = SMatrix::<T, 6, MAX_RELEASED>::zeros();
     for k in 0..released_count::<J>() {
         let column: Vector6<T> = if tau[k].value().abs() >= TAYLOR_BELOW {
             (f(k + 1) - f(k)) / tau[k]
         } else {
-            let mut d = [H::from_re(0.0); MAX_RELEASED];
+            let mut d: [H; MAX_RELEASED] = std::array::from_fn(|i| H::from_re(from[i].value()));
             for (i, di) in d.iter_mut().enumerate().take(k) {
-                *di = H::from_re(tau[i].value());
+                *di = H::from_re(from[i].value() + tau[i].value());
             }
-            d[k] = H::from_re(0.0).derivative1(0).derivative2(0);
+            d[k] = H::from_re(from[k].value()).derivative1(0).derivative2(0);
             let (r, l) = released_at(joint, start, &d);
-            let dr = r - r_n.map(H::from_re);
-            let th = cayley_inverse(&(l * l_n.map(H::from_re).transpose()));
+            let base: [H; MAX_RELEASED] = std::array::from_fn(|i| H::from_re(from[i].value()));
+            let (r0, l0) = released_at(joint, start, &base);
+            let dr = r - r0;
+            let th = cayley_inverse(&(l * l0.transpose()));
             let d1 = |v: H| v.eps1.unwrap_generic(Const::<1>, U1)[0];
             let d2 = |v: H| v.eps1eps2.unwrap_generic(Const::<1>, Const::<1>)[0];
-            let taylor = |v: H| cst::<T>(d1(v)) + tau[k] * cst::<T>(0.5 * d2(v));
+            // The base point moves with `from`: `F′(Pₖ₋₁ + δ) ≈ F′ + F″ δ`.
+            let shift = (from[k] - cst::<T>(from[k].value())) * cst::<T>(2.0);
+            let taylor = |v: H| cst::<T>(d1(v)) + (tau[k] + shift) * cst::<T>(0.5 * d2(v));
             stack(&dr.map(taylor), &th.map(taylor))
         };
         b.set_column(k, &column);

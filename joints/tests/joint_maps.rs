@@ -21,7 +21,7 @@ use flexmech_core::rotation::{cayley, cayley_inverse, cayley_mid, exp, log, skew
 use flexmech_core::{cst, Scalar};
 use flexmech_joints::{
     Cam, Cylindrical, DependentJoint, DependentJointMaps, JointMap, JointStep, Lift, Lobe,
-    Prismatic, RackPinion, ReleasedState, Revolute, Rigid, Screw, Spherical, LOCAL,
+    Prismatic, RackPinion, ReleasedState, Revolute, Rigid, Screw, Spherical, LOCAL, MAX_RELEASED,
 };
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector6};
 use proptest::prelude::*;
@@ -1450,6 +1450,9 @@ fn incremental_transfer_derivative_matches_differences() {
     );
 }
 
+/// A kind's `translation_by` at one angle.
+type Slopes<'a> = dyn Fn() -> Option<[Vector3<f64>; 2]> + 'a;
+
 #[test]
 fn parameter_slopes_match_the_closed_forms() {
     // ∂f/∂p and ∂²f/∂ψ∂p of the built-in kinds' real parameters, by hyper-dual
@@ -1476,7 +1479,7 @@ fn parameter_slopes_match_the_closed_forms() {
                 offset: p.cam_a,
             };
             let t_r = p.perp;
-            let cases: [(&dyn Fn() -> Option<[Vector3<f64>; 2]>, [Vector3<f64>; 2]); 4] = [
+            let cases: [(&Slopes, [Vector3<f64>; 2]); 4] = [
                 (
                     &|| screw.translation_by("pitch", psi),
                     [p.axis * psi, p.axis],
@@ -1501,6 +1504,90 @@ fn parameter_slopes_match_the_closed_forms() {
                 w.bounded(&format!("kind {k}"), err, scale, 16.0 * EPS * scale)?;
             }
             prop_assert!(cam.translation_by("axis", psi).is_none());
+            Ok(())
+        },
+    );
+}
+
+#[test]
+fn incremental_transfer_start_derivative_matches_differences() {
+    property(
+        "6e. d(Ntilde^T g)/d(start state) by AD = central differences, every kind",
+        CASES,
+        (
+            params(),
+            released(),
+            pose(),
+            vec3(-1.0, 1.0),
+            vec3(-0.7, 0.7),
+            (
+                released_increment(),
+                released_increment(),
+                released_increment(),
+            ),
+        ),
+        |(p, q, m, u_m, w_m, (d0, d1, d2)), w| {
+            let theta_m = flexmech_core::rotation::tan_scaled(&w_m);
+            let (x1, r1) = (m.x + u_m, cayley(&theta_m) * m.r);
+            let g = Vector6::new(d0 + 0.2, 1.0, -2.0, 0.5, d1 + 0.3, -0.7);
+            for kind in all_kinds(&p, &q) {
+                if kind.skip_second_fd {
+                    continue;
+                }
+                let end = step_of(&kind, &[d0, d1, d2]);
+                let k = kind.map.released_count();
+                // The step's start moved by `e`, its end held.
+                let at = |e: &SVector<f64, LOCAL>| {
+                    let x = m.x + e.fixed_rows::<3>(0);
+                    let r = flexmech_core::rotation::exp(&e.fixed_rows::<3>(3).into_owned()) * m.r;
+                    let mut start = kind.state;
+                    let inc: Vec<f64> = (0..k).map(|c| e[6 + c]).collect();
+                    kind.map.advance(&mut start, &inc);
+                    kind.map
+                        .incremental_step([(&x, &r), (&x1, &r1)], [&start, &end])
+                        .transfer(&g)
+                };
+                for c in 0..6 + k {
+                    // As in 6d: the stencil of a released column follows its
+                    // own coordinate's τ (moving the start moves τ).
+                    let tau = if c >= 6 && !kind.spherical {
+                        (end.q[c - 6] - kind.state.q[c - 6]).abs()
+                    } else {
+                        1.0
+                    };
+                    if (0.5e-6..=2e-6).contains(&tau) {
+                        continue;
+                    }
+                    let h = if tau < 1e-5 {
+                        1e-8
+                    } else {
+                        (0.1 * tau).clamp(1e-6, 1e-4)
+                    };
+                    let mut e = SVector::<f64, LOCAL>::zeros();
+                    e[c] = h;
+                    let fd = (at(&e) - at(&(-e))) / (2.0 * h);
+                    let mut dir = ([0.0; 6], [0.0; MAX_RELEASED]);
+                    if c < 6 {
+                        dir.0[c] = 1.0;
+                    } else {
+                        dir.1[c - 6] = 1.0;
+                    }
+                    let ad = kind
+                        .map
+                        .incremental_transfer_start(
+                            [(&m.x, &m.r), (&x1, &r1)],
+                            [&kind.state, &end],
+                            &g,
+                            (&dir.0, &dir.1),
+                        )
+                        .ok_or_else(|| TestCaseError::fail("no start derivative"))?;
+                    w.check(
+                        &format!("{}: start column {c}", kind.name),
+                        (fd - ad).norm() / (1.0 + ad.norm()),
+                        FD_TOL,
+                    )?;
+                }
+            }
             Ok(())
         },
     );

@@ -19,13 +19,19 @@
 //! with the start pose `xₙ + ε dxₙ`, `Rₙ ← exp(ε θ̂ₙ)Rₙ`, the inertial moment
 //! likewise. The forces are linear in each stiffness (the discrete gradient
 //! of an energy linear in it is linear in it), so `∂q/∂C` is the scheme's
-//! force of the unit-stiffness element. Mechanisms with joints (whose
-//! incremental map `Ñ` depends on the start state) and the paper's scheme
-//! (its bordered β) are not differentiated yet.
+//! force of the unit-stiffness element. Joints enter through the reduction
+//! `Σ Ñᵀ g`, whose incremental map `Ñ` depends on the step's start: its
+//! derivative along the start (the masters' start poses and the released
+//! start coordinates, with their derivatives) comes by dual numbers through
+//! `Ñ` ([`crate::constraints::Topology::incremental_start_terms`]); the
+//! slaves' end poses follow `dq` through `N`. The paper's scheme (its
+//! bordered β) and joints' own values as parameters are not differentiated
+//! yet.
 
 use flexmech_core::conserving::{MidRotation, Pose, Pose3};
 use flexmech_core::rotation::cayley_inverse;
 use flexmech_core::{Configuration, Element, Inertia, MassKind, Scalar};
+use flexmech_joints::MAX_RELEASED;
 use nalgebra::{Matrix3, Vector3};
 use num_dual::Dual64;
 
@@ -47,16 +53,19 @@ struct History {
     theta: Vec<Vector3<f64>>,
     v: Vec<Vector3<f64>>,
     w: Vec<Vector3<f64>>,
+    /// Per joint, its released coordinates' (increments).
+    released: Vec<[f64; MAX_RELEASED]>,
 }
 
 impl History {
-    fn at_rest(nodes: usize) -> Self {
+    fn at_rest(nodes: usize, joints: usize) -> Self {
         let z = vec![Vector3::zeros(); nodes];
         Self {
             x: z.clone(),
             theta: z.clone(),
             v: z.clone(),
             w: z,
+            released: vec![[0.0; MAX_RELEASED]; joints],
         }
     }
 }
@@ -89,19 +98,18 @@ impl MidpointSensitivities {
                  available yet: use \"energy-momentum\" or \"momentum\"",
             );
         }
-        if !mech.joints.is_empty() {
-            return refuse(
-                "sensitivities of a mechanism with joints under the momentum and energy-momentum \
-                 schemes are not available yet (the incremental map Ñ depends on the step's \
-                 start): use \"newmark\" or \"generalized-alpha\"",
-            );
-        }
         let nodes = mech.mesh.node_count();
         let mut history = Vec::with_capacity(params.len());
         let mut units = Vec::with_capacity(params.len());
         for p in params {
             p.check(mech)?;
-            let mut h = History::at_rest(nodes);
+            if let Parameter::Joint { .. } = p {
+                return refuse(
+                    "sensitivities by a joint's value with the momentum and energy-momentum \
+                     schemes are not available yet: use \"newmark\" or \"generalized-alpha\"",
+                );
+            }
+            let mut h = History::at_rest(nodes, mech.joints.len());
             if let Parameter::InitialMotion { motion } = p {
                 (h.v, h.w) = slave_velocities(mech, &sys.topo, &sys.end, motion);
             }
@@ -168,6 +176,7 @@ impl MidpointSensitivities {
                 &mut self.nodal,
                 mech,
             );
+            let extra = joint_history(sys, &self.history[k], &mut self.nodal)?;
             let mut mass = 0.0;
             if let Some(unit) = &self.units[k] {
                 inertial_forces(
@@ -182,6 +191,9 @@ impl MidpointSensitivities {
             }
             let mut dq = vec![0.0; sys.topo.dofs.n_eq];
             sys.reduce(&self.nodal, &mut dq);
+            for (eq, value) in extra {
+                dq[eq] += value;
+            }
             dq.iter_mut().for_each(|v| *v = -*v);
             self.lu.solve(&mut dq).map_err(failed)?;
             let next = advance(sys, &self.history[k], &dq);
@@ -363,10 +375,41 @@ fn inertial_forces(
     }
 }
 
+/// `∂(Σ Ñᵀ g)/∂hₙ · dhₙ/dp` of the joints' incremental maps (the step's
+/// end held, `g` the converged nodal residual): master parts into the nodal
+/// `g_out`, the released equations' shares returned.
+fn joint_history(
+    sys: &ReducedSystem<'_, MidpointTerms>,
+    h: &History,
+    g_out: &mut [f64],
+) -> Result<Vec<(usize, f64)>, SolveError> {
+    if sys.mech.joints.is_empty() {
+        return Ok(Vec::new());
+    }
+    let ends = (&sys.start, &sys.end);
+    let (nodal, history) = (&sys.nodal, (h.x.as_slice(), h.theta.as_slice()));
+    (sys.topo)
+        .incremental_start_terms(sys.mech, ends, nodal, history, &h.released, g_out)
+        .map_err(|j| {
+            SolveError::InvalidMechanism(format!(
+                "joint `{}`: its kind's released coordinates give no derivative of the \
+                 incremental map along the step's start, which sensitivities with the momentum \
+                 and energy-momentum schemes need: use \"newmark\" or \"generalized-alpha\"",
+                sys.mech.joints[j].name
+            ))
+        })
+}
+
 /// The history derivatives at the step's end for the solved `dq = dq₁/dp`.
 fn advance(sys: &ReducedSystem<'_, MidpointTerms>, h: &History, dq: &[f64]) -> History {
     let (start, end, dt) = (&sys.start.config, &sys.end.config, sys.terms.dt);
-    let mut next = History::at_rest(h.x.len());
+    let mut next = History::at_rest(h.x.len(), h.released.len());
+    for (j, eqs) in sys.topo.released_eqs.iter().enumerate() {
+        for (c, eq) in eqs.iter().enumerate() {
+            // A driven coordinate does not depend on the parameters.
+            next.released[j][c] = eq.map_or(0.0, |e| dq[e]);
+        }
+    }
     for i in 0..h.x.len() {
         let d = sys.topo.dofs.node_increment(i, dq);
         next.x[i] = d.fixed_rows::<3>(0).into_owned();
