@@ -91,6 +91,22 @@ impl JointShift {
         inertia: Option<(&flexmech_core::Inertia, f64)>,
         g: &mut [f64],
     ) {
+        let tangent = |e: &flexmech_core::Element, r: &mut [f64], k: &mut [f64]| {
+            e.residual_tangent(&config.x, &config.rot, r, k)
+        };
+        self.add_stiffness_with(mech, tangent, inertia, g);
+    }
+
+    /// [`Self::add_stiffness`] with the elements' force and tangent with
+    /// respect to the moved end pose from `tangent(element, r, k)` (a time
+    /// scheme's kernel).
+    pub(crate) fn add_stiffness_with(
+        &self,
+        mech: &Mechanism,
+        tangent: impl Fn(&flexmech_core::Element, &mut [f64], &mut [f64]),
+        inertia: Option<(&flexmech_core::Inertia, f64)>,
+        g: &mut [f64],
+    ) {
         let moved = |n: usize| self.nodes.contains(&n);
         for e in &mech.mesh.elements {
             let nodes = e.nodes();
@@ -99,7 +115,7 @@ impl JointShift {
             }
             let n = 6 * nodes.len();
             let (mut r, mut k) = (vec![0.0; n], vec![0.0; n * n]);
-            e.residual_tangent(&config.x, &config.rot, &mut r, &mut k);
+            tangent(e, &mut r, &mut k);
             for (b, &nb) in nodes.iter().enumerate() {
                 if !moved(nb) {
                     continue;
@@ -146,6 +162,17 @@ impl JointShift {
             out[6 * self.master + 3 + c] += moment[c];
         }
         self.psi_eq.map(|eq| (eq, self.slope.dot(force)))
+    }
+
+    /// `ω_m × δ + s ψ̇₀`: the moved nodes' initial velocity's derivative for
+    /// the master's spatial angular velocity `omega` and the joint's rate.
+    pub(crate) fn velocity(&self, omega: &Vector3<f64>, rate: f64) -> Vector3<f64> {
+        omega.cross(&self.delta) + self.slope * rate
+    }
+
+    /// The joint's master.
+    pub(crate) fn master(&self) -> usize {
+        self.master
     }
 
     /// The shift of node `n` (zero off the moved nodes).

@@ -25,7 +25,7 @@
 
 use crate::incremental::{JointStep, NodePose};
 use crate::kinematics::{
-    released_count, Increments, JointKinematics, ReleasedState, LOCAL, MAX_RELEASED,
+    released_count, Increments, JointKinematics, ReleasedState, LOCAL, MAX_RELEASED, TAYLOR_BELOW,
 };
 use flexmech_core::rotation::exp;
 use flexmech_core::{cst, Scalar};
@@ -118,6 +118,22 @@ pub trait JointMap: Send + Sync + Debug {
         released: [&ReleasedState; 2],
         g: &Vector6<f64>,
         from: (&[f64; 6], &[f64; MAX_RELEASED]),
+    ) -> Option<SVector<f64, LOCAL>>;
+
+    /// `(∂Ñ/∂p)ᵀ g` for the kind's real parameter `name` (slave residual
+    /// `g`, both ends of the step held): `Ñ` depends on `r_R` through the
+    /// mid-step offset `d = ½(Λ_m,ₙ r_R,ₙ + Λ_m,ₙ₊₁ r_R,ₙ₊₁) + …` and the
+    /// secant column of `B`, `(r_R,ₙ₊₁ − r_R,ₙ)/τ` (`∂r_R/∂q₁` below the
+    /// Taylor threshold, leaving out `O(τ ∂³r_R/∂q₁²∂p)`), so the master's
+    /// moment gains `∂d × g_u` and the released equation
+    /// `(lever ∂B_u)·g_u`. `None` where the kind cannot differentiate by
+    /// `name` or has more than one released coordinate.
+    fn incremental_transfer_by(
+        &self,
+        name: &str,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+        g: &Vector6<f64>,
     ) -> Option<SVector<f64, LOCAL>>;
 
     /// `B` with `(u_R, θ_R) = B τ` over a step (see [`JointKinematics::step_map`]).
@@ -502,6 +518,35 @@ impl<J: JointKinematics> JointMap for J {
         for c in 6 + released_count::<J>()..LOCAL {
             t[c] = 0.0;
         }
+        Some(t)
+    }
+
+    fn incremental_transfer_by(
+        &self,
+        name: &str,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+        g: &Vector6<f64>,
+    ) -> Option<SVector<f64, LOCAL>> {
+        if released_count::<J>() != 1 {
+            return None;
+        }
+        let [fp0, slope0] = self.parameter_derivative(name, released[0])?;
+        let [fp1, _] = self.parameter_derivative(name, released[1])?;
+        let [(_, r0), (_, r1)] = master;
+        let zero = [0.0; MAX_RELEASED];
+        let step = JointStep::of(self, master, released, &[0.0; 6], &zero);
+        let tau = released[1].q[0] - released[0].q[0];
+        let column = if tau.abs() >= TAYLOR_BELOW {
+            (fp1 - fp0) / tau
+        } else {
+            slope0
+        };
+        let force = g.fixed_rows::<3>(0).into_owned();
+        let offset = (r0 * fp0 + r1 * fp1) * 0.5;
+        let mut t = SVector::<f64, LOCAL>::zeros();
+        t.fixed_rows_mut::<3>(3).copy_from(&offset.cross(&force));
+        t[6] = (step.lever * column).dot(&force);
         Some(t)
     }
 

@@ -394,7 +394,7 @@ pub fn hat(a: &Vector3<f64>) -> Matrix3<f64> {
 /// second-order Taylor expansion instead of the difference quotient: the
 /// quotient's cancellation error is then ≤ eps/1e-6 ≈ 2e-10 relative, and the
 /// expansion's `f‴τ³/6` misses the increment by < 2e-19·f‴, below round-off.
-const TAYLOR_BELOW: f64 = 1e-6;
+pub(crate) const TAYLOR_BELOW: f64 = 1e-6;
 
 /// `B` for kinds with additive coordinates (the default of
 /// [`JointKinematics::step_map`]): along the path that changes one coordinate

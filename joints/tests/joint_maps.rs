@@ -1592,3 +1592,73 @@ fn incremental_transfer_start_derivative_matches_differences() {
         },
     );
 }
+
+#[test]
+fn incremental_transfer_by_a_parameter_matches_differences() {
+    // (∂Ñ/∂p)ᵀ g of the built-in kinds' values against central differences
+    // of Ñᵀ g with the value moved (both ends of the step held).
+    property(
+        "6f. d(Ntilde^T g)/dp = central differences, screw / rack / cam values",
+        CASES,
+        (
+            params(),
+            released(),
+            pose(),
+            vec3(-1.0, 1.0),
+            vec3(-0.7, 0.7),
+            released_increment(),
+        ),
+        |(p, q, m, u_m, w_m, d0), w| {
+            let theta_m = flexmech_core::rotation::tan_scaled(&w_m);
+            let (x1, r1) = (m.x + u_m, cayley(&theta_m) * m.r);
+            let g = Vector6::new(d0 + 0.2, 1.0, -2.0, 0.5, 0.3, -0.7);
+            let mut start = ReleasedState::new([q.psi0, 0.0, 0.0, 0.0]);
+            start.q[0] = q.psi;
+            let mut end = start;
+            end.q[0] += d0;
+            let screw = |c: f64| Screw {
+                axis: p.axis,
+                pitch: c,
+            };
+            let rack = |b: f64| RackPinion {
+                axis: p.axis,
+                slide: p.perp,
+                radius: b,
+            };
+            let cam = |r: f64, a: f64| Cam {
+                axis: p.axis,
+                slide: p.perp,
+                radius: r,
+                offset: a,
+            };
+            type Kind<'a> = (&'a str, f64, &'a dyn Fn(f64) -> Box<dyn JointMap>);
+            let kinds: [Kind; 4] = [
+                ("pitch", p.pitch, &|v| Box::new(screw(v))),
+                ("radius", p.pinion, &|v| Box::new(rack(v))),
+                ("radius", p.cam_r, &|v| Box::new(cam(v, p.cam_a))),
+                ("offset", p.cam_a, &|v| Box::new(cam(p.cam_r, v))),
+            ];
+            let master = [(&m.x, &m.r), (&x1, &r1)];
+            for (k, (name, value, make)) in kinds.into_iter().enumerate() {
+                let ad = make(value)
+                    .incremental_transfer_by(name, master, [&start, &end], &g)
+                    .ok_or_else(|| TestCaseError::fail("no derivative"))?;
+                // Each value enters `f` linearly: a wide stencil is exact and
+                // keeps the secant's round-off (eps|f|/τ) small against h.
+                let h = 1e-2;
+                let at = |v: f64| {
+                    make(v)
+                        .incremental_step(master, [&start, &end])
+                        .transfer(&g)
+                };
+                let fd = (at(value + h) - at(value - h)) / (2.0 * h);
+                w.check(
+                    &format!("kind {k} by {name}"),
+                    (fd - ad).norm() / (1.0 + ad.norm()),
+                    FD_TOL,
+                )?;
+            }
+            Ok(())
+        },
+    );
+}

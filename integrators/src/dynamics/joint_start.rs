@@ -86,7 +86,7 @@ impl JointStart {
             .map(|&n| Vector3::from_fn(|c, _| g0[6 * n + c] + ma[n][c]))
             .sum();
         Ok(Self {
-            velocity: omega.cross(&shift.delta) + shift.slope * rate,
+            velocity: shift.velocity(&omega, rate),
             acceleration: alpha.cross(&shift.delta) + shift.slope * psi_acc,
             force,
             shift,

@@ -128,7 +128,7 @@ pub(crate) struct MidpointTerms {
     pub(super) v_n: Vec<Vector3<f64>>,
     pub(super) w_n: Vec<Vector3<f64>>,
     /// Rates of each joint's released coordinates over the last step.
-    rates: Vec<Vec<f64>>,
+    pub(super) rates: Vec<Vec<f64>>,
     /// Whether the energy–momentum scheme's exact tangent is asked for
     /// (see [`NewtonSystem::set_exact_tangent`](crate::newton::NewtonSystem::set_exact_tangent)).
     pub(super) exact_tangent: bool,

@@ -24,9 +24,9 @@
 //! derivative along the start (the masters' start poses and the released
 //! start coordinates, with their derivatives) comes by dual numbers through
 //! `Ñ` ([`crate::constraints::Topology::incremental_start_terms`]); the
-//! slaves' end poses follow `dq` through `N`. The paper's scheme (its
-//! bordered β) and joints' own values as parameters are not differentiated
-//! yet.
+//! slaves' end poses follow `dq` through `N`. A joint's own value enters as
+//! in [`super::midpoint_joint`]. The paper's scheme (its bordered β) is not
+//! differentiated yet.
 
 use flexmech_core::conserving::{MidRotation, Pose, Pose3};
 use flexmech_core::rotation::cayley_inverse;
@@ -36,10 +36,12 @@ use nalgebra::{Matrix3, Vector3};
 use num_dual::Dual64;
 
 use super::midpoint::{end_motion, MidpointTerms};
+use super::midpoint_joint;
 use super::midpoint_kernels::{element_force, CorrectionTally};
 use super::newmark_sensitivity::{dual, dual_rotation, kinetic_derivative};
 use super::{slave_velocities, Scheme};
 use crate::error::SolveError;
+use crate::joint_parameter::{JointShift, StartShift};
 use crate::linsolve::SparseLu;
 use crate::record::Sensitivity;
 use crate::sensitivity::{mass_derivative, with_unit_stiffness, Parameter};
@@ -47,11 +49,11 @@ use crate::system::ReducedSystem;
 
 /// The derivatives of every node's start state by one parameter.
 #[derive(Debug, Clone)]
-struct History {
-    x: Vec<Vector3<f64>>,
+pub(super) struct History {
+    pub(super) x: Vec<Vector3<f64>>,
     /// Spatial: `dR/dp = θ̂ R`.
     theta: Vec<Vector3<f64>>,
-    v: Vec<Vector3<f64>>,
+    pub(super) v: Vec<Vector3<f64>>,
     w: Vec<Vector3<f64>>,
     /// Per joint, its released coordinates' (increments).
     released: Vec<[f64; MAX_RELEASED]>,
@@ -74,6 +76,8 @@ impl History {
 pub(crate) struct MidpointSensitivities {
     params: Vec<Parameter>,
     units: Vec<Option<Inertia>>,
+    /// Per parameter, its re-placement of a carried body at t = 0.
+    starts: Vec<StartShift>,
     /// The sensitivities of the state at t = 0.
     pub(crate) initial: Vec<Sensitivity>,
     lu: SparseLu,
@@ -101,19 +105,19 @@ impl MidpointSensitivities {
         let nodes = mech.mesh.node_count();
         let mut history = Vec::with_capacity(params.len());
         let mut units = Vec::with_capacity(params.len());
+        let mut starts = Vec::with_capacity(params.len());
         for p in params {
             p.check(mech)?;
-            if let Parameter::Joint { .. } = p {
-                return refuse(
-                    "sensitivities by a joint's value with the momentum and energy-momentum \
-                     schemes are not available yet: use \"newmark\" or \"generalized-alpha\"",
-                );
-            }
             let mut h = History::at_rest(nodes, mech.joints.len());
             if let Parameter::InitialMotion { motion } = p {
                 (h.v, h.w) = slave_velocities(mech, &sys.topo, &sys.end, motion);
             }
+            let start = p.start_shift(sys)?;
+            if let Parameter::Joint { joint, name } = p {
+                midpoint_joint::start_history(sys, (*joint, name), &start, &mut h)?;
+            }
             history.push(h);
+            starts.push(start);
             units.push(mass_derivative(mech, p, kind));
         }
         let (v0, w0) = (&sys.terms.v_n, &sys.terms.w_n);
@@ -127,6 +131,7 @@ impl MidpointSensitivities {
         Ok(Self {
             params: params.to_vec(),
             units,
+            starts,
             initial,
             lu: SparseLu::new(sys.asm.pattern().clone()).map_err(SolveError::Singular)?,
             history,
@@ -176,7 +181,16 @@ impl MidpointSensitivities {
                 &mut self.nodal,
                 mech,
             );
-            let extra = joint_history(sys, &self.history[k], &mut self.nodal)?;
+            let mut extra = joint_history(sys, &self.history[k], &mut self.nodal)?;
+            let shift = match p {
+                Parameter::Joint { joint, name } => {
+                    let shift = midpoint_joint::shift(sys, *joint, name)?;
+                    let at = (*joint, name.as_str());
+                    extra.extend(midpoint_joint::forces(sys, at, &shift, &mut self.nodal)?);
+                    Some(shift)
+                }
+                _ => None,
+            };
             let mut mass = 0.0;
             if let Some(unit) = &self.units[k] {
                 inertial_forces(
@@ -196,7 +210,7 @@ impl MidpointSensitivities {
             }
             dq.iter_mut().for_each(|v| *v = -*v);
             self.lu.solve(&mut dq).map_err(failed)?;
-            let next = advance(sys, &self.history[k], &dq);
+            let next = advance(sys, &self.history[k], &dq, shift.as_ref());
             let mut energy = partial + mass;
             energy += kinetic_derivative(&sys.terms.inertia, (&v1, &w1), (&next.v, &next.w));
             for n in 0..v1.len() {
@@ -206,8 +220,16 @@ impl MidpointSensitivities {
                     energy -= fext_end[6 * n + c] * next.x[n][c];
                 }
             }
+            let start = &self.starts[k];
+            energy += start.work(fext_end);
+            let displacement = (next.x.iter().enumerate())
+                .map(|(n, d)| {
+                    let d = d - start.of(n);
+                    [d.x, d.y, d.z]
+                })
+                .collect();
             out.push(Sensitivity {
-                displacement: next.x.iter().map(|d| [d.x, d.y, d.z]).collect(),
+                displacement,
                 energy,
             });
             self.history[k] = next;
@@ -401,7 +423,12 @@ fn joint_history(
 }
 
 /// The history derivatives at the step's end for the solved `dq = dq₁/dp`.
-fn advance(sys: &ReducedSystem<'_, MidpointTerms>, h: &History, dq: &[f64]) -> History {
+fn advance(
+    sys: &ReducedSystem<'_, MidpointTerms>,
+    h: &History,
+    dq: &[f64],
+    shift: Option<&JointShift>,
+) -> History {
     let (start, end, dt) = (&sys.start.config, &sys.end.config, sys.terms.dt);
     let mut next = History::at_rest(h.x.len(), h.released.len());
     for (j, eqs) in sys.topo.released_eqs.iter().enumerate() {
@@ -412,7 +439,7 @@ fn advance(sys: &ReducedSystem<'_, MidpointTerms>, h: &History, dq: &[f64]) -> H
     }
     for i in 0..h.x.len() {
         let d = sys.topo.dofs.node_increment(i, dq);
-        next.x[i] = d.fixed_rows::<3>(0).into_owned();
+        next.x[i] = d.fixed_rows::<3>(0) + shift.map_or(Vector3::zeros(), |s| s.of(i));
         next.theta[i] = d.fixed_rows::<3>(3).into_owned();
         next.v[i] = (next.x[i] - h.x[i]) * (2.0 / dt) - h.v[i];
         let r_n = dual_rotation(&start.rot[i], &h.theta[i]);
