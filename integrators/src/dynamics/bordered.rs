@@ -287,3 +287,51 @@ fn beta_increment(work: &BorderedWork, c_tot: f64, energy: f64, beta: f64) -> Op
     (pivot.abs() > TOLERANCES.border_pivot * size && pivot.is_finite())
         .then(|| (-energy - cy1) / pivot)
 }
+
+/// The border of a converged step of the paper's scheme, for exact
+/// sensitivities: `y₂ = K⁻¹b`, the energy equation's reduced gradient
+/// `c = ∇E + β∇C` and the pivot `d − c·y₂` (`d = C`).
+pub(super) struct Border {
+    y2: Vec<f64>,
+    c: Vec<f64>,
+    pivot: f64,
+}
+
+impl Border {
+    /// At the converged state of a step [`solve_step`] solved with β, `lu`
+    /// holding its factorised exact tangent.
+    pub(super) fn at<T: Bordered>(
+        sys: &ReducedSystem<'_, T>,
+        lu: &mut SparseLu,
+        beta: f64,
+    ) -> Result<Self, String> {
+        let mut work = BorderedWork::new(sys.topo.dofs.n_eq);
+        let sums = energy_equation(sys, &mut work);
+        let mut y2 = work.b.clone();
+        lu.solve(&mut y2)?;
+        let c: Vec<f64> = (work.ge.iter().zip(&work.gc))
+            .map(|(a, g)| a + beta * g)
+            .collect();
+        let cy2: f64 = c.iter().zip(&y2).map(|(a, b)| a * b).sum();
+        let pivot = sums.c_tot - cy2;
+        let size = sums.c_tot.abs()
+            + c.iter().map(|v| v * v).sum::<f64>().sqrt()
+                * y2.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(pivot.is_finite() && pivot != 0.0) || size == 0.0 {
+            return Err("the energy equation's border has no pivot".into());
+        }
+        Ok(Self { y2, c, pivot })
+    }
+
+    /// `dq = y₁ − y₂ dβ` from `y₁ = −K⁻¹ r_p` and the energy equation's
+    /// `e_p`, with `dβ = (−e_p − c·y₁)/(d − c·y₂)` (the bordered system's
+    /// last row); returns `dβ`.
+    pub(super) fn correct(&self, y1: &mut [f64], e_p: f64) -> f64 {
+        let cy1: f64 = self.c.iter().zip(y1.iter()).map(|(a, b)| a * b).sum();
+        let dbeta = (-e_p - cy1) / self.pivot;
+        for (y, z) in y1.iter_mut().zip(&self.y2) {
+            *y -= z * dbeta;
+        }
+        dbeta
+    }
+}

@@ -122,7 +122,10 @@ pub(crate) struct MidpointTerms {
     slots: MassSlots,
     pub(super) scheme: Scheme,
     /// The paper's energy–momentum β (0 for the other schemes).
-    beta: f64,
+    pub(super) beta: f64,
+    /// Whether the last step solved its energy equation for β (the paper's
+    /// scheme, where β had a lever on the energy).
+    pub(super) bordered: bool,
     pub(super) dt: f64,
     /// Velocities at the start of the step.
     pub(super) v_n: Vec<Vector3<f64>>,
@@ -168,6 +171,7 @@ impl MidpointTerms {
             slots,
             scheme,
             beta: 0.0,
+            bordered: false,
             dt: f64::NAN,
             v_n,
             w_n,
@@ -345,7 +349,12 @@ impl TimeScheme for MidpointTerms {
                     });
                 (rep, size)
             }),
-            Scheme::EnergyMomentumPaper => bordered::solve_step(sys, lu, settings),
+            Scheme::EnergyMomentumPaper => {
+                let solved = bordered::solve_step(sys, lu, settings);
+                // β took part in the step's equations (else it was left out).
+                sys.terms.bordered = matches!(&solved, Ok((_, beta)) if beta.is_finite());
+                solved
+            }
         }
     }
 

@@ -28,23 +28,23 @@
 //! in [`super::midpoint_joint`]. The paper's scheme (its bordered β) is not
 //! differentiated yet.
 
-use flexmech_core::conserving::{MidRotation, Pose, Pose3};
-use flexmech_core::rotation::cayley_inverse;
-use flexmech_core::{Configuration, Element, Inertia, MassKind, Scalar};
+use flexmech_core::{Inertia, MassKind};
 use flexmech_joints::MAX_RELEASED;
-use nalgebra::{Matrix3, Vector3};
-use num_dual::Dual64;
+use nalgebra::Vector3;
 
+use super::bordered::Border;
 use super::midpoint::{end_motion, MidpointTerms};
+use super::midpoint_history::{
+    end_internal_forces, end_spin, history_forces, inertial_forces, unit_forces,
+};
 use super::midpoint_joint;
-use super::midpoint_kernels::{element_force, CorrectionTally};
 use super::newmark_sensitivity::{dual, dual_rotation, kinetic_derivative};
 use super::{slave_velocities, Scheme};
 use crate::error::SolveError;
 use crate::joint_parameter::{JointShift, StartShift};
 use crate::linsolve::SparseLu;
 use crate::record::Sensitivity;
-use crate::sensitivity::{mass_derivative, with_unit_stiffness, Parameter};
+use crate::sensitivity::{mass_derivative, Parameter};
 use crate::system::ReducedSystem;
 
 /// The derivatives of every node's start state by one parameter.
@@ -52,9 +52,9 @@ use crate::system::ReducedSystem;
 pub(super) struct History {
     pub(super) x: Vec<Vector3<f64>>,
     /// Spatial: `dR/dp = θ̂ R`.
-    theta: Vec<Vector3<f64>>,
+    pub(super) theta: Vec<Vector3<f64>>,
     pub(super) v: Vec<Vector3<f64>>,
-    w: Vec<Vector3<f64>>,
+    pub(super) w: Vec<Vector3<f64>>,
     /// Per joint, its released coordinates' (increments).
     released: Vec<[f64; MAX_RELEASED]>,
 }
@@ -96,10 +96,11 @@ impl MidpointSensitivities {
     ) -> Result<Self, SolveError> {
         let mech = sys.mech;
         let refuse = |why: &str| Err(SolveError::InvalidMechanism(why.into()));
-        if sys.terms.scheme == Scheme::EnergyMomentumPaper {
+        let paper = sys.terms.scheme == Scheme::EnergyMomentumPaper;
+        if paper && params.iter().any(|p| matches!(p, Parameter::Joint { .. })) {
             return refuse(
-                "sensitivities with the paper's energy-momentum scheme (its bordered β) are not \
-                 available yet: use \"energy-momentum\" or \"momentum\"",
+                "sensitivities by a joint's value with the paper's energy-momentum scheme are \
+                 not available yet: use \"energy-momentum\" or \"momentum\"",
             );
         }
         let nodes = mech.mesh.node_count();
@@ -155,244 +156,129 @@ impl MidpointSensitivities {
         sys.evaluate_with(&mut self.r, true);
         sys.terms.exact_tangent = !cheap;
         self.lu.factor(&sys.asm.values).map_err(failed)?;
-        let (mech, dt) = (sys.mech, sys.terms.dt);
-        let (start, end) = (&sys.start.config, &sys.end.config);
-        let f_int = end_internal_forces(mech, end);
-        let (v1, w1) = end_motion(start, end, &sys.terms.v_n, &sys.terms.w_n, dt);
+        let border = match sys.terms.scheme {
+            Scheme::EnergyMomentumPaper if sys.terms.bordered => {
+                Some(Border::at(sys, &mut self.lu, sys.terms.beta).map_err(failed)?)
+            }
+            _ => None,
+        };
+        let end_state = EndState::of(sys);
         let mut out = Vec::with_capacity(self.params.len());
         for k in 0..self.params.len() {
-            let p = &self.params[k];
-            let partial = p.nodal_derivative(mech, end, t + 0.5 * dt, &mut self.nodal);
-            if let Parameter::Stiffness {
-                elements,
-                component,
-            } = p
-            {
-                self.nodal.iter_mut().for_each(|v| *v = 0.0);
-                unit_forces(sys, elements, *component, &mut self.nodal);
-            } else {
-                p.nodal_derivative(mech, end, t, &mut self.nodal);
-            }
-            history_forces(
-                &sys.terms,
-                start,
-                end,
-                &self.history[k],
-                &mut self.nodal,
-                mech,
-            );
-            let mut extra = joint_history(sys, &self.history[k], &mut self.nodal)?;
-            let shift = match p {
-                Parameter::Joint { joint, name } => {
-                    let shift = midpoint_joint::shift(sys, *joint, name)?;
-                    let at = (*joint, name.as_str());
-                    extra.extend(midpoint_joint::forces(sys, at, &shift, &mut self.nodal)?);
-                    Some(shift)
-                }
-                _ => None,
-            };
-            let mut mass = 0.0;
-            if let Some(unit) = &self.units[k] {
-                inertial_forces(
-                    unit,
-                    start,
-                    end,
-                    (&sys.terms.v_n, &sys.terms.w_n),
-                    dt,
-                    &mut self.nodal,
-                );
-                mass = unit.kinetic_energy(&v1, &w1);
-            }
-            let mut dq = vec![0.0; sys.topo.dofs.n_eq];
-            sys.reduce(&self.nodal, &mut dq);
-            for (eq, value) in extra {
-                dq[eq] += value;
-            }
+            let (mut dq, shift, partial, e_p) = self.residual_derivative(sys, k)?;
             dq.iter_mut().for_each(|v| *v = -*v);
             self.lu.solve(&mut dq).map_err(failed)?;
-            let next = advance(sys, &self.history[k], &dq, shift.as_ref());
-            let mut energy = partial + mass;
-            energy += kinetic_derivative(&sys.terms.inertia, (&v1, &w1), (&next.v, &next.w));
-            for n in 0..v1.len() {
-                for c in 0..3 {
-                    energy +=
-                        f_int[6 * n + c] * next.x[n][c] + f_int[6 * n + 3 + c] * next.theta[n][c];
-                    energy -= fext_end[6 * n + c] * next.x[n][c];
-                }
+            if let Some(border) = &border {
+                border.correct(&mut dq, e_p);
             }
-            let start = &self.starts[k];
-            energy += start.work(fext_end);
-            let displacement = (next.x.iter().enumerate())
-                .map(|(n, d)| {
-                    let d = d - start.of(n);
-                    [d.x, d.y, d.z]
-                })
-                .collect();
-            out.push(Sensitivity {
-                displacement,
-                energy,
-            });
+            let next = advance(sys, &self.history[k], &dq, shift.as_ref());
+            out.push(end_state.sensitivity(sys, &next, &self.starts[k], fext_end, partial));
             self.history[k] = next;
         }
         Ok(out)
     }
+
+    /// Parameter `k`'s reduced `∂r/∂p + ∂r/∂hₙ · dhₙ/dp` at the converged
+    /// step, its joint shift, `∂E/∂p` of the total energy at the step's end
+    /// (with a mass's kinetic share) and the paper's energy equation's
+    /// `∂e/∂p + ∂e/∂hₙ · dhₙ/dp`.
+    #[allow(clippy::type_complexity)]
+    fn residual_derivative(
+        &mut self,
+        sys: &ReducedSystem<'_, MidpointTerms>,
+        k: usize,
+    ) -> Result<(Vec<f64>, Option<JointShift>, f64, f64), SolveError> {
+        let (mech, dt, t) = (sys.mech, sys.terms.dt, sys.load_time);
+        let (start, end) = (&sys.start.config, &sys.end.config);
+        let p = &self.params[k];
+        let mut partial = p.nodal_derivative(mech, end, t + 0.5 * dt, &mut self.nodal);
+        let mut e_p = 0.0;
+        if let Parameter::Stiffness {
+            elements,
+            component,
+        } = p
+        {
+            self.nodal.iter_mut().for_each(|v| *v = 0.0);
+            e_p += unit_forces(sys, elements, *component, &mut self.nodal);
+        } else {
+            p.nodal_derivative(mech, end, t, &mut self.nodal);
+        }
+        let h = &self.history[k];
+        e_p += history_forces(&sys.terms, start, end, h, &mut self.nodal, mech);
+        let mut extra = joint_history(sys, h, &mut self.nodal)?;
+        let shift = match p {
+            Parameter::Joint { joint, name } => {
+                let shift = midpoint_joint::shift(sys, *joint, name)?;
+                let at = (*joint, name.as_str());
+                extra.extend(midpoint_joint::forces(sys, at, &shift, &mut self.nodal)?);
+                Some(shift)
+            }
+            _ => None,
+        };
+        if let Some(unit) = &self.units[k] {
+            let (v_n, w_n) = (&sys.terms.v_n, &sys.terms.w_n);
+            inertial_forces(unit, start, end, (v_n, w_n), dt, &mut self.nodal);
+            let (v1, w1) = end_motion(start, end, v_n, w_n, dt);
+            partial += unit.kinetic_energy(&v1, &w1);
+        }
+        let mut dq = vec![0.0; sys.topo.dofs.n_eq];
+        sys.reduce(&self.nodal, &mut dq);
+        for (eq, value) in extra {
+            dq[eq] += value;
+        }
+        Ok((dq, shift, partial, e_p))
+    }
 }
 
-/// The beams' internal forces `∂U/∂(x, φ)` at `config` (6 per node).
-fn end_internal_forces(mech: &crate::mechanism::Mechanism, config: &Configuration) -> Vec<f64> {
-    let mut f = vec![0.0; 6 * mech.mesh.node_count()];
-    let mut r = Vec::new();
-    for e in &mech.mesh.elements {
-        r.resize(e.dofs(), 0.0);
-        e.internal_force_into(&config.x, &config.rot, &mut r);
-        for (k, &n) in e.nodes().iter().enumerate() {
-            for c in 0..6 {
-                f[6 * n + c] += r[6 * k + c];
+/// What the records' derivatives need of a converged step's end: the
+/// internal forces and the velocities there.
+struct EndState {
+    f_int: Vec<f64>,
+    v1: Vec<Vector3<f64>>,
+    w1: Vec<Vector3<f64>>,
+}
+
+impl EndState {
+    fn of(sys: &ReducedSystem<'_, MidpointTerms>) -> Self {
+        let (start, end) = (&sys.start.config, &sys.end.config);
+        let (v1, w1) = end_motion(start, end, &sys.terms.v_n, &sys.terms.w_n, sys.terms.dt);
+        Self {
+            f_int: end_internal_forces(sys.mech, end),
+            v1,
+            w1,
+        }
+    }
+
+    /// The displacements' derivatives (from each model's own initial
+    /// positions, `start`) and the total energy's,
+    /// `Σ (M v)·dv + Σ J₀W·dW + Σ f_int·dx − Σ f_ext·du + ∂E/∂p`.
+    fn sensitivity(
+        &self,
+        sys: &ReducedSystem<'_, MidpointTerms>,
+        next: &History,
+        start: &StartShift,
+        fext_end: &[f64],
+        partial: f64,
+    ) -> Sensitivity {
+        let inertia = &sys.terms.inertia;
+        let mut energy = partial + start.work(fext_end);
+        energy += kinetic_derivative(inertia, (&self.v1, &self.w1), (&next.v, &next.w));
+        for n in 0..self.v1.len() {
+            for c in 0..3 {
+                energy += self.f_int[6 * n + c] * next.x[n][c]
+                    + self.f_int[6 * n + 3 + c] * next.theta[n][c];
+                energy -= fext_end[6 * n + c] * next.x[n][c];
             }
         }
-    }
-    f
-}
-
-/// `∂q/∂C` of a stiffness: the scheme's force of the unit-stiffness
-/// elements between the step's ends, added to `g`.
-fn unit_forces(
-    sys: &ReducedSystem<'_, MidpointTerms>,
-    elements: &[usize],
-    component: usize,
-    g: &mut [f64],
-) {
-    let (start, end) = (&sys.start.config, &sys.end.config);
-    let tally = CorrectionTally::default();
-    let mut r = Vec::new();
-    for &e in elements {
-        let unit = with_unit_stiffness(&sys.mech.mesh.elements[e], component);
-        r.resize(unit.dofs(), 0.0);
-        element_force(&unit, start, end, sys.terms.scheme, 0.0, &tally, &mut r);
-        for (k, &n) in unit.nodes().iter().enumerate() {
-            for c in 0..6 {
-                g[6 * n + c] += r[6 * k + c];
-            }
-        }
-    }
-}
-
-/// The scheme's element force with the start pose seeded by `h` (the end
-/// held): its derivative along the history.
-fn element_history(
-    el: &Element,
-    scheme: Scheme,
-    start: &Configuration,
-    end: &Configuration,
-    h: &History,
-) -> Vec<f64> {
-    type D = Dual64;
-    let s = |i: usize| {
-        (
-            dual(&start.x[i], &h.x[i]),
-            dual_rotation(&start.rot[i], &h.theta[i]),
-        )
-    };
-    let e = |i: usize| (end.x[i].map(D::from), end.rot[i].map(D::from));
-    let q = match el {
-        Element::Linear(el) => {
-            let n = el.nodes;
-            let sd: Pose<D> = (n.map(|i| s(i).0), n.map(|i| s(i).1));
-            let ed: Pose<D> = (n.map(|i| e(i).0), n.map(|i| e(i).1));
-            if scheme == Scheme::Momentum {
-                let (n0, m0) = el.resultants(&sd.0, &sd.1);
-                let (n1, m1) = el.resultants(&ed.0, &ed.1);
-                let half = D::from(0.5);
-                let (nbar, mbar) = ((n0 + n1) * half, (m0 + m1) * half);
-                el.midpoint_force(&sd, &ed, &nbar, &mbar, MidRotation::Geodesic)
-                    .as_slice()
-                    .to_vec()
-            } else {
-                el.energy_momentum_force(&sd, &ed).as_slice().to_vec()
-            }
-        }
-        Element::Quadratic(el) => {
-            let n = el.nodes;
-            let sd: Pose3<D> = (n.map(|i| s(i).0), n.map(|i| s(i).1));
-            let ed: Pose3<D> = (n.map(|i| e(i).0), n.map(|i| e(i).1));
-            el.discrete_gradient_force(&sd, &ed).as_slice().to_vec()
-        }
-    };
-    q.iter().map(|v| v.eps).collect()
-}
-
-/// `Wₙ₊₁ = 2Rₙᵀ cay⁻¹(Rₙ₊₁Rₙᵀ)/Δt − Wₙ` (generic, for dual numbers).
-fn end_spin<T: Scalar>(r_n: &Matrix3<T>, r1: &Matrix3<T>, w_n: &Vector3<T>, dt: f64) -> Vector3<T> {
-    let theta = cayley_inverse(&(r1 * r_n.transpose()));
-    r_n.transpose() * theta * T::from_subset(&(2.0 / dt)) - w_n
-}
-
-/// `∂g/∂hₙ · dhₙ/dp` at fixed end configuration, added to `g`: the
-/// elements' and the inertial forces' dependence on the start state.
-fn history_forces(
-    terms: &MidpointTerms,
-    start: &Configuration,
-    end: &Configuration,
-    h: &History,
-    g: &mut [f64],
-    mech: &crate::mechanism::Mechanism,
-) {
-    for el in &mech.mesh.elements {
-        let q = element_history(el, terms.scheme, start, end, h);
-        for (k, &n) in el.nodes().iter().enumerate() {
-            for c in 0..6 {
-                g[6 * n + c] += q[6 * k + c];
-            }
-        }
-    }
-    let dt = terms.dt;
-    // M(vₙ₊₁ − vₙ)/Δt = M(2(xₙ₊₁ − xₙ)/Δt − 2vₙ)/Δt: linear in the history.
-    let dv: Vec<Vector3<f64>> = (0..h.x.len())
-        .map(|j| (h.x[j] * (-2.0 / dt) - h.v[j] * 2.0) / dt)
-        .collect();
-    for (i, f) in terms.inertia.apply_mass(&dv).iter().enumerate() {
-        for c in 0..3 {
-            g[6 * i + c] += f[c];
-        }
-    }
-    for (i, j0) in terms.inertia.rotational.iter().enumerate() {
-        if *j0 == Matrix3::zeros() {
-            continue;
-        }
-        let r_n = dual_rotation(&start.rot[i], &h.theta[i]);
-        let r1 = end.rot[i].map(Dual64::from);
-        let w_n = dual(&terms.w_n[i], &h.w[i]);
-        let jd = j0.map(Dual64::from);
-        let m = (r1 * (jd * end_spin(&r_n, &r1, &w_n, dt)) - r_n * (jd * w_n)) / Dual64::from(dt);
-        for c in 0..3 {
-            g[6 * i + 3 + c] += m[c].eps;
-        }
-    }
-}
-
-/// `∂g/∂p` of a mass parameter's unit inertia `unit`: its inertial forces
-/// over the step, added to `g`.
-fn inertial_forces(
-    unit: &Inertia,
-    start: &Configuration,
-    end: &Configuration,
-    (v_n, w_n): (&[Vector3<f64>], &[Vector3<f64>]),
-    dt: f64,
-    g: &mut [f64],
-) {
-    let dv: Vec<Vector3<f64>> = (0..v_n.len())
-        .map(|j| ((end.x[j] - start.x[j]) * (2.0 / dt) - v_n[j] * 2.0) / dt)
-        .collect();
-    for (i, f) in unit.apply_mass(&dv).iter().enumerate() {
-        for c in 0..3 {
-            g[6 * i + c] += f[c];
-        }
-    }
-    for (i, j0) in unit.rotational.iter().enumerate() {
-        let w1 = end_spin(&start.rot[i], &end.rot[i], &w_n[i], dt);
-        let m = (end.rot[i] * (j0 * w1) - start.rot[i] * (j0 * w_n[i])) / dt;
-        for c in 0..3 {
-            g[6 * i + 3 + c] += m[c];
+        let displacement = (next.x.iter().enumerate())
+            .map(|(n, d)| {
+                let d = d - start.of(n);
+                [d.x, d.y, d.z]
+            })
+            .collect();
+        Sensitivity {
+            displacement,
+            energy,
         }
     }
 }

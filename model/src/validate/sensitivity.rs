@@ -311,17 +311,12 @@ pub(crate) fn analysis_allows_sensitivity(model: &Model) -> Result<(), &'static 
             }
         }
         Analysis::Dynamic {
-            integrator: IntegratorKind::Momentum | IntegratorKind::EnergyMomentum,
+            integrator:
+                IntegratorKind::Momentum
+                | IntegratorKind::EnergyMomentum
+                | IntegratorKind::EnergyMomentumPaper,
             ..
         } => {}
-        _ => {
-            return Err(
-                "sensitivities are computed for statics (load control and arc-length) and for \
-                 dynamics with integrator \"newmark\", \"generalized-alpha\", \"momentum\" \
-                 or \"energy-momentum\" so far, not with \"energy-momentum-paper\" (its \
-                 bordered β); remove `sensitivity` from [output], or change the integrator",
-            )
-        }
     }
     let follower = model.loads.iter().any(|l| l.follower)
         || model.distributed_loads.iter().any(|l| l.follower);
