@@ -162,6 +162,34 @@ impl<const N: usize> BeamElement<N> {
         e
     }
 
+    /// `∂Π/∂σ` at `σ = 1` for the element's initial length stretched to
+    /// `σL` along its straight axis, the initial strains `(Γ₀, K₀) = (e₁, 0)`
+    /// of a straight element unchanged: the strains from the initial
+    /// configuration become `(Γ + Γ₀)/σ − Γ₀` and `K/σ`, the weights `σL`, so
+    ///
+    /// ```text
+    /// ∂Π/∂σ = −Σ_g w_g (L/2) (½ Γ·C_N Γ + Γ₀·C_N Γ + ½ K·C_M K).
+    /// ```
+    ///
+    /// For any scalar: its gradient is the internal force's derivative by
+    /// the stretch (exact sensitivities by a beam's end coordinates).
+    pub fn stretch_rate<T: Scalar>(&self, x: &[Vector3<T>; N], rot: &[Matrix3<T>; N]) -> T {
+        let cn = self.section.c_n.map(cst::<T>);
+        let cm = self.section.c_m.map(cst::<T>);
+        let s = self.strains(x, rot);
+        let mut e = T::zero();
+        for (g, &(_, w)) in reduced_gauss(N).iter().enumerate() {
+            let (gam, kap) = s[g];
+            let gam0 = self.strain0[g].0.map(cst::<T>);
+            let n = gam.component_mul(&cn);
+            e -= (n.dot(&gam) * cst::<T>(0.5)
+                + n.dot(&gam0)
+                + kap.component_mul(&cm).dot(&kap) * cst::<T>(0.5))
+                * cst::<T>(0.5 * w * self.length);
+        }
+        e
+    }
+
     /// Gradient of [`Self::energy`] with respect to the nodal increments
     /// `(δx₀, δφ₀, δx₁, δφ₁, …)` (spatial spins), by forward-mode AD.
     /// `D` must equal `6N`.

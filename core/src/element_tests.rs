@@ -244,3 +244,44 @@ fn residual_is_equilibrated() {
         + r.fixed_rows::<3>(9);
     assert!(f.norm() < 1e-10 * r.norm() && m.norm() < 1e-10 * r.norm());
 }
+
+#[test]
+fn the_stretch_rate_is_the_energys_derivative_by_the_initial_length() {
+    // ∂Π/∂σ in closed form against central differences of the energy of
+    // the same element built σ = 1 ± h times as long (its initial nodes
+    // moved along its axis), in a deformed state; 2- and 3-node elements.
+    let (e, x0) = straight2();
+    let dir = (x0[1] - x0[0]).normalize();
+    let l0 = e.lambda0[0];
+    let x = [
+        x0[0] + Vector3::new(0.01, -0.03, 0.02),
+        x0[1] + Vector3::new(-0.05, 0.04, 0.1),
+    ];
+    let rot = [
+        exp(&Vector3::new(0.1, -0.2, 0.05)),
+        exp(&Vector3::new(-0.15, 0.1, 0.3)),
+    ];
+    let h = 1e-5;
+    let energy = |s: f64| {
+        let x0s = [x0[0], x0[0] + dir * (1.3 * s)];
+        BeamElement::new([0, 1], section(), 1.3 * s, &x0s, [l0, l0]).energy(&x, &rot)
+    };
+    let fd = (energy(1.0 + h) - energy(1.0 - h)) / (2.0 * h);
+    let exact: f64 = e.stretch_rate(&x, &rot);
+    assert!((exact - fd).abs() <= 1e-8 * fd.abs(), "{exact} vs {fd}");
+    let x3 = [x0[0], (x0[0] + x0[1]) * 0.5, x0[1]];
+    let e3 = BeamElement::new([0, 1, 2], section(), 1.3, &x3, [l0, l0, l0]);
+    let xd = [
+        x3[0] + Vector3::new(0.01, 0.0, -0.02),
+        x3[1] + Vector3::new(0.0, 0.05, 0.01),
+        x3[2],
+    ];
+    let rd = [rot[0], exp(&Vector3::new(0.05, 0.05, 0.0)), rot[1]];
+    let energy3 = |s: f64| {
+        let xs = [x3[0], x3[0] + dir * (0.65 * s), x3[0] + dir * (1.3 * s)];
+        BeamElement::new([0, 1, 2], section(), 1.3 * s, &xs, [l0, l0, l0]).energy(&xd, &rd)
+    };
+    let fd = (energy3(1.0 + h) - energy3(1.0 - h)) / (2.0 * h);
+    let exact: f64 = e3.stretch_rate(&xd, &rd);
+    assert!((exact - fd).abs() <= 1e-8 * fd.abs(), "{exact} vs {fd}");
+}

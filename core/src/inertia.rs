@@ -102,6 +102,59 @@ impl Inertia {
         }
     }
 
+    /// The derivative of the beams' inertia by a change of their initial
+    /// geometry in which element `e` of `stretch` lengthens by `s_e L_e`
+    /// (`dL/dp = s_e L_e`) and every listed element's initial triads turn by
+    /// `spin` (`dλ₀/dp = ω̂ λ₀`): the translational masses `ρA L` scale with
+    /// `s_e`, the rotational `λ₀ J_ρ λ₀ᵀ w L` gains
+    /// `(ω̂ A − A ω̂) w L + A w L s_e` (`A = λ₀ J_ρ λ₀ᵀ`). Elements not listed
+    /// contribute nothing.
+    pub fn geometry_derivative(
+        mesh: &Mesh,
+        kind: MassKind,
+        stretch: &[(usize, f64)],
+        spin: &Vector3<f64>,
+    ) -> Self {
+        let n = mesh.node_count();
+        let mut out = Self {
+            mass: Vec::new(),
+            row_mass: vec![0.0; n],
+            rotational: vec![Matrix3::zeros(); n],
+        };
+        let omega = crate::rotation::skew(spin);
+        for &(k, s) in stretch {
+            let e = &mesh.elements[k];
+            let (nodes, sec, l) = (e.nodes(), e.section(), e.length());
+            let frac = consistent_fractions(nodes.len());
+            for a in 0..nodes.len() {
+                for b in 0..nodes.len() {
+                    let m = sec.rho_a * l * s * frac[a][b];
+                    let (i, j) = match kind {
+                        MassKind::Consistent => (nodes[a], nodes[b]),
+                        MassKind::Lumped => (nodes[a], nodes[a]),
+                    };
+                    out.add_pair(i, j, m);
+                    out.row_mass[nodes[a]] += m;
+                }
+            }
+            let j_rho = Matrix3::from_diagonal(&sec.rho_j);
+            for (a, w) in nodal_weights(nodes.len()).iter().enumerate() {
+                let l0 = triad0(e, a);
+                let big_a = l0 * j_rho * l0.transpose();
+                out.rotational[nodes[a]] += (omega * big_a - big_a * omega + big_a * s) * (w * l);
+            }
+        }
+        out
+    }
+
+    /// Adds `m` to the pair `(i, j)` (kept sorted).
+    fn add_pair(&mut self, i: usize, j: usize, m: f64) {
+        match self.mass.binary_search_by_key(&(i, j), |&(a, b, _)| (a, b)) {
+            Ok(k) => self.mass[k].2 += m,
+            Err(k) => self.mass.insert(k, (i, j, m)),
+        }
+    }
+
     /// Adds a rigid body whose centre of mass is `node`: mass `m` on the
     /// node's translations and inertia `j` about its centre of mass (global
     /// axes of the initial configuration, where every node's frame is the

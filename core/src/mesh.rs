@@ -5,6 +5,7 @@
 use crate::element::BeamElement;
 use crate::rotation::{exp, log};
 use crate::section::Section;
+use crate::Scalar;
 use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
 
@@ -226,6 +227,23 @@ impl Element {
         }
     }
 
+    /// `∂Π/∂σ` and its gradient `∂f/∂σ` (`6N`) for the element's length
+    /// stretched to `σL` ([`BeamElement::stretch_rate`]; straight elements).
+    pub fn stretch_force(&self, x: &[Vector3<f64>], rot: &[Matrix3<f64>]) -> (f64, Vec<f64>) {
+        match self {
+            Element::Linear(e) => {
+                let (xe, re) = gather(&e.nodes, x, rot);
+                let (g, _) = e.gradient_hessian_ad::<12>(&xe, &re, |x, q| e.stretch_rate(x, q));
+                (e.stretch_rate(&xe, &re), g.as_slice().to_vec())
+            }
+            Element::Quadratic(e) => {
+                let (xe, re) = gather(&e.nodes, x, rot);
+                let (g, _) = e.gradient_hessian_ad::<18>(&xe, &re, |x, q| e.stretch_rate(x, q));
+                (e.stretch_rate(&xe, &re), g.as_slice().to_vec())
+            }
+        }
+    }
+
     /// Residual (internal force, `6N`) and tangent (`6N × 6N`, column-major)
     /// in a global configuration, written into `r` and `k`.
     pub fn residual_tangent(
@@ -325,8 +343,17 @@ fn triad(t1: &Vector3<f64>, e2: &Vector3<f64>) -> Result<Matrix3<f64>, MeshError
     if t2.norm() <= 1e-8 * e2.norm() || e2.norm() == 0.0 {
         return Err(MeshError::ParallelE2);
     }
-    let t2 = t2.normalize();
-    Ok(Matrix3::from_columns(&[*t1, t2, t1.cross(&t2)]))
+    Ok(straight_triad(t1, e2))
+}
+
+/// The initial triad of a straight beam along the unit `t1` with the
+/// section axis `e2` (not parallel to `t1`): `[t1, t2, t1 × t2]`, `t2` the
+/// normalised part of `e2` orthogonal to `t1`. For any scalar (the triad's
+/// derivative by the beam's end coordinates).
+pub fn straight_triad<T: Scalar>(t1: &Vector3<T>, e2: &Vector3<T>) -> Matrix3<T> {
+    let t2 = e2 - t1 * e2.dot(t1);
+    let t2 = t2 / t2.norm();
+    Matrix3::from_columns(&[*t1, t2, t1.cross(&t2)])
 }
 
 impl Mesh {

@@ -21,7 +21,7 @@
 //! the model places it. The derivative is then that of the model whose
 //! **carried body** — the slave and every node joined to it by elements and
 //! other joints, this joint cut — is re-placed rigidly with it by
-//! `δ₀ = R_m ∂f/∂p(ψ₀)` ([`StartShift`]): what a researcher does by hand to
+//! `δ₀ = R_m ∂f/∂p(ψ₀)` ([`crate::start_shift::StartShift`]): what a researcher does by hand to
 //! change a cam's offset (move the follower's beams with it). A rigid
 //! translation leaves the carried elements' strains, masses and dead loads
 //! as they were, so the body's positions start at `dx₀/dp = δ₀` and its
@@ -37,7 +37,7 @@ use crate::mechanism::Mechanism;
 
 /// Below this size (relative to the mechanism) a joint parameter's shift of
 /// the slave at t = 0 counts as none.
-const START_SHIFT: f64 = 1e-12;
+pub(crate) const START_SHIFT: f64 = 1e-12;
 
 /// A joint parameter's direct effect at one state.
 pub(crate) struct JointShift {
@@ -107,38 +107,9 @@ impl JointShift {
         inertia: Option<(&flexmech_core::Inertia, f64)>,
         g: &mut [f64],
     ) {
-        let moved = |n: usize| self.nodes.contains(&n);
-        for e in &mech.mesh.elements {
-            let nodes = e.nodes();
-            if !nodes.iter().any(|&n| moved(n)) {
-                continue;
-            }
-            let n = 6 * nodes.len();
-            let (mut r, mut k) = (vec![0.0; n], vec![0.0; n * n]);
-            tangent(e, &mut r, &mut k);
-            for (b, &nb) in nodes.iter().enumerate() {
-                if !moved(nb) {
-                    continue;
-                }
-                for c in 0..3 {
-                    let column = &k[(6 * b + c) * n..(6 * b + c + 1) * n];
-                    for (a, &na) in nodes.iter().enumerate() {
-                        for i in 0..6 {
-                            g[6 * na + i] += column[6 * a + i] * self.delta[c];
-                        }
-                    }
-                }
-            }
-        }
-        if let Some((inertia, c)) = inertia {
-            for &(i, j, m) in &inertia.mass {
-                if moved(j) {
-                    for comp in 0..3 {
-                        g[6 * i + comp] += c * m * self.delta[comp];
-                    }
-                }
-            }
-        }
+        let moved: Vec<(usize, Vector3<f64>)> =
+            self.nodes.iter().map(|&n| (n, self.delta)).collect();
+        add_moved_stiffness(mech, tangent, inertia, &moved, g);
     }
 
     /// Adds `(∂T/∂p)ᵀ g` for the nodal residual `g`: the master's moment into
@@ -198,61 +169,14 @@ fn placed_from(mech: &Mechanism, topo: &Topology, slave: usize) -> Vec<usize> {
     nodes
 }
 
-/// The rigid re-placement at t = 0 of the body a joint parameter carries
-/// (module docs): the carried nodes and `δ₀ = R_m ∂f/∂p(ψ₀)` (none when the
-/// parameter leaves the slave where it is).
-#[derive(Debug, Clone, Default)]
-pub(crate) struct StartShift {
-    nodes: Vec<usize>,
-    delta: Vector3<f64>,
-}
-
-impl StartShift {
-    /// The re-placement by parameter `name` of joint `joint` at the initial
-    /// `state`; refused where the carried body is held otherwise.
-    pub(crate) fn new(
-        mech: &Mechanism,
-        topo: &Topology,
-        state: &MechanismState,
-        joint: usize,
-        name: &str,
-    ) -> Result<Self, SolveError> {
-        let shift = JointShift::at(mech, topo, state, joint, name)?;
-        if shift.delta.norm() <= START_SHIFT * mech.size_at(&mech.mesh.positions).max(1.0) {
-            return Ok(Self::default());
-        }
-        Ok(Self {
-            nodes: carried_body(mech, joint, name)?,
-            delta: shift.delta,
-        })
-    }
-
-    /// `dX/dp` of node `n`'s initial position.
-    pub(crate) fn of(&self, n: usize) -> Vector3<f64> {
-        if self.nodes.contains(&n) {
-            self.delta
-        } else {
-            Vector3::zeros()
-        }
-    }
-
-    /// The carried nodes (none without a shift).
-    pub(crate) fn nodes(&self) -> &[usize] {
-        &self.nodes
-    }
-
-    /// `Σ f·δ₀` over the carried nodes' translations of the nodal `f`.
-    pub(crate) fn work(&self, f: &[f64]) -> f64 {
-        (self.nodes.iter())
-            .map(|&n| Vector3::new(f[6 * n], f[6 * n + 1], f[6 * n + 2]).dot(&self.delta))
-            .sum()
-    }
-}
-
 /// The body joint `joint` carries: the nodes reached from its slave through
 /// elements and the other joints. Refused with `name` where it reaches the
 /// master, a support or a prescribed motion (it could not move rigidly).
-fn carried_body(mech: &Mechanism, joint: usize, name: &str) -> Result<Vec<usize>, SolveError> {
+pub(crate) fn carried_body(
+    mech: &Mechanism,
+    joint: usize,
+    name: &str,
+) -> Result<Vec<usize>, SolveError> {
     let n = mech.mesh.node_count();
     let mut links: Vec<Vec<usize>> = vec![Vec::new(); n];
     let mut link = |a: usize, b: usize| {
@@ -303,5 +227,48 @@ fn carried_body(mech: &Mechanism, joint: usize, name: &str) -> Result<Vec<usize>
              by a parameter that leaves f(ψ₀) unchanged, or free the body",
             j.name
         ))),
+    }
+}
+
+/// Adds `∂g/∂x · δ` of the elements (force and tangent from
+/// `tangent(element, r, k)`, the tangent with respect to the end pose) and,
+/// with `inertia = (M, c)`, `c M δ`, for nodes moved by `moved` (node, `δ`),
+/// to the nodal `g`.
+pub(crate) fn add_moved_stiffness(
+    mech: &Mechanism,
+    tangent: impl Fn(&flexmech_core::Element, &mut [f64], &mut [f64]),
+    inertia: Option<(&flexmech_core::Inertia, f64)>,
+    moved: &[(usize, Vector3<f64>)],
+    g: &mut [f64],
+) {
+    let shift = |n: usize| moved.iter().find(|(m, _)| *m == n).map(|(_, d)| *d);
+    for e in &mech.mesh.elements {
+        let nodes = e.nodes();
+        if !nodes.iter().any(|&n| shift(n).is_some()) {
+            continue;
+        }
+        let n = 6 * nodes.len();
+        let (mut r, mut k) = (vec![0.0; n], vec![0.0; n * n]);
+        tangent(e, &mut r, &mut k);
+        for (b, &nb) in nodes.iter().enumerate() {
+            let Some(delta) = shift(nb) else { continue };
+            for c in 0..3 {
+                let column = &k[(6 * b + c) * n..(6 * b + c + 1) * n];
+                for (a, &na) in nodes.iter().enumerate() {
+                    for i in 0..6 {
+                        g[6 * na + i] += column[6 * a + i] * delta[c];
+                    }
+                }
+            }
+        }
+    }
+    if let Some((inertia, c)) = inertia {
+        for &(i, j, m) in &inertia.mass {
+            if let Some(delta) = shift(j) {
+                for comp in 0..3 {
+                    g[6 * i + comp] += c * m * delta[comp];
+                }
+            }
+        }
     }
 }

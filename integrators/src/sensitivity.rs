@@ -37,10 +37,11 @@ use nalgebra::Vector3;
 use std::ops::AddAssign;
 
 use crate::error::SolveError;
-use crate::joint_parameter::{JointShift, StartShift};
+use crate::joint_parameter::JointShift;
 use crate::linsolve::SparseLu;
 use crate::mechanism::{nodal_weights, Mechanism};
 use crate::record::Sensitivity;
+use crate::start_shift::StartShift;
 use crate::system::{ReducedSystem, StepTerms};
 use flexmech_core::{Configuration, Element, Section};
 
@@ -101,6 +102,18 @@ pub enum Parameter {
         /// The parameter's name.
         name: String,
     },
+    /// A change of a straight beam's initial geometry (one coordinate of
+    /// its end): its elements lengthen, `dL/dp = s_e L_e`, their initial
+    /// triads turn, `dλ₀/dp = ω̂ λ₀`, and its nodes' initial positions move
+    /// by `dX/dp` ([`crate::geometry`]).
+    Geometry {
+        /// The beam's elements with their relative stretch `s_e`.
+        stretch: Vec<(usize, f64)>,
+        /// `ω`.
+        spin: Vector3<f64>,
+        /// The moved nodes' `dX/dp`.
+        shifts: Vec<(usize, Vector3<f64>)>,
+    },
     /// A value of the initial motion (dynamics): `motion` is the
     /// derivative of the initial nodal velocities (and joint rates) by it;
     /// the slaves' follow through `N`.
@@ -113,6 +126,9 @@ pub enum Parameter {
 impl Parameter {
     /// Whether it names elements, a load and a component that exist.
     pub fn check(&self, mech: &Mechanism) -> Result<(), SolveError> {
+        if let Parameter::Geometry { shifts, .. } = self {
+            crate::geometry::check_joints(mech, shifts)?;
+        }
         let ok = match self {
             Parameter::Stiffness {
                 elements,
@@ -134,6 +150,14 @@ impl Parameter {
                 component,
             } => *component < 4 && elements.iter().all(|&e| e < mech.mesh.elements.len()),
             Parameter::Joint { joint, .. } => *joint < mech.joints.len(),
+            Parameter::Geometry {
+                stretch, shifts, ..
+            } => {
+                stretch
+                    .iter()
+                    .all(|&(e, s)| e < mech.mesh.elements.len() && s.is_finite())
+                    && shifts.iter().all(|&(n, _)| n < mech.mesh.node_count())
+            }
             Parameter::BodyMass { body, component } => *body < mech.bodies.len() && *component < 4,
         };
         if ok {
@@ -168,9 +192,21 @@ impl Parameter {
     ) -> Result<StartShift, SolveError> {
         match self {
             Parameter::Joint { joint, name } => {
-                StartShift::new(sys.mech, &sys.topo, &sys.end, *joint, name)
+                StartShift::for_joint(sys.mech, &sys.topo, &sys.end, *joint, name)
             }
+            Parameter::Geometry { shifts, .. } => Ok(StartShift::of_nodes(shifts.clone())),
             _ => Ok(StartShift::default()),
+        }
+    }
+
+    /// The held translations this parameter moves at every step, node by
+    /// node ([`crate::geometry::held_shifts`]; none but for a geometry).
+    pub(crate) fn held_shift(&self, mech: &Mechanism) -> StartShift {
+        match self {
+            Parameter::Geometry { shifts, .. } => {
+                StartShift::of_nodes(crate::geometry::held_shifts(mech, shifts))
+            }
+            _ => StartShift::default(),
         }
     }
 
@@ -182,6 +218,7 @@ impl Parameter {
             | Parameter::InitialMotion { .. }
             | Parameter::Mass { .. }
             | Parameter::Joint { .. }
+            | Parameter::Geometry { .. }
             | Parameter::BodyMass { .. } => (Vec::new(), 0),
             Parameter::Load { load, component } => (vec![(*load, 1.0)], *component),
             Parameter::Loads { shares, component } => (shares.clone(), *component),
@@ -225,6 +262,9 @@ impl Parameter {
         } = self
         {
             return unit_gravity(mech, elements, *component, config, lambda, out);
+        }
+        if let Parameter::Geometry { stretch, spin, .. } = self {
+            return crate::geometry::forces(mech, config, lambda, (stretch, spin), out);
         }
         if let Parameter::BodyMass { body, component: 0 } = self {
             let n = mech.bodies[*body].node;
@@ -288,6 +328,9 @@ pub(crate) fn mass_derivative(
     kind: flexmech_core::MassKind,
 ) -> Option<flexmech_core::Inertia> {
     match p {
+        Parameter::Geometry { stretch, spin, .. } => Some(
+            flexmech_core::Inertia::geometry_derivative(&mech.mesh, kind, stretch, spin),
+        ),
         Parameter::Mass {
             elements,
             component,
@@ -405,6 +448,8 @@ impl StaticSensitivities {
                 s.add_stiffness(sys.mech, &sys.end.config, None, &mut self.nodal);
                 s.add_transfer(&sys.nodal, &mut self.nodal)
             });
+            let held = p.held_shift(sys.mech);
+            held.add_stiffness(sys.mech, &sys.end.config, None, &mut self.nodal);
             let mut dq = vec![0.0; sys.topo.dofs.n_eq];
             sys.reduce(&self.nodal, &mut dq);
             if let Some((eq, share)) = psi {
@@ -413,7 +458,13 @@ impl StaticSensitivities {
             dq.iter_mut().for_each(|v| *v = -*v);
             self.lu.solve(&mut dq).map_err(failed)?;
             let partial = partial + start.work(&sys.fext);
-            out.push(sensitivity_of(sys, &dq, shift.as_ref(), start, partial));
+            out.push(sensitivity_of(
+                sys,
+                &dq,
+                (shift.as_ref(), &held),
+                start,
+                partial,
+            ));
         }
         Ok(out)
     }
@@ -425,7 +476,7 @@ impl StaticSensitivities {
 fn sensitivity_of<T: StepTerms>(
     sys: &ReducedSystem<'_, T>,
     dq: &[f64],
-    shift: Option<&JointShift>,
+    (shift, held): (Option<&JointShift>, &StartShift),
     start: &StartShift,
     partial: f64,
 ) -> Sensitivity {
@@ -436,6 +487,7 @@ fn sensitivity_of<T: StepTerms>(
             if let Some(s) = shift {
                 d.fixed_rows_mut::<3>(0).add_assign(&s.of(n));
             }
+            d.fixed_rows_mut::<3>(0).add_assign(&held.of(n));
             for c in 0..6 {
                 // f_int = g + f_ext; the dead loads' potential sees translations only.
                 let f = sys.nodal[6 * n + c] + sys.fext[6 * n + c];

@@ -69,6 +69,56 @@ impl Built {
         motion
     }
 
+    /// The geometry parameter of coordinate `component` of straight beam
+    /// `b`'s start (`end` 0) or end (1): with `t` the unit axis and `ℓ` the
+    /// length, node `k` at `s_k ℓ` along the beam moves by `(1 − s_k) e_c`
+    /// (start) or `s_k e_c` (end), every element stretches by
+    /// `∓ t·e_c / ℓ`, and the triads `[t, t₂, t × t₂]` turn as `t` does,
+    /// `dt = ±(e_c − t (t·e_c))/ℓ` (their derivative by a dual number through
+    /// the mesher's own construction).
+    fn beam_end_parameter(&self, model: &Model, b: usize, end: usize, c: usize) -> Parameter {
+        let crate::types::BeamGeometry::Straight {
+            start,
+            end: tip,
+            e2,
+        } = model.beams[b].geometry
+        else {
+            unreachable!("the key was checked to name a straight beam's end")
+        };
+        let (axis, length) = ((tip - start).normalize(), (tip - start).norm());
+        let sign = if end == 0 { -1.0 } else { 1.0 };
+        let e_c = Vector3::ith(c, 1.0);
+        let dt = (e_c - axis * axis.dot(&e_c)) * (sign / length);
+        let dual = |v: &Vector3<f64>, d: &Vector3<f64>| {
+            Vector3::from_fn(|i, _| num_dual::Dual64::new(v[i], d[i]))
+        };
+        let triad =
+            flexmech_core::mesh::straight_triad(&dual(&axis, &dt), &dual(&e2, &Vector3::zeros()));
+        let (l0, dl0) = (triad.map(|v| v.re), triad.map(|v| v.eps));
+        let w = dl0 * l0.transpose();
+        let spin = Vector3::new(
+            w[(2, 1)] - w[(1, 2)],
+            w[(0, 2)] - w[(2, 0)],
+            w[(1, 0)] - w[(0, 1)],
+        ) * 0.5;
+        let x0 = &self.mechanism.mesh.positions;
+        let shifts = (self.beam_nodes[b].iter())
+            .map(|&n| {
+                let s = (x0[n] - start).dot(&axis) / length;
+                (n, e_c * if end == 0 { 1.0 - s } else { s })
+            })
+            .collect();
+        let stretch = sign * axis.dot(&e_c) / length;
+        Parameter::Geometry {
+            stretch: self.beam_elements[b]
+                .clone()
+                .map(|e| (e, stretch))
+                .collect(),
+            spin,
+            shifts,
+        }
+    }
+
     /// The mechanism's parameter of every `[output] sensitivity` key of
     /// `model` (the model this was built from), in order: a section's
     /// stiffness on the elements of every beam of that section; a load's
@@ -105,6 +155,11 @@ impl Built {
                 shares: self.load_shares[loads + load].clone(),
                 component,
             },
+            SensitivityKey::BeamEnd {
+                beam,
+                end,
+                component,
+            } => self.beam_end_parameter(model, beam, end, component),
             SensitivityKey::InitialVelocity { field, component } => Parameter::InitialMotion {
                 motion: self.initial_motion_derivative(model, field, component),
             },

@@ -311,6 +311,16 @@ impl Checker<'_> {
                 SensitivityKey::InitialVelocity { field, component } => {
                     field < m.initial_velocities.len() && component < 6
                 }
+                SensitivityKey::BeamEnd {
+                    beam,
+                    end,
+                    component,
+                } => {
+                    let field = format!("{}[{component}]", ["start", "end"][end.min(1)]);
+                    beam < m.beams.len()
+                        && end < 2
+                        && crate::validate::beam_end(m, beam, &field).is_some_and(|r| r.is_ok())
+                }
             };
             if !ok {
                 return Err(self.fail(

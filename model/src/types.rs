@@ -371,6 +371,17 @@ pub enum SensitivityKey {
         /// The parameter's name.
         name: String,
     },
+    /// Coordinate `component` (0–2) of the start (`end` 0) or end (`end` 1)
+    /// of straight `[[beam]]` `beam`: its nodes move along their places on
+    /// the beam.
+    BeamEnd {
+        /// Index into [`Model::beams`].
+        beam: usize,
+        /// 0: `start`, 1: `end`.
+        end: usize,
+        /// Which coordinate, 0–2.
+        component: usize,
+    },
     /// Component `component` (0–2 `linear`, 3–5 `angular`) of
     /// `[[initial_velocity]]` `field` (dynamics).
     InitialVelocity {

@@ -18,7 +18,7 @@
 //! equation of a free `ψ`, `F` the translational force of `h` on the subtree
 //! (`ψ̈₀ = 0` for a driven angle, whose acceleration the scheme's `q̈` does
 //! not hold). A carried body re-placed with the slave
-//! ([`crate::joint_parameter::StartShift`]) moves rigidly, so `∂g/∂p = 0`
+//! ([`crate::start_shift::StartShift`]) moves rigidly, so `∂g/∂p = 0`
 //! from its elements.
 
 use nalgebra::Vector3;

@@ -13,7 +13,7 @@
 //!
 //! the scheme's element tangent with respect to the end pose applied to
 //! the shift. At t = 0 the body the joint carries is re-placed with the
-//! slave ([`crate::joint_parameter::StartShift`]) and the slave's velocity
+//! slave ([`crate::start_shift::StartShift`]) and the slave's velocity
 //! `N q̇` changes by `ω_m × δ + s ψ̇₀`. A slave that carries further joints
 //! is not differentiated yet.
 
@@ -23,7 +23,8 @@ use super::midpoint::MidpointTerms;
 use super::midpoint_kernels::element_kernel;
 use super::midpoint_sensitivity::History;
 use crate::error::SolveError;
-use crate::joint_parameter::{JointShift, StartShift};
+use crate::joint_parameter::JointShift;
+use crate::start_shift::StartShift;
 use crate::system::ReducedSystem;
 
 /// The direct effect of value `name` of joint `joint` at the end of the
@@ -55,9 +56,9 @@ pub(super) fn start_history(
     h: &mut History,
 ) -> Result<(), SolveError> {
     let shift = shift(sys, joint, name)?;
-    let spinning = (start.nodes().iter())
-        .find(|n| !shift.nodes.contains(n) && sys.terms.w_n[**n] != Vector3::zeros());
-    if let Some(&n) = spinning {
+    let spinning =
+        (start.nodes()).find(|n| !shift.nodes.contains(n) && sys.terms.w_n[*n] != Vector3::zeros());
+    if let Some(n) = spinning {
         return Err(SolveError::InvalidMechanism(format!(
             "the body joint `{}`'s `{name}` re-places at t = 0 (with node {n}) starts with an \
              angular velocity, whose velocity field depends on the body's position: \

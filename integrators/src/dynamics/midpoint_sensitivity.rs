@@ -41,10 +41,11 @@ use super::midpoint_joint;
 use super::newmark_sensitivity::{dual, dual_rotation, kinetic_derivative};
 use super::{slave_velocities, Scheme};
 use crate::error::SolveError;
-use crate::joint_parameter::{JointShift, StartShift};
+use crate::joint_parameter::JointShift;
 use crate::linsolve::SparseLu;
 use crate::record::Sensitivity;
 use crate::sensitivity::{mass_derivative, Parameter};
+use crate::start_shift::StartShift;
 use crate::system::ReducedSystem;
 
 /// The derivatives of every node's start state by one parameter.
@@ -96,6 +97,15 @@ impl MidpointSensitivities {
     ) -> Result<Self, SolveError> {
         let mech = sys.mech;
         let refuse = |why: &str| Err(SolveError::InvalidMechanism(why.into()));
+        if params
+            .iter()
+            .any(|p| matches!(p, Parameter::Geometry { .. }))
+        {
+            return refuse(
+                "sensitivities by a beam's end coordinates are computed in statics and with \
+                 \"newmark\" or \"generalized-alpha\" so far",
+            );
+        }
         let paper = sys.terms.scheme == Scheme::EnergyMomentumPaper;
         if paper && params.iter().any(|p| matches!(p, Parameter::Joint { .. })) {
             return refuse(

@@ -31,10 +31,11 @@ use super::joint_start::JointStart;
 use super::newmark_terms::{initial_accelerations, Coefficients, NewmarkTerms};
 use super::slave_velocities;
 use crate::error::SolveError;
-use crate::joint_parameter::{JointShift, StartShift};
+use crate::joint_parameter::JointShift;
 use crate::linsolve::SparseLu;
 use crate::record::Sensitivity;
 use crate::sensitivity::{mass_derivative, Parameter};
+use crate::start_shift::StartShift;
 use crate::system::ReducedSystem;
 use flexmech_core::rotation::{log, skew};
 use flexmech_core::{Configuration, Inertia, MassKind};
@@ -151,7 +152,14 @@ impl NewmarkSensitivities {
             .collect();
         for (p, unit) in params.iter().zip(&units) {
             let mut h = History::at_rest(nodes);
-            p.nodal_derivative(mech, &sys.end.config, 0.0, &mut nodal);
+            match p {
+                Parameter::Geometry { stretch, .. } => {
+                    crate::geometry::initial_forces(mech, &sys.end.config, stretch, &mut nodal)
+                }
+                _ => {
+                    p.nodal_derivative(mech, &sys.end.config, 0.0, &mut nodal);
+                }
+            }
             if let Some(unit) = unit {
                 // M a₀ + g = 0: ∂M a₀ + M ∂a₀ + ∂g = 0 (rotations at t = 0: I).
                 let prev = &sys.terms.prev;
@@ -185,6 +193,9 @@ impl NewmarkSensitivities {
                 (h.v, h.w) = slave_velocities(mech, &sys.topo, &sys.end, motion);
             }
             let start = p.start_shift(sys)?;
+            for (n, x) in h.x.iter_mut().enumerate() {
+                *x = start.of(n);
+            }
             if let Some(joint) = &joint {
                 joint_history(sys, joint, &start, &mut h)?;
             }
@@ -248,6 +259,11 @@ impl NewmarkSensitivities {
                 s.add_stiffness(sys.mech, &sys.end.config, inertia, &mut self.nodal);
                 s.add_transfer(&sys.nodal, &mut self.nodal)
             });
+            let held = self.params[k].held_shift(sys.mech);
+            let kc = &sys.terms.coefficients;
+            let c = (1.0 - kc.alpha_m) / ((1.0 - kc.alpha_f) * kc.beta * sys.terms.dt.powi(2));
+            let inertia = Some((&sys.terms.inertia, c));
+            held.add_stiffness(sys.mech, &sys.end.config, inertia, &mut self.nodal);
             let mut dq = vec![0.0; sys.topo.dofs.n_eq];
             sys.reduce(&self.nodal, &mut dq);
             if let Some((eq, share)) = psi {
@@ -255,7 +271,8 @@ impl NewmarkSensitivities {
             }
             dq.iter_mut().for_each(|v| *v = -*v);
             self.lu.solve(&mut dq).map_err(failed)?;
-            let (next, v1, w1) = advance(sys, &self.history[k], &dq, shift.as_ref());
+            let moved = (shift.as_ref(), &held);
+            let (next, v1, w1) = advance(sys, &self.history[k], &dq, moved);
             let mass = self.units[k]
                 .as_ref()
                 .map_or(0.0, |u| u.kinetic_energy(&v1, &w1));
@@ -278,8 +295,8 @@ impl NewmarkSensitivities {
     }
 }
 
-/// A joint parameter's history at t = 0 beyond its initial accelerations:
-/// the carried body's positions `dX/dp` ([`StartShift`]) and the subtree's
+/// A joint parameter's history at t = 0 beyond its initial accelerations and
+/// the carried body's positions `dX/dp` ([`StartShift`]): the subtree's
 /// velocity terms ([`JointStart`]). A carried body given an initial spin is
 /// refused: its velocity field `v₀ + ω × (x − origin)` depends on where the
 /// body is, which the re-placement does not say.
@@ -289,17 +306,14 @@ fn joint_history(
     start: &StartShift,
     h: &mut History,
 ) -> Result<(), SolveError> {
-    let spinning = (start.nodes().iter())
-        .find(|n| !joint.nodes().contains(n) && sys.terms.prev.w[**n] != Vector3::zeros());
-    if let Some(&n) = spinning {
+    let spinning = (start.nodes())
+        .find(|n| !joint.nodes().contains(n) && sys.terms.prev.w[*n] != Vector3::zeros());
+    if let Some(n) = spinning {
         return Err(SolveError::InvalidMechanism(format!(
             "the body a joint parameter re-places at t = 0 (with node {n}) starts with an \
              angular velocity, whose velocity field depends on the body's position: \
              differentiate by this parameter from a start without spin"
         )));
-    }
-    for (n, x) in h.x.iter_mut().enumerate() {
-        *x = start.of(n);
     }
     let mut a = h.a.clone();
     joint.add_motion(&mut h.v, &mut a);
@@ -391,7 +405,7 @@ fn advance(
     sys: &ReducedSystem<'_, NewmarkTerms>,
     h: &History,
     dq: &[f64],
-    shift: Option<&JointShift>,
+    (shift, held): (Option<&JointShift>, &StartShift),
 ) -> (History, Vec<Vector3<f64>>, Vec<Vector3<f64>>) {
     let terms = &sys.terms;
     let (k, dt, prev) = (&terms.coefficients, terms.dt, &terms.prev);
@@ -401,7 +415,7 @@ fn advance(
     let (mut v1, mut w1s) = (Vec::with_capacity(nodes), Vec::with_capacity(nodes));
     for i in 0..nodes {
         let d = sys.topo.dofs.node_increment(i, dq);
-        let direct = shift.map_or(Vector3::zeros(), |s| s.of(i));
+        let direct = shift.map_or(Vector3::zeros(), |s| s.of(i)) + held.of(i);
         let (dx1, dth1) = (
             d.fixed_rows::<3>(0).into_owned() + direct,
             d.fixed_rows::<3>(3).into_owned(),

@@ -19,7 +19,7 @@ mod loading;
 mod rigid_bodies;
 mod rust_loads;
 mod sensitivity;
-pub(crate) use sensitivity::{add_sensitivity, analysis_allows_sensitivity};
+pub(crate) use sensitivity::{add_sensitivity, analysis_allows_sensitivity, beam_end};
 mod solver;
 
 type Res<T> = Result<T, ModelError>;

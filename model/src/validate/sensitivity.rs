@@ -13,7 +13,9 @@ const AVAILABLE: &str = "section values (`section.<name>.EA`, `GA[0]`, `GA[1]`, 
                          `EI[0]`, `EI[1]`, `rhoA`, `rhoJ[0]`, `rhoJ[1]`, `rhoJ[2]`), rigid \
                          bodies' `rigid_body[i].mass` and principal `inertia[k]`, joints' \
                          `joint.<name>.pitch` (screw), `.radius` (rack_pinion, cam), \
-                         `.offset` (cam) and `joint.<name>.parameters.<p>` (expression), dead load components \
+                         `.offset` (cam) and `joint.<name>.parameters.<p>` (expression), straight beams' ends \
+                         (`beam.<name>.start[c]`, `beam.<name>.end[c]`; statics and the \
+                         Newmark family), dead load components \
                          (`load[i].force[c]`, `load[i].moment[c]`, \
                          `distributed_load[i].force[c]`, `distributed_load[i].moment[c]`) and, \
                          in dynamics, initial velocities (`initial_velocity[i].linear[c]`, \
@@ -101,6 +103,53 @@ fn joint_parameter(
 const JOINT_VALUES: &str = "joints can be differentiated by `pitch` of a screw, `radius` of a \
                             rack_pinion, `radius` and `offset` of a cam and the parameters of \
                             an expression joint, `joint.<name>.parameters.<p>`";
+
+/// The coordinate `field` (`start[c]`, `end[c]`) of beam `b`'s end, where
+/// the beam is straight and nothing on it depends on its nodes' places but
+/// what the derivative follows: refused where a distributed load acts on it
+/// (its nodal shares change with the elements' lengths) or an initial
+/// velocity with an angular part covers it (`ω × (x − origin)` changes).
+/// `None`: `field` is no end coordinate.
+pub(crate) fn beam_end(
+    model: &Model,
+    b: usize,
+    field: &str,
+) -> Option<Result<SensitivityKey, String>> {
+    let (end, component) = (0..2)
+        .flat_map(|end| (0..3).map(move |c| (end, c)))
+        .find(|&(end, c)| field == format!("{}[{c}]", ["start", "end"][end]))?;
+    let spec = &model.beams[b];
+    let refuse = |why: String| Some(Err(why));
+    if !matches!(spec.geometry, crate::types::BeamGeometry::Straight { .. }) {
+        return refuse(format!(
+            "beam `{}` is not straight; the end coordinates of straight beams can be \
+             differentiated by",
+            spec.name
+        ));
+    }
+    if model.distributed_loads.iter().any(|l| l.beam == b) {
+        return refuse(format!(
+            "a [[distributed_load]] acts on beam `{}`, whose nodal shares change with its \
+             length, which is not differentiated yet; differentiate by another beam's end",
+            spec.name
+        ));
+    }
+    let spinning = (model.initial_velocities.iter())
+        .any(|v| v.angular != [0.0; 3] && v.nodes.iter().any(|n| n.beam == b));
+    if spinning {
+        return refuse(format!(
+            "an [[initial_velocity]] with an angular part covers beam `{}`: its velocity \
+             field `ω × (x − origin)` depends on where the nodes are; differentiate from a \
+             start without spin",
+            spec.name
+        ));
+    }
+    Some(Ok(SensitivityKey::BeamEnd {
+        beam: b,
+        end,
+        component,
+    }))
+}
 
 /// What kind of value `v` is, when it is no real number.
 fn not_real(v: &Value) -> Option<&'static str> {
@@ -240,6 +289,15 @@ impl Ctx<'_> {
         if let Some(key) = found {
             return self.dead(key, model, text);
         }
+        if table_name == "beam" {
+            let beam = match entry {
+                Some(Segment::Key(name)) => model.beams.iter().position(|b| &b.name == name),
+                _ => index(model.beams.len()),
+            };
+            if let Some(key) = beam.and_then(|b| beam_end(model, b, &field)) {
+                return key.map_err(|why| format!("cannot differentiate by \"{text}\": {why}"));
+            }
+        }
 
         let why = if matches!(text, "solver.dt" | "solver.t_end") {
             "the step size and the end time are no parameters of the solution".to_string()
@@ -267,6 +325,7 @@ impl Ctx<'_> {
             SensitivityKey::DistributedLoad { load, .. } => model.distributed_loads[load].follower,
             SensitivityKey::Section { .. }
             | SensitivityKey::JointParameter { .. }
+            | SensitivityKey::BeamEnd { .. }
             | SensitivityKey::BodyMass { .. } => false,
             SensitivityKey::InitialVelocity { .. } => {
                 if !matches!(model.solver.analysis, Analysis::Dynamic { .. }) {
