@@ -187,6 +187,14 @@ pub(super) fn solve_step<T: Bordered>(
 /// `work.b` (a residual, through `Ñ`), `work.ge` and `work.gc` (derivatives,
 /// through the end-point maps).
 fn energy_equation<T: Bordered>(sys: &ReducedSystem<'_, T>, work: &mut BorderedWork) -> EnergySums {
+    energy_equation_nodal(sys, work).0
+}
+
+/// [`energy_equation`] with its nodal vectors (`q_k(N_d, 0)`, `∇e`, `∇c`).
+fn energy_equation_nodal<T: Bordered>(
+    sys: &ReducedSystem<'_, T>,
+    work: &mut BorderedWork,
+) -> (EnergySums, [Vec<f64>; 3]) {
     let nodes = sys.end.config.x.len();
     // Energy equation and its border, element by element (in order: deterministic).
     let (mut e_tot, mut c_tot, mut e_scale) = (0.0, 0.0, 0.0);
@@ -226,11 +234,12 @@ fn energy_equation<T: Bordered>(sys: &ReducedSystem<'_, T>, work: &mut BorderedW
     sys.reduce(&nodal[0], &mut work.b);
     sys.topo.dofs.reduce(&nodal[1], &mut work.ge);
     sys.topo.dofs.reduce(&nodal[2], &mut work.gc);
-    EnergySums {
+    let sums = EnergySums {
         e_tot,
         c_tot,
         e_scale,
-    }
+    };
+    (sums, nodal)
 }
 
 /// The size of the step's increments, `(Σᵢ |uᵢ|² + |θᵢ|²)^½` with
@@ -295,6 +304,8 @@ pub(super) struct Border {
     y2: Vec<f64>,
     c: Vec<f64>,
     pivot: f64,
+    /// The energy residual's nodal gradient `∂e/∂(x, φ)` (6 per node).
+    nodal: Vec<f64>,
 }
 
 impl Border {
@@ -306,7 +317,8 @@ impl Border {
         beta: f64,
     ) -> Result<Self, String> {
         let mut work = BorderedWork::new(sys.topo.dofs.n_eq);
-        let sums = energy_equation(sys, &mut work);
+        let (sums, [_, de, dc]) = energy_equation_nodal(sys, &mut work);
+        let nodal = de.iter().zip(&dc).map(|(a, b)| a + beta * b).collect();
         let mut y2 = work.b.clone();
         lu.solve(&mut y2)?;
         let c: Vec<f64> = (work.ge.iter().zip(&work.gc))
@@ -320,7 +332,19 @@ impl Border {
         if !(pivot.is_finite() && pivot != 0.0) || size == 0.0 {
             return Err("the energy equation's border has no pivot".into());
         }
-        Ok(Self { y2, c, pivot })
+        Ok(Self {
+            y2,
+            c,
+            pivot,
+            nodal,
+        })
+    }
+
+    /// `∂e/∂x · δ` for nodes moved by `moved` (node, `δ`).
+    pub(super) fn along(&self, moved: &[(usize, nalgebra::Vector3<f64>)]) -> f64 {
+        (moved.iter())
+            .map(|(n, d)| (0..3).map(|c| self.nodal[6 * n + c] * d[c]).sum::<f64>())
+            .sum()
     }
 
     /// `dq = y₁ − y₂ dβ` from `y₁ = −K⁻¹ r_p` and the energy equation's

@@ -88,7 +88,16 @@ pub(super) fn forces(
 ) -> Result<Option<(usize, f64)>, SolveError> {
     let (start, end, terms) = (&sys.start, &sys.end, &sys.terms);
     let tangent = |e: &flexmech_core::Element, r: &mut [f64], k: &mut [f64]| {
-        element_kernel(e, &start.config, &end.config, terms.scheme, 0.0, true, r, k)
+        element_kernel(
+            e,
+            &start.config,
+            &end.config,
+            terms.scheme,
+            terms.beta,
+            true,
+            r,
+            k,
+        )
     };
     let inertia = Some((&terms.inertia, 2.0 / (terms.dt * terms.dt)));
     shift.add_stiffness_with(sys.mech, tangent, inertia, g_out);

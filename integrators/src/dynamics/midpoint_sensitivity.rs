@@ -106,13 +106,6 @@ impl MidpointSensitivities {
                  \"newmark\" or \"generalized-alpha\" so far",
             );
         }
-        let paper = sys.terms.scheme == Scheme::EnergyMomentumPaper;
-        if paper && params.iter().any(|p| matches!(p, Parameter::Joint { .. })) {
-            return refuse(
-                "sensitivities by a joint's value with the paper's energy-momentum scheme are \
-                 not available yet: use \"energy-momentum\" or \"momentum\"",
-            );
-        }
         let nodes = mech.mesh.node_count();
         let mut history = Vec::with_capacity(params.len());
         let mut units = Vec::with_capacity(params.len());
@@ -179,7 +172,11 @@ impl MidpointSensitivities {
             dq.iter_mut().for_each(|v| *v = -*v);
             self.lu.solve(&mut dq).map_err(failed)?;
             if let Some(border) = &border {
-                border.correct(&mut dq, e_p);
+                // A joint's value moves the slave's end pose: `∂e/∂x · δ`.
+                let moved = shift.as_ref().map_or(Vec::new(), |s| {
+                    s.nodes.iter().map(|&n| (n, s.delta)).collect()
+                });
+                border.correct(&mut dq, e_p + border.along(&moved));
             }
             let next = advance(sys, &self.history[k], &dq, shift.as_ref());
             out.push(end_state.sensitivity(sys, &next, &self.starts[k], fext_end, partial));
