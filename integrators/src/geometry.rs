@@ -64,7 +64,7 @@ pub(crate) fn forces(
 
 /// The weight's derivative `−ρA g w s L` at the beam's nodes into `out`;
 /// returns its potential's `−Σ ∂f·u`.
-fn weight(
+pub(crate) fn weight(
     mech: &Mechanism,
     config: &Configuration,
     lambda: f64,

@@ -21,7 +21,7 @@
 //! the model places it. The derivative is then that of the model whose
 //! **carried body** — the slave and every node joined to it by elements and
 //! other joints, this joint cut — is re-placed rigidly with it by
-//! `δ₀ = R_m ∂f/∂p(ψ₀)` ([`crate::start_shift::StartShift`]): what a researcher does by hand to
+//! `δ₀ = R_m ∂f/∂p(ψ₀)` (`StartShift`): what a researcher does by hand to
 //! change a cam's offset (move the follower's beams with it). A rigid
 //! translation leaves the carried elements' strains, masses and dead loads
 //! as they were, so the body's positions start at `dx₀/dp = δ₀` and its

@@ -105,7 +105,7 @@ pub enum Parameter {
     /// A change of a straight beam's initial geometry (one coordinate of
     /// its end): its elements lengthen, `dL/dp = s_e L_e`, their initial
     /// triads turn, `dλ₀/dp = ω̂ λ₀`, and its nodes' initial positions move
-    /// by `dX/dp` ([`crate::geometry`]).
+    /// by `dX/dp`.
     Geometry {
         /// The beam's elements with their relative stretch `s_e`.
         stretch: Vec<(usize, f64)>,

@@ -52,6 +52,11 @@ impl StartShift {
             .map_or(Vector3::zeros(), |(_, d)| *d)
     }
 
+    /// The moved nodes and their `dX/dp`.
+    pub(crate) fn shifts(&self) -> &[(usize, Vector3<f64>)] {
+        &self.shifts
+    }
+
     /// The moved nodes.
     pub(crate) fn nodes(&self) -> impl Iterator<Item = usize> + '_ {
         self.shifts.iter().map(|(n, _)| *n)

@@ -100,19 +100,37 @@ pub(super) fn unit_forces(
 /// residual's (zero for the other schemes).
 fn element_history(
     el: &Element,
-    (scheme, beta): (Scheme, f64),
+    scheme: (Scheme, f64),
     start: &Configuration,
     end: &Configuration,
     h: &History,
 ) -> (Vec<f64>, f64) {
+    let zero = |_: usize| (Vector3::zeros(), Vector3::zeros());
+    let from = |i: usize| (h.x[i], h.theta[i]);
+    element_seeded(el, scheme, (start, end), (&from, &zero))
+}
+
+/// Node `i`'s seed: a translation and a spatial spin.
+pub(super) type Seed<'a> = &'a dyn Fn(usize) -> (Vector3<f64>, Vector3<f64>);
+
+/// The scheme's element force and the paper's energy residual (zero for the
+/// other schemes) with both ends seeded in one dual number
+/// (`x ← x + ε dx`, `R ← exp(ε θ̂)R`): their derivative along the seeds.
+pub(super) fn element_seeded(
+    el: &Element,
+    (scheme, beta): (Scheme, f64),
+    (start, end): (&Configuration, &Configuration),
+    (from, to): (Seed<'_>, Seed<'_>),
+) -> (Vec<f64>, f64) {
     type D = Dual64;
     let s = |i: usize| {
-        (
-            dual(&start.x[i], &h.x[i]),
-            dual_rotation(&start.rot[i], &h.theta[i]),
-        )
+        let (dx, th) = from(i);
+        (dual(&start.x[i], &dx), dual_rotation(&start.rot[i], &th))
     };
-    let e = |i: usize| (end.x[i].map(D::from), end.rot[i].map(D::from));
+    let e = |i: usize| {
+        let (dx, th) = to(i);
+        (dual(&end.x[i], &dx), dual_rotation(&end.rot[i], &th))
+    };
     let (q, energy) = match el {
         Element::Linear(el) => {
             let n = el.nodes;
@@ -140,13 +158,39 @@ fn element_history(
             let n = el.nodes;
             let sd: Pose3<D> = (n.map(|i| s(i).0), n.map(|i| s(i).1));
             let ed: Pose3<D> = (n.map(|i| e(i).0), n.map(|i| e(i).1));
-            (
-                el.discrete_gradient_force(&sd, &ed).as_slice().to_vec(),
-                0.0,
-            )
+            let q = el.discrete_gradient_force(&sd, &ed);
+            (q.as_slice().to_vec(), 0.0)
         }
     };
     (q.iter().map(|v| v.eps).collect(), energy)
+}
+
+/// The scheme's element force and the paper's energy residual between the
+/// step's ends (plain numbers).
+pub(super) fn element_value(
+    el: &Element,
+    (scheme, beta): (Scheme, f64),
+    (start, end): (&Configuration, &Configuration),
+) -> (Vec<f64>, f64) {
+    let mut r = vec![0.0; el.dofs()];
+    element_force(
+        el,
+        start,
+        end,
+        scheme,
+        beta,
+        &CorrectionTally::default(),
+        &mut r,
+    );
+    let energy = match (scheme, el) {
+        (Scheme::EnergyMomentumPaper, Element::Linear(u)) => {
+            let n = u.nodes;
+            let pose = |c: &Configuration| (n.map(|i| c.x[i]), n.map(|i| c.rot[i]));
+            paper_force_energy(u, &pose(start), &pose(end), beta).1
+        }
+        _ => 0.0,
+    };
+    (r, energy)
 }
 
 /// `Wₙ₊₁ = 2Rₙᵀ cay⁻¹(Rₙ₊₁Rₙᵀ)/Δt − Wₙ` (generic, for dual numbers).

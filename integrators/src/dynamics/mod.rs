@@ -25,6 +25,7 @@ pub mod generalized_alpha;
 mod joint_start;
 mod mass_slots;
 pub mod midpoint;
+mod midpoint_geometry;
 mod midpoint_history;
 mod midpoint_joint;
 pub mod midpoint_kernels;
