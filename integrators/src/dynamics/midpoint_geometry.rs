@@ -82,3 +82,93 @@ fn doubled(el: &Element, x0: &[Vector3<f64>]) -> Element {
         Element::Quadratic(e) => Element::Quadratic(of(e, x0)),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::Scheme;
+    use flexmech_core::rotation::exp;
+    use flexmech_core::{Configuration, Section};
+    use nalgebra::Matrix3;
+
+    /// A 2-node element of length `l` along x and a deformed step's ends.
+    fn element(l: f64) -> (Element, Vec<Vector3<f64>>) {
+        let x0 = vec![Vector3::zeros(), Vector3::new(l, 0.0, 0.0)];
+        let section = Section::new(
+            [2.0e4, 8.0e3, 9.0e3],
+            [30.0, 45.0, 60.0],
+            1.0,
+            [0.2, 0.1, 0.1],
+        );
+        let e = BeamElement::new(
+            [0, 1],
+            section,
+            l,
+            &[x0[0], x0[1]],
+            [Matrix3::identity(); 2],
+        );
+        (Element::Linear(e), x0)
+    }
+
+    fn ends() -> (Configuration, Configuration) {
+        let config = |x: [Vector3<f64>; 2], r: [Vector3<f64>; 2]| Configuration {
+            x: x.to_vec(),
+            rot: r.iter().map(exp).collect(),
+        };
+        (
+            config(
+                [
+                    Vector3::new(0.01, 0.0, 0.02),
+                    Vector3::new(1.32, 0.05, -0.03),
+                ],
+                [
+                    Vector3::new(0.1, -0.05, 0.02),
+                    Vector3::new(-0.03, 0.2, 0.1),
+                ],
+            ),
+            config(
+                [
+                    Vector3::new(0.02, 0.01, 0.03),
+                    Vector3::new(1.29, 0.09, -0.01),
+                ],
+                [
+                    Vector3::new(0.15, -0.02, 0.05),
+                    Vector3::new(0.02, 0.25, 0.12),
+                ],
+            ),
+        )
+    }
+
+    #[test]
+    fn the_doubled_strain_gives_each_schemes_stretch_derivative() {
+        // ∂q/∂σ and the paper's ∂e/∂σ by q[Γ₀ → 2Γ₀] − 2q against central
+        // differences of the element re-built σ = 1 ± h times as long.
+        let (start, end) = ends();
+        let (l, h) = (1.3, 1e-6);
+        for scheme in [
+            Scheme::Momentum,
+            Scheme::EnergyMomentum,
+            Scheme::EnergyMomentumPaper,
+        ] {
+            let s = (scheme, 0.37);
+            let (el, x0) = element(l);
+            let (q0, e0) = element_value(&el, s, (&start, &end));
+            let (q1, e1) = element_value(&doubled(&el, &x0), s, (&start, &end));
+            let at = |f: f64| element_value(&element(l * f).0, s, (&start, &end));
+            let ((qp, ep), (qm, em)) = (at(1.0 + h), at(1.0 - h));
+            for i in 0..12 {
+                let fd = (qp[i] - qm[i]) / (2.0 * h);
+                let exact = q1[i] - 2.0 * q0[i];
+                assert!(
+                    (exact - fd).abs() <= 1e-6 * (1.0 + fd.abs()),
+                    "{scheme:?} {i}: {exact} vs {fd}"
+                );
+            }
+            let fd = (ep - em) / (2.0 * h);
+            assert!(
+                (e1 - 2.0 * e0 - fd).abs() <= 1e-6 * (1.0 + fd.abs()),
+                "{scheme:?} e"
+            );
+        }
+    }
+}
