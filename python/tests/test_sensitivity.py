@@ -1,6 +1,6 @@
 """Exact sensitivities from Python: a cantilever built in Python asks for
-its tip deflection's derivatives by a stiffness and by the load, checked
-against Timoshenko's closed form of the discrete beam."""
+its tip deflection's derivatives by a stiffness, by the load and by its
+length, checked against Timoshenko's closed form of the discrete beam."""
 
 from __future__ import annotations
 
@@ -33,6 +33,17 @@ def test_the_tip_deflection_by_ei_and_by_the_load():
     # w = c F, so dE/dF = -c F = -w.
     by_f_energy = result["/sensitivity/load[0].force[2]/energy/total"][-1]
     assert abs(by_f_energy + w) < 1e-5 * abs(w), (by_f_energy, w)
+
+
+def test_the_tip_deflection_by_the_beams_length():
+    # Moving the beam's end along its axis: dw/dL = F L^2/EI (1 - 1/(4N^2)) + F/GA
+    # for the discrete Timoshenko beam (its w = F L^3/(3EI)(1 - 1/(4N^2)) + F L/GA).
+    model = cantilever().sensitivity("beam.arm.end[0]")
+    result = flexmech.run(model)
+    assert result.completed
+    by_l = result["/sensitivity/beam.arm.end[0]/nodes/arm.end/displacement"][-1, 2]
+    exact = F * L**2 / EI * (1 - 1 / (4 * N * N)) + F / GA
+    assert abs(by_l / exact - 1) < 1e-5, (by_l, exact)
 
 
 def test_a_key_that_names_no_real_value_is_refused():
