@@ -52,6 +52,17 @@ impl StartShift {
             .map_or(Vector3::zeros(), |(_, d)| *d)
     }
 
+    /// The displacements' derivatives `dx/dp − dX/dp` from the positions'
+    /// `dx/dp`, node by node.
+    pub(crate) fn displacements(&self, dx: &[Vector3<f64>]) -> Vec<[f64; 3]> {
+        (dx.iter().enumerate())
+            .map(|(n, d)| {
+                let d = d - self.of(n);
+                [d.x, d.y, d.z]
+            })
+            .collect()
+    }
+
     /// The moved nodes and their `dX/dp`.
     pub(crate) fn shifts(&self) -> &[(usize, Vector3<f64>)] {
         &self.shifts

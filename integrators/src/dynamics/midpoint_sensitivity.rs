@@ -291,14 +291,8 @@ impl EndState {
                 energy -= fext_end[6 * n + c] * next.x[n][c];
             }
         }
-        let displacement = (next.x.iter().enumerate())
-            .map(|(n, d)| {
-                let d = d - start.of(n);
-                [d.x, d.y, d.z]
-            })
-            .collect();
         Sensitivity {
-            displacement,
+            displacement: start.displacements(&next.x),
             energy,
         }
     }

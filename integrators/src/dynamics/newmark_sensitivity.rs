@@ -250,19 +250,16 @@ impl NewmarkSensitivities {
             if let Some(unit) = &self.units[k] {
                 unit_inertial_forces(sys, unit, &mut self.nodal);
             }
+            // Moved nodes at fixed unknowns: q̈₁ changes by c δ.
+            let kc = &sys.terms.coefficients;
+            let c = (1.0 - kc.alpha_m) / ((1.0 - kc.alpha_f) * kc.beta * sys.terms.dt.powi(2));
+            let inertia = Some((&sys.terms.inertia, c));
             let shift = self.params[k].shift(sys)?;
             let psi = shift.as_ref().and_then(|s| {
-                let kc = &sys.terms.coefficients;
-                let dt = sys.terms.dt;
-                let c = (1.0 - kc.alpha_m) / ((1.0 - kc.alpha_f) * kc.beta * dt * dt);
-                let inertia = Some((&sys.terms.inertia, c));
                 s.add_stiffness(sys.mech, &sys.end.config, inertia, &mut self.nodal);
                 s.add_transfer(&sys.nodal, &mut self.nodal)
             });
             let held = self.params[k].held_shift(sys.mech);
-            let kc = &sys.terms.coefficients;
-            let c = (1.0 - kc.alpha_m) / ((1.0 - kc.alpha_f) * kc.beta * sys.terms.dt.powi(2));
-            let inertia = Some((&sys.terms.inertia, c));
             held.add_stiffness(sys.mech, &sys.end.config, inertia, &mut self.nodal);
             let mut dq = vec![0.0; sys.topo.dofs.n_eq];
             sys.reduce(&self.nodal, &mut dq);
@@ -279,14 +276,8 @@ impl NewmarkSensitivities {
             let start = &self.starts[k];
             let partial = partial + mass + start.work(fext_end);
             let energy = energy_derivative(sys, &next, (&v1, &w1), fext_end, partial);
-            let displacement = (next.x.iter().enumerate())
-                .map(|(n, d)| {
-                    let d = d - start.of(n);
-                    [d.x, d.y, d.z]
-                })
-                .collect();
             out.push(Sensitivity {
-                displacement,
+                displacement: start.displacements(&next.x),
                 energy,
             });
             self.history[k] = next;
