@@ -107,8 +107,9 @@ const JOINT_VALUES: &str = "joints can be differentiated by `pitch` of a screw, 
 /// The coordinate `field` (`start[c]`, `end[c]`) of beam `b`'s end, where
 /// the beam is straight and nothing on it depends on its nodes' places but
 /// what the derivative follows: refused where a distributed load acts on it
-/// (its nodal shares change with the elements' lengths) or an initial
-/// velocity with an angular part covers it (`ω × (x − origin)` changes).
+/// (its nodal shares change with the elements' lengths), an initial
+/// velocity with an angular part covers it (`ω × (x − origin)` changes) or
+/// a joint or an offset rigid body ties a node it moves.
 /// `None`: `field` is no end coordinate.
 pub(crate) fn beam_end(
     model: &Model,
@@ -141,6 +142,25 @@ pub(crate) fn beam_end(
             "an [[initial_velocity]] with an angular part covers beam `{}`: its velocity \
              field `ω × (x − origin)` depends on where the nodes are; differentiate from a \
              start without spin",
+            spec.name
+        ));
+    }
+    // Moved: every node but the other end's.
+    let last = spec.node_count() - 1;
+    let moved = |n: &crate::types::NodeRef| n.beam == b && n.node != [last, 0][end];
+    let tied = (model.joints.iter())
+        .find(|j| moved(&j.slave) || j.master.as_ref().is_some_and(moved))
+        .map(|j| format!("joint `{}`", j.name))
+        .or_else(|| {
+            (model.rigid_bodies.iter())
+                .find(|r| r.offset != [0.0; 3] && moved(&r.node))
+                .map(|r| format!("rigid body `{}` (its offset is a link)", r.name))
+        });
+    if let Some(what) = tied {
+        return refuse(format!(
+            "moving that end moves a node of beam `{}` that {what} ties, which the joint \
+             would no longer place; differentiate by the other end, or by a beam whose moved \
+             nodes carry no joint",
             spec.name
         ));
     }
