@@ -90,16 +90,17 @@ pub(crate) fn weight(
     energy
 }
 
-/// [`weight`] alone: the residual's derivative at t = 0, where the model
-/// starts unstrained whatever its geometry.
+/// [`weight`] and [`line_loads`] alone: the residual's derivative at t = 0,
+/// where the model starts unstrained whatever its geometry.
 pub(crate) fn initial_forces(
     mech: &Mechanism,
     config: &Configuration,
-    stretch: &[(usize, f64)],
+    (stretch, loads): (&[(usize, f64)], &[usize]),
     out: &mut [f64],
 ) {
     out.iter_mut().for_each(|v| *v = 0.0);
     weight(mech, config, 0.0, stretch, out);
+    line_loads(mech, config, 0.0, (stretch, loads), out);
 }
 
 /// Refuses moved nodes that a joint ties (a master, a slave, a rigid
@@ -140,4 +141,32 @@ pub(crate) fn held_shifts(
             (h != Vector3::zeros()).then_some((n, h))
         })
         .collect()
+}
+
+/// The beam's line loads' derivative: the dead nodal loads `loads` a
+/// distributed load on it became scale with its elements' lengths, which all
+/// stretch by `s` (`dF/dp = s F(λ)`), into `out` as `−dF`; returns their
+/// potential's `−Σ dF·u`.
+pub(crate) fn line_loads(
+    mech: &Mechanism,
+    config: &Configuration,
+    lambda: f64,
+    (stretch, loads): (&[(usize, f64)], &[usize]),
+    out: &mut [f64],
+) -> f64 {
+    let Some(&(_, s)) = stretch.first() else {
+        return 0.0;
+    };
+    let mut energy = 0.0;
+    for &l in loads {
+        let load = &mech.loads[l];
+        let k = load.scale.at(lambda) * s;
+        let (f, m) = (load.force * k, load.moment * k);
+        for c in 0..3 {
+            out[6 * load.node + c] -= f[c];
+            out[6 * load.node + 3 + c] -= m[c];
+        }
+        energy -= f.dot(&(config.x[load.node] - mech.mesh.positions[load.node]));
+    }
+    energy
 }

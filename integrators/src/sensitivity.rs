@@ -113,6 +113,9 @@ pub enum Parameter {
         spin: Vector3<f64>,
         /// The moved nodes' `dX/dp`.
         shifts: Vec<(usize, Vector3<f64>)>,
+        /// The dead nodal loads the beam's distributed loads became: they
+        /// scale with its elements' lengths (`dF/dp = s F`).
+        loads: Vec<usize>,
     },
     /// A value of the initial motion (dynamics): `motion` is the
     /// derivative of the initial nodal velocities (and joint rates) by it;
@@ -151,12 +154,16 @@ impl Parameter {
             } => *component < 4 && elements.iter().all(|&e| e < mech.mesh.elements.len()),
             Parameter::Joint { joint, .. } => *joint < mech.joints.len(),
             Parameter::Geometry {
-                stretch, shifts, ..
+                stretch,
+                shifts,
+                loads,
+                ..
             } => {
                 stretch
                     .iter()
                     .all(|&(e, s)| e < mech.mesh.elements.len() && s.is_finite())
                     && shifts.iter().all(|&(n, _)| n < mech.mesh.node_count())
+                    && loads.iter().all(|&l| l < mech.loads.len())
             }
             Parameter::BodyMass { body, component } => *body < mech.bodies.len() && *component < 4,
         };
@@ -263,8 +270,16 @@ impl Parameter {
         {
             return unit_gravity(mech, elements, *component, config, lambda, out);
         }
-        if let Parameter::Geometry { stretch, spin, .. } = self {
-            return crate::geometry::forces(mech, config, lambda, (stretch, spin), out);
+        if let Parameter::Geometry {
+            stretch,
+            spin,
+            loads,
+            ..
+        } = self
+        {
+            let energy = crate::geometry::forces(mech, config, lambda, (stretch, spin), out);
+            let lines = (stretch.as_slice(), loads.as_slice());
+            return energy + crate::geometry::line_loads(mech, config, lambda, lines, out);
         }
         if let Parameter::BodyMass { body, component: 0 } = self {
             let n = mech.bodies[*body].node;

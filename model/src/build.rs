@@ -109,6 +109,11 @@ impl Built {
             })
             .collect();
         let stretch = sign * axis.dot(&e_c) / length;
+        let first = model.loads.len();
+        let loads = (model.distributed_loads.iter().enumerate())
+            .filter(|(_, d)| d.beam == b)
+            .flat_map(|(d, _)| self.load_shares[first + d].iter().map(|&(l, _)| l))
+            .collect();
         Parameter::Geometry {
             stretch: self.beam_elements[b]
                 .clone()
@@ -116,6 +121,7 @@ impl Built {
                 .collect(),
             spin,
             shifts,
+            loads,
         }
     }
 

@@ -32,12 +32,12 @@ use crate::system::ReducedSystem;
 use nalgebra::Vector3;
 
 /// `∂g/∂p` of a geometry parameter at the converged step of `sys` (the
-/// elements' force, the weight at the step's load time and the held
-/// translations), added to `g`; returns the paper's energy residual's
+/// elements' force, the weight and line loads at the step's load time and
+/// the held translations), added to `g`; returns the paper's energy residual's
 /// `∂e/∂p` (zero for the other schemes).
 pub(super) fn forces(
     sys: &ReducedSystem<'_, MidpointTerms>,
-    (stretch, spin): (&[(usize, f64)], &Vector3<f64>),
+    (stretch, spin, loads): (&[(usize, f64)], &Vector3<f64>, &[usize]),
     held: &StartShift,
     g: &mut [f64],
 ) -> f64 {
@@ -45,6 +45,8 @@ pub(super) fn forces(
     let ends = (&sys.start.config, &sys.end.config);
     let scheme = (terms.scheme, terms.beta);
     crate::geometry::weight(mech, &sys.end.config, sys.load_time, stretch, g);
+    let lines = (stretch, loads);
+    crate::geometry::line_loads(mech, &sys.end.config, sys.load_time, lines, g);
     let from = |i: usize| (Vector3::zeros(), ends.0.rot[i] * spin);
     let to = |i: usize| (Vector3::zeros(), ends.1.rot[i] * spin);
     let mut energy = 0.0;

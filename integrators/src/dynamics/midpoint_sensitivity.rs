@@ -215,9 +215,14 @@ impl MidpointSensitivities {
                 self.nodal.iter_mut().for_each(|v| *v = 0.0);
                 e_p += unit_forces(sys, elements, *component, &mut self.nodal);
             }
-            Parameter::Geometry { stretch, spin, .. } => {
+            Parameter::Geometry {
+                stretch,
+                spin,
+                loads,
+                ..
+            } => {
                 self.nodal.iter_mut().for_each(|v| *v = 0.0);
-                let geometry = (stretch.as_slice(), spin);
+                let geometry = (stretch.as_slice(), spin, loads.as_slice());
                 e_p += midpoint_geometry::forces(sys, geometry, &held, &mut self.nodal);
             }
             _ => {

@@ -153,8 +153,9 @@ impl NewmarkSensitivities {
         for (p, unit) in params.iter().zip(&units) {
             let mut h = History::at_rest(nodes);
             match p {
-                Parameter::Geometry { stretch, .. } => {
-                    crate::geometry::initial_forces(mech, &sys.end.config, stretch, &mut nodal)
+                Parameter::Geometry { stretch, loads, .. } => {
+                    let config = &sys.end.config;
+                    crate::geometry::initial_forces(mech, config, (stretch, loads), &mut nodal)
                 }
                 _ => {
                     p.nodal_derivative(mech, &sys.end.config, 0.0, &mut nodal);

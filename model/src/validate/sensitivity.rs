@@ -106,9 +106,7 @@ const JOINT_VALUES: &str = "joints can be differentiated by `pitch` of a screw, 
 
 /// The coordinate `field` (`start[c]`, `end[c]`) of beam `b`'s end, where
 /// the beam is straight and nothing on it depends on its nodes' places but
-/// what the derivative follows: refused where a distributed load acts on it
-/// (its nodal shares change with the elements' lengths), an initial
-/// velocity with an angular part covers it (`ω × (x − origin)` changes) or
+/// what the derivative follows: refused where an initial velocity with an angular part covers it (`ω × (x − origin)` changes) or
 /// a joint or an offset rigid body ties a node it moves.
 /// `None`: `field` is no end coordinate.
 pub(crate) fn beam_end(
@@ -125,13 +123,6 @@ pub(crate) fn beam_end(
         return refuse(format!(
             "beam `{}` is not straight; the end coordinates of straight beams can be \
              differentiated by",
-            spec.name
-        ));
-    }
-    if model.distributed_loads.iter().any(|l| l.beam == b) {
-        return refuse(format!(
-            "a [[distributed_load]] acts on beam `{}`, whose nodal shares change with its \
-             length, which is not differentiated yet; differentiate by another beam's end",
             spec.name
         ));
     }
