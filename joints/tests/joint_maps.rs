@@ -1363,6 +1363,62 @@ fn a_custom_joint_needs_only_its_profile() {
     );
 }
 
+/// A random step: a joint's master moving from `m` to `(x1, r1)`, released
+/// increments `d` and a slave residual `g`.
+#[derive(Debug, Clone)]
+struct Step {
+    p: Params,
+    q: Released,
+    m: Pose,
+    x1: Vector3<f64>,
+    r1: Matrix3<f64>,
+    g: Vector6<f64>,
+    d: [f64; 3],
+}
+
+fn steps() -> impl Strategy<Value = Step> {
+    let increments = (
+        released_increment(),
+        released_increment(),
+        released_increment(),
+    );
+    let ends = (vec3(-1.0, 1.0), vec3(-0.7, 0.7), increments);
+    (params(), released(), pose(), ends).prop_map(|(p, q, m, (u_m, w_m, (d0, d1, d2)))| {
+        let theta_m = flexmech_core::rotation::tan_scaled(&w_m);
+        Step {
+            x1: m.x + u_m,
+            r1: cayley(&theta_m) * m.r,
+            g: Vector6::new(d0 + 0.2, 1.0, -2.0, 0.5, d1 + 0.3, -0.7),
+            d: [d0, d1, d2],
+            p,
+            q,
+            m,
+        }
+    })
+}
+
+/// The central differences' step for local coordinate `c` of `kind` over
+/// the step to `end`. `B` switches form at |τ| = 1e-6: a released column
+/// whose τ lies near it has no smooth stencil (`None`); a τ below it takes a
+/// stencil that stays in the Taylor form; above, the divided difference
+/// inside `B` carries eps|F|/τ of round-off, so the stencil grows with τ to
+/// keep it below [`FD_TOL`].
+fn stencil(kind: &Kind, end: &ReleasedState, c: usize) -> Option<f64> {
+    let tau = if c >= 6 && !kind.spherical {
+        (end.q[c - 6] - kind.state.q[c - 6]).abs()
+    } else {
+        1.0
+    };
+    if (0.5e-6..=2e-6).contains(&tau) {
+        return None;
+    }
+    Some(if tau < 1e-5 {
+        1e-8
+    } else {
+        (0.1 * tau).clamp(1e-6, 1e-4)
+    })
+}
+
 /// Central differences of `Ñᵀg` (quotients over `τ` inside `B`) agree with
 /// the derivative to their own truncation and round-off, ~1e-6 relative.
 const FD_TOL: f64 = 1e-5;
@@ -1372,22 +1428,17 @@ fn incremental_transfer_derivative_matches_differences() {
     property(
         "6d. d(Ntilde^T g)/d(end state) by AD = central differences, every kind",
         CASES,
-        (
-            params(),
-            released(),
-            pose(),
-            vec3(-1.0, 1.0),
-            vec3(-0.7, 0.7),
-            (
-                released_increment(),
-                released_increment(),
-                released_increment(),
-            ),
-        ),
-        |(p, q, m, u_m, w_m, (d0, d1, d2)), w| {
-            let theta_m = flexmech_core::rotation::tan_scaled(&w_m);
-            let (x1, r1) = (m.x + u_m, cayley(&theta_m) * m.r);
-            let g = Vector6::new(d0 + 0.2, 1.0, -2.0, 0.5, d1 + 0.3, -0.7);
+        steps(),
+        |Step {
+             p,
+             q,
+             m,
+             x1,
+             r1,
+             g,
+             d: [d0, d1, d2],
+         },
+         w| {
             for kind in all_kinds(&p, &q) {
                 if kind.skip_second_fd {
                     continue;
@@ -1417,23 +1468,8 @@ fn incremental_transfer_derivative_matches_differences() {
                     1e-9,
                 )?;
                 for c in 0..6 + k {
-                    // B switches form at |τ| = 1e-6: a released column whose
-                    // τ lies near it has no smooth stencil (skip it); a τ
-                    // below it takes a stencil that stays in the Taylor form.
-                    let tau = if c >= 6 && !kind.spherical {
-                        (end.q[c - 6] - kind.state.q[c - 6]).abs()
-                    } else {
-                        1.0
-                    };
-                    if (0.5e-6..=2e-6).contains(&tau) {
+                    let Some(h) = stencil(&kind, &end, c) else {
                         continue;
-                    }
-                    // The divided difference inside B carries eps|F|/τ of
-                    // round-off: the stencil grows with τ to keep it below FD_TOL.
-                    let h = if tau < 1e-5 {
-                        1e-8
-                    } else {
-                        (0.1 * tau).clamp(1e-6, 1e-4)
                     };
                     let mut e = SVector::<f64, LOCAL>::zeros();
                     e[c] = h;
@@ -1514,22 +1550,17 @@ fn incremental_transfer_start_derivative_matches_differences() {
     property(
         "6e. d(Ntilde^T g)/d(start state) by AD = central differences, every kind",
         CASES,
-        (
-            params(),
-            released(),
-            pose(),
-            vec3(-1.0, 1.0),
-            vec3(-0.7, 0.7),
-            (
-                released_increment(),
-                released_increment(),
-                released_increment(),
-            ),
-        ),
-        |(p, q, m, u_m, w_m, (d0, d1, d2)), w| {
-            let theta_m = flexmech_core::rotation::tan_scaled(&w_m);
-            let (x1, r1) = (m.x + u_m, cayley(&theta_m) * m.r);
-            let g = Vector6::new(d0 + 0.2, 1.0, -2.0, 0.5, d1 + 0.3, -0.7);
+        steps(),
+        |Step {
+             p,
+             q,
+             m,
+             x1,
+             r1,
+             g,
+             d: [d0, d1, d2],
+         },
+         w| {
             for kind in all_kinds(&p, &q) {
                 if kind.skip_second_fd {
                     continue;
@@ -1548,20 +1579,9 @@ fn incremental_transfer_start_derivative_matches_differences() {
                         .transfer(&g)
                 };
                 for c in 0..6 + k {
-                    // As in 6d: the stencil of a released column follows its
-                    // own coordinate's τ (moving the start moves τ).
-                    let tau = if c >= 6 && !kind.spherical {
-                        (end.q[c - 6] - kind.state.q[c - 6]).abs()
-                    } else {
-                        1.0
-                    };
-                    if (0.5e-6..=2e-6).contains(&tau) {
+                    // Moving the start moves τ as moving the end does.
+                    let Some(h) = stencil(&kind, &end, c) else {
                         continue;
-                    }
-                    let h = if tau < 1e-5 {
-                        1e-8
-                    } else {
-                        (0.1 * tau).clamp(1e-6, 1e-4)
                     };
                     let mut e = SVector::<f64, LOCAL>::zeros();
                     e[c] = h;
