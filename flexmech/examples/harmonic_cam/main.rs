@@ -17,7 +17,7 @@
 
 use flexmech::core::{cst, Scalar};
 use flexmech::joints::model_joint::{direction, perpendicular_slide, ModelJoint, ParamError};
-use flexmech::joints::DependentJoint;
+use flexmech::joints::{parameter_slopes, DependentJoint};
 use flexmech::model::JointRegistry;
 use nalgebra::Vector3;
 use serde::Deserialize;
@@ -38,8 +38,31 @@ impl DependentJoint for HarmonicCam {
     }
 
     fn translation<T: Scalar>(&self, psi: T) -> Vector3<T> {
+        self.profile(psi, cst(self.rise), cst(self.offset))
+    }
+
+    /// Exact sensitivities by `rise` and `offset` (`[output] sensitivity =
+    /// ["joint.cam.rise"]`): the same profile in hyper-dual numbers.
+    fn translation_by(&self, name: &str, psi: f64) -> Option<[Vector3<f64>; 2]> {
+        let (rise, offset) = (cst(self.rise), cst(self.offset));
+        match name {
+            "rise" => Some(parameter_slopes(psi, self.rise, |psi, r| {
+                self.profile(psi, r, offset)
+            })),
+            "offset" => Some(parameter_slopes(psi, self.offset, |psi, a| {
+                self.profile(psi, rise, a)
+            })),
+            _ => None,
+        }
+    }
+}
+
+impl HarmonicCam {
+    /// `f(ψ) = −(a + rise (1 − cos nψ)/2) t_r` for any scalar, `rise` and `a`
+    /// among them.
+    fn profile<T: Scalar>(&self, psi: T, rise: T, offset: T) -> Vector3<T> {
         let stroke = T::one() - (psi * cst::<T>(self.lobes)).cos();
-        let lift = cst::<T>(self.offset) + stroke * cst::<T>(0.5 * self.rise);
+        let lift = offset + stroke * rise * cst::<T>(0.5);
         self.slide.map(cst::<T>) * (-lift)
     }
 }
@@ -222,6 +245,52 @@ mod tests {
                 let expected = v(&xm) + Rotation3::new(v(&rot)) * f;
                 let gap = (v(&xs) - expected).norm();
                 assert!(gap <= 1e-12, "run {run} step {k}: {gap:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn sensitivities_by_the_users_rise_equal_the_expression_joints() {
+        // The Rust kind's `translation_by` and the expression joint's
+        // parameter (itself checked against central differences in the
+        // suite) give the tip's derivative by the rise, 0.3 s of the spin-up.
+        let rust_text = std::fs::read_to_string(here("cam.toml"))
+            .unwrap()
+            .replace("t_end = 1.0", "t_end = 0.3")
+            .replace(
+                "integrator = \"energy-momentum\"",
+                "integrator = \"newmark\"",
+            );
+        let expression_text = rust_text
+            .replace("type = \"harmonic_cam\"", "type = \"expression\"")
+            .replace("slide = [1.0, 0.0, 0.0]", "")
+            .replace("rise = 0.1", "")
+            .replace("offset = 0.02 ", "#")
+            .replace(
+                "lobes = 1 ",
+                "translation = [\"-(a + (1 - cos(psi*n))*(0.5*rise))\", \"0\", \"0\"]\n\
+                 parameters = { a = 0.02, rise = 0.1, n = 1.0 }\n#",
+            );
+        let derivative = |text: &str, key: &str| {
+            let mut model = parse_model_with(text, &here("cam.toml"), &registry()).unwrap();
+            model.add_sensitivity(&[key.to_string()]).unwrap();
+            let mut memory = flexmech::results::Memory::default();
+            flexmech::results::run(&model, &mut memory).unwrap();
+            assert_eq!(memory.status(), "completed");
+            let tip = flexmech::model::build(&model)
+                .unwrap()
+                .node(model.output.track[0].1);
+            (memory.records.iter())
+                .map(|r| r.sensitivities[0].displacement[tip])
+                .collect::<Vec<_>>()
+        };
+        let mine = derivative(&rust_text, "joint.cam.rise");
+        let theirs = derivative(&expression_text, "joint.cam.parameters.rise");
+        let scale = theirs.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(scale > 1e-3, "a derivative that moves the tip: {scale}");
+        for (a, b) in mine.iter().zip(&theirs) {
+            for c in 0..3 {
+                assert!((a[c] - b[c]).abs() <= 1e-9 * scale, "{a:?} vs {b:?}");
             }
         }
     }
