@@ -249,6 +249,21 @@ mod tests {
         }
     }
 
+    /// `cam.toml`'s text with the cam written as an expression joint: the
+    /// same `f(ψ) = −(a + rise (1 − cos nψ)/2) t_r` in the model file.
+    fn as_expression(rust_text: &str) -> String {
+        rust_text
+            .replace("type = \"harmonic_cam\"", "type = \"expression\"")
+            .replace("slide = [1.0, 0.0, 0.0]", "")
+            .replace("rise = 0.1", "")
+            .replace("offset = 0.02 ", "#")
+            .replace(
+                "lobes = 1 ",
+                "translation = [\"-(a + (1 - cos(psi*n))*(0.5*rise))\", \"0\", \"0\"]\n\
+                 parameters = { a = 0.02, rise = 0.1, n = 1.0 }\n#",
+            )
+    }
+
     #[test]
     fn sensitivities_by_the_users_rise_equal_the_expression_joints() {
         // The Rust kind's `translation_by` and the expression joint's
@@ -261,16 +276,7 @@ mod tests {
                 "integrator = \"energy-momentum\"",
                 "integrator = \"newmark\"",
             );
-        let expression_text = rust_text
-            .replace("type = \"harmonic_cam\"", "type = \"expression\"")
-            .replace("slide = [1.0, 0.0, 0.0]", "")
-            .replace("rise = 0.1", "")
-            .replace("offset = 0.02 ", "#")
-            .replace(
-                "lobes = 1 ",
-                "translation = [\"-(a + (1 - cos(psi*n))*(0.5*rise))\", \"0\", \"0\"]\n\
-                 parameters = { a = 0.02, rise = 0.1, n = 1.0 }\n#",
-            );
+        let expression_text = as_expression(&rust_text);
         let derivative = |text: &str, key: &str| {
             let mut model = parse_model_with(text, &here("cam.toml"), &registry()).unwrap();
             model.add_sensitivity(&[key.to_string()]).unwrap();
@@ -304,16 +310,7 @@ mod tests {
         let rust_text = std::fs::read_to_string(here("cam.toml"))
             .unwrap()
             .replace("t_end = 1.0", "t_end = 0.5");
-        let expression_text = rust_text
-            .replace("type = \"harmonic_cam\"", "type = \"expression\"")
-            .replace("slide = [1.0, 0.0, 0.0]", "")
-            .replace("rise = 0.1", "")
-            .replace("offset = 0.02 ", "#")
-            .replace(
-                "lobes = 1 ",
-                "translation = [\"-(a + (1 - cos(psi*n))*(0.5*rise))\", \"0\", \"0\"]\n\
-                 parameters = { a = 0.02, rise = 0.1, n = 1.0 }\n#",
-            );
+        let expression_text = as_expression(&rust_text);
         let positions = |text: &str| {
             let model = parse_model_with(text, &here("cam.toml"), &registry()).unwrap();
             let mut memory = flexmech::results::Memory::default();
