@@ -72,6 +72,19 @@ impl<const N: usize> BeamElement<N> {
         element
     }
 
+    /// The element with its stress-free strains lowered by `delta` at its
+    /// Gauss points (first `N − 1` used): in its initial configuration it
+    /// then carries the stress resultants `(C_N Δ_Γ, C_M Δ_K)` — the
+    /// prestress of linear buckling ([`crate::prestress`]).
+    pub fn prestrained(&self, delta: &[Strains<f64>]) -> Self {
+        let mut e = self.clone();
+        for (s0, d) in e.strain0.iter_mut().zip(delta).take(N - 1) {
+            s0.0 -= d.0;
+            s0.1 -= d.1;
+        }
+        e
+    }
+
     /// Strains of the initial configuration at the Gauss points.
     pub fn initial_strains(&self) -> &[Strains<f64>] {
         &self.strain0[..N - 1]

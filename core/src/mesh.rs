@@ -316,7 +316,7 @@ fn dissipation_of<const N: usize>(
     2.0 * psi
 }
 
-fn gather<const N: usize>(
+pub(crate) fn gather<const N: usize>(
     nodes: &[usize; N],
     x: &[Vector3<f64>],
     rot: &[Matrix3<f64>],

@@ -19,6 +19,7 @@ pub mod joint_parameter;
 pub mod linsolve;
 pub mod measure;
 pub mod mechanism;
+pub mod modal;
 pub mod newton;
 pub mod record;
 pub mod rotation_guard;
