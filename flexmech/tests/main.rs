@@ -27,6 +27,7 @@ mod ground_joints;
 mod joint_models;
 mod merit;
 mod model_files;
+mod modes;
 mod modified_newton;
 mod paper_drive;
 mod published_dynamics;

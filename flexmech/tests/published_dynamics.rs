@@ -181,7 +181,7 @@ impl Run {
 fn model_integrator(model: &Model) -> &'static str {
     match model.solver.analysis {
         Analysis::Dynamic { integrator, .. } => integrator.name(),
-        Analysis::Static { .. } | Analysis::ArcLength { .. } => "static",
+        _ => "static",
     }
 }
 

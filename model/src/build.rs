@@ -188,8 +188,8 @@ fn v(a: [f64; 3]) -> Vector3<f64> {
 fn schedule(time: &Option<TimeFunction>, analysis: &Analysis) -> Schedule {
     match (time, analysis) {
         (Some(f), _) => schedule_of(f),
-        (None, Analysis::Static { .. } | Analysis::ArcLength { .. }) => Schedule::ramp(),
-        (None, Analysis::Dynamic { .. }) => Schedule::constant(1.0),
+        (None, a) if a.is_load_path() => Schedule::ramp(),
+        (None, _) => Schedule::constant(1.0),
     }
 }
 

@@ -275,6 +275,18 @@ impl Checker<'_> {
                     ));
                 }
             }
+            Analysis::Modal { modes, load_steps } => {
+                if modes == 0 || load_steps == 0 {
+                    return Err(self.fail(
+                        "solver.modes",
+                        "a modal analysis needs modes and load_steps of at least 1",
+                    ));
+                }
+            }
+            Analysis::Buckling { modes: 0 } => {
+                return Err(self.fail("solver.modes", "must be at least 1"));
+            }
+            Analysis::Buckling { .. } => {}
             Analysis::Dynamic { dt, t_end, .. } => {
                 self.positive("solver.dt", &[dt])?;
                 self.positive("solver.t_end", &[t_end])?;

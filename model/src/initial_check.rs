@@ -29,7 +29,7 @@ pub(crate) fn check(
         .fold(1.0, f64::max);
     let dt = match model.solver.analysis {
         Analysis::Dynamic { dt, .. } => Some(dt),
-        Analysis::Static { .. } | Analysis::ArcLength { .. } => None,
+        _ => None,
     };
     check_elements(model, mech, radius, dt)?;
     check_rigid_bodies(model, radius, dt)?;

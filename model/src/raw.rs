@@ -233,6 +233,7 @@ pub(crate) struct RawSolver {
     pub control: Option<S<String>>,
     pub max_arc_steps: Option<S<i64>>,
     pub branch_switch: Option<S<bool>>,
+    pub modes: Option<S<i64>>,
 }
 
 /// `[output]`.

@@ -217,6 +217,21 @@ pub enum Analysis {
         /// fundamental path along the critical mode.
         branch_switch: bool,
     },
+    /// Vibration modes (`analysis = "modal"`): the `modes` lowest, about
+    /// the initial state or — when the model is loaded or driven — about
+    /// the static equilibrium at load factor 1 reached in `load_steps`.
+    Modal {
+        /// How many of the lowest modes.
+        modes: usize,
+        /// Load steps of the static path to the state (when loaded).
+        load_steps: usize,
+    },
+    /// Linear buckling (`analysis = "buckling"`): the `modes` lowest
+    /// positive load factors multiplying the model's loads.
+    Buckling {
+        /// How many load factors.
+        modes: usize,
+    },
     /// Time integration from 0 to `t_end`.
     Dynamic {
         /// The scheme.
@@ -226,6 +241,29 @@ pub enum Analysis {
         /// End time.
         t_end: f64,
     },
+}
+
+impl Analysis {
+    /// Whether loads and drivers follow the load factor (statics, arc-length,
+    /// the preload of modes, buckling) rather than time.
+    pub fn is_load_path(&self) -> bool {
+        !matches!(self, Analysis::Dynamic { .. })
+    }
+
+    /// Whether the analysis needs the mass (dynamics, modes).
+    pub fn needs_mass(&self) -> bool {
+        matches!(self, Analysis::Dynamic { .. } | Analysis::Modal { .. })
+    }
+
+    /// The model-file name of the analysis (`solver.analysis`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Analysis::Static { .. } | Analysis::ArcLength { .. } => "static",
+            Analysis::Modal { .. } => "modal",
+            Analysis::Buckling { .. } => "buckling",
+            Analysis::Dynamic { .. } => "dynamic",
+        }
+    }
 }
 
 /// `[solver]`.

@@ -281,6 +281,18 @@ impl Model {
                 put("max_arc_steps", int(max_steps));
                 put("branch_switch", Value::Boolean(branch_switch));
             }
+            Analysis::Modal { modes, load_steps } => {
+                put("analysis", Value::String("modal".into()));
+                put("modes", int(modes));
+                put("load_steps", int(load_steps));
+                if s.mass == MassKind::Lumped {
+                    put("mass", Value::String("lumped".into()));
+                }
+            }
+            Analysis::Buckling { modes } => {
+                put("analysis", Value::String("buckling".into()));
+                put("modes", int(modes));
+            }
             Analysis::Dynamic {
                 integrator,
                 dt,

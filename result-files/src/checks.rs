@@ -202,7 +202,13 @@ impl RunChecks {
         );
         Self {
             balance: dynamic.then(|| Balance::new(dissipative)),
-            stability: (!dynamic).then(|| Stability::new(conservative(model))),
+            // Modal and buckling analyses report stability by their modes
+            // (a negative ω², the load factors).
+            stability: matches!(
+                model.solver.analysis,
+                Analysis::Static { .. } | Analysis::ArcLength { .. }
+            )
+            .then(|| Stability::new(conservative(model))),
         }
     }
 

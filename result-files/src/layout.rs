@@ -215,6 +215,10 @@ pub fn joint_path(name: &str, leaf: &str) -> String {
 /// `/sensitivity`: one group per `[output] sensitivity` key path, named
 /// as written (`/sensitivity/section.rod.EI[0]`).
 pub const SENSITIVITY: &str = "/sensitivity";
+/// Vibration modes of `analysis = "modal"`.
+pub const MODES: &str = "/modes";
+/// Buckling modes of `analysis = "buckling"`.
+pub const BUCKLING: &str = "/buckling";
 
 /// Path of the group of sensitivity key `key`: `/sensitivity/<key>`.
 pub fn sensitivity_group(key: &str) -> String {

@@ -94,6 +94,7 @@ pub mod export;
 pub mod layout;
 pub mod merit;
 mod mesh;
+mod modes;
 pub mod reader;
 pub mod restart;
 pub mod resultants;

@@ -9,7 +9,10 @@ use crate::{
     layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultantsMeta, RunMeta,
 };
 use flexmech_integrators::arc_length::{solve_arc_length_with, ArcLengthSettings};
+use flexmech_integrators::constraints::initial_state;
 use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
+use flexmech_integrators::measure::static_record;
+use flexmech_integrators::modal::{buckling_modes, solve_modal, ModalSettings, ModeSet};
 use flexmech_integrators::{
     solve_static_with, Mechanism, NewtonSettings, SolveError, StaticSettings, StepRecord,
 };
@@ -226,6 +229,18 @@ impl Keeper<'_> {
         }
     }
 
+    /// Hands the modes of a modal or buckling analysis to the sink, after
+    /// the last step.
+    fn modes(&mut self, set: &ModeSet) {
+        self.flush_last();
+        if self.error.is_none() {
+            let joints: Vec<String> = self.mech.joints.iter().map(|j| j.name.clone()).collect();
+            if let Err(e) = self.sink.modes(set, &joints) {
+                self.error = Some(e);
+            }
+        }
+    }
+
     /// The warnings of a completed run's checks.
     fn warnings(&self) -> Vec<String> {
         self.checks.warnings()
@@ -384,8 +399,10 @@ fn run_meta(model: &Model, built: &Built) -> RunMeta {
     RunMeta {
         model_text: model.text(),
         integrator: match model.solver.analysis {
-            Analysis::Static { .. } | Analysis::ArcLength { .. } => "static".to_string(),
             Analysis::Dynamic { integrator, .. } => integrator.name().to_string(),
+            // Their records are static states (the modes go to /modes or
+            // /buckling).
+            _ => "static".to_string(),
         },
         initial_positions: mech
             .mesh
@@ -501,6 +518,28 @@ fn solve(
                 keeper.push(s);
             });
             (outcome.map(|_| ()), 0.0)
+        }
+        Analysis::Modal { modes, load_steps } => {
+            let settings = ModalSettings {
+                modes,
+                mass: model.solver.mass,
+                preload: StaticSettings {
+                    load_steps,
+                    newton,
+                    max_halvings,
+                },
+            };
+            let outcome = solve_modal(mech, &settings, |s| {
+                keeper.push(s);
+            });
+            (outcome.map(|set| keeper.modes(&set)), 0.0)
+        }
+        Analysis::Buckling { modes } => {
+            let state = initial_state(mech);
+            let fext = vec![0.0; 6 * mech.mesh.node_count()];
+            keeper.push(&static_record(mech, &state, &fext, 0.0, 0.0, None));
+            let outcome = buckling_modes(mech, modes);
+            (outcome.map(|set| keeper.modes(&set)), 0.0)
         }
         Analysis::Dynamic {
             integrator,

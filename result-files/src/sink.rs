@@ -18,6 +18,7 @@
 //! # }
 //! ```
 
+use flexmech_integrators::modal::ModeSet;
 use std::path::{Path, PathBuf};
 
 use flexmech_integrators::dynamics::Checkpoint;
@@ -66,6 +67,11 @@ pub trait Sink {
     fn checkpoint(&mut self, _state: &Checkpoint) -> Result<(), SinkError> {
         Ok(())
     }
+    /// The modes of a modal or buckling analysis, after its steps;
+    /// `joints` names the model's joints. Default: ignored.
+    fn modes(&mut self, _set: &ModeSet, _joints: &[String]) -> Result<(), SinkError> {
+        Ok(())
+    }
     /// The run's end; also called after a failure, with its status.
     fn finish(&mut self, end: &RunEnd) -> Result<(), SinkError>;
     /// The file the steps went to, if the sink writes one (named in a
@@ -86,6 +92,8 @@ pub struct Memory {
     pub checkpoint: Option<Checkpoint>,
     /// How the run ended (`None` while it runs).
     pub end: Option<RunEnd>,
+    /// The modes of a modal or buckling analysis.
+    pub modes: Option<ModeSet>,
 }
 
 impl Memory {
@@ -122,6 +130,11 @@ impl Sink for Memory {
 
     fn checkpoint(&mut self, state: &Checkpoint) -> Result<(), SinkError> {
         self.checkpoint = Some(state.clone());
+        Ok(())
+    }
+
+    fn modes(&mut self, set: &ModeSet, _joints: &[String]) -> Result<(), SinkError> {
+        self.modes = Some(set.clone());
         Ok(())
     }
 
@@ -217,6 +230,10 @@ impl Sink for FileSink {
 
     fn checkpoint(&mut self, state: &Checkpoint) -> Result<(), SinkError> {
         Ok(self.writer()?.checkpoint(state)?)
+    }
+
+    fn modes(&mut self, set: &ModeSet, joints: &[String]) -> Result<(), SinkError> {
+        Ok(self.writer()?.modes(set, joints)?)
     }
 
     fn finish(&mut self, end: &RunEnd) -> Result<(), SinkError> {

@@ -1398,6 +1398,19 @@ impl ResultWriter {
         Ok(path)
     }
 
+    /// Writes the modes of a modal or buckling analysis (`/modes` or
+    /// `/buckling`, see [`flexmech_integrators::modal::ModeSet`]); `joints`
+    /// names the model's joints.
+    pub fn modes(
+        &mut self,
+        set: &flexmech_integrators::modal::ModeSet,
+        joints: &[String],
+    ) -> Result<(), ResultError> {
+        self.flush()?;
+        super::modes::write(&self.file, set, joints)
+            .ctx(&self.path, || "writing the modes".to_owned())
+    }
+
     /// Sets the root attribute `warnings`: what the run's checks found
     /// doubtful in a result that completed (e.g. an energy balance off by more
     /// than its threshold). Absent when there is nothing to say.

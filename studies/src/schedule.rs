@@ -27,6 +27,10 @@ fn step_weight(integrator: IntegratorKind) -> f64 {
     }
 }
 
+/// The cost of one linearisation (an eigen-solve) in steps, for the
+/// schedule's ordering only.
+const LINEARISATION_STEPS: f64 = 100.0;
+
 /// An estimate of a run's cost in node-steps: nodes × steps × the scheme's
 /// [`step_weight`] (a static path counts its most steps).
 pub(crate) fn estimated_cost(model: &Model) -> f64 {
@@ -34,6 +38,9 @@ pub(crate) fn estimated_cost(model: &Model) -> f64 {
     let steps = match model.solver.analysis {
         Analysis::Static { load_steps } => load_steps as f64,
         Analysis::ArcLength { max_steps, .. } => max_steps as f64,
+        // A dense eigen-solve costs about as much as a few hundred steps.
+        Analysis::Modal { load_steps, .. } => load_steps as f64 + LINEARISATION_STEPS,
+        Analysis::Buckling { .. } => LINEARISATION_STEPS,
         Analysis::Dynamic {
             integrator,
             dt,

@@ -68,7 +68,9 @@ pub fn buckling_modes(mech: &Mechanism, modes: usize) -> Result<ModeSet, SolveEr
         Ok(r) => r,
         Err(PencilError::NotDefinite) => return Err(unsupported()),
         Err(PencilError::Failed(why)) => {
-            return Err(SolveError::InvalidMechanism(format!("buckling analysis: {why}")))
+            return Err(SolveError::InvalidMechanism(format!(
+                "buckling analysis: {why}"
+            )))
         }
     };
     let mut set = ModeSet::empty(ModeKind::Buckling, solver, n, asymmetry);

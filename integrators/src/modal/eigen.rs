@@ -130,7 +130,8 @@ fn dense(
     let mut vectors = Vec::with_capacity(count);
     for k in (n - count..n).rev() {
         let mut y = u.col(k).to_owned();
-        l.transpose().solve_upper_triangular_in_place(y.as_mat_mut());
+        l.transpose()
+            .solve_upper_triangular_in_place(y.as_mat_mut());
         values.push(s[k]);
         vectors.push((0..n).map(|i| y[i]).collect());
     }
@@ -317,7 +318,12 @@ fn ritz(
         pattern.product(a, &y, &mut ay);
         pattern.product(b, &y, &mut by);
         let mu = s[k];
-        let res = by.iter().zip(&ay).map(|(x, z)| (x - mu * z).powi(2)).sum::<f64>().sqrt();
+        let res = by
+            .iter()
+            .zip(&ay)
+            .map(|(x, z)| (x - mu * z).powi(2))
+            .sum::<f64>()
+            .sqrt();
         let scale = mu.abs() * ay.iter().map(|z| z * z).sum::<f64>().sqrt();
         if !(res <= MODE_RESIDUAL * scale) {
             return Err(PencilError::Failed(format!(

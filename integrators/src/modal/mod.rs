@@ -152,7 +152,10 @@ pub fn solve_modal(
     mut on_step: impl FnMut(&StepRecord),
 ) -> Result<ModeSet, SolveError> {
     let (state, load) = if is_loaded(mech) {
-        (solve_static(mech, &settings.preload, &mut on_step)?.state, 1.0)
+        (
+            solve_static(mech, &settings.preload, &mut on_step)?.state,
+            1.0,
+        )
     } else {
         let state = initial_state(mech);
         let fext = vec![0.0; 6 * mech.mesh.node_count()];
@@ -190,8 +193,14 @@ pub fn vibration_modes(
         )));
     }
     let m = lin.mass(mass);
-    let mut set = ModeSet::empty(ModeKind::Vibration, EigenSolver::for_unknowns(n), n, asymmetry);
-    let reference = diagonal_sum(&lin.pattern, &k) / diagonal_sum(&lin.pattern, &m).max(f64::MIN_POSITIVE);
+    let mut set = ModeSet::empty(
+        ModeKind::Vibration,
+        EigenSolver::for_unknowns(n),
+        n,
+        asymmetry,
+    );
+    let reference =
+        diagonal_sum(&lin.pattern, &k) / diagonal_sum(&lin.pattern, &m).max(f64::MIN_POSITIVE);
     let (s, mu, vectors) = shifted_modes(&lin.pattern, (&k, &m), modes, reference, set.solver)?;
     for (mu, y) in mu.into_iter().zip(vectors) {
         if !(mu > 0.0) {
@@ -265,9 +274,9 @@ fn shift_solve(
     match eigen::largest(pattern, (&a, m), modes, solver) {
         Ok(found) => Ok(Some(found)),
         Err(PencilError::NotDefinite) => Ok(None),
-        Err(PencilError::Failed(why)) => {
-            Err(SolveError::InvalidMechanism(format!("modal analysis: {why}")))
-        }
+        Err(PencilError::Failed(why)) => Err(SolveError::InvalidMechanism(format!(
+            "modal analysis: {why}"
+        ))),
     }
 }
 
@@ -290,7 +299,9 @@ fn check_count(modes: usize, unknowns: usize) -> Result<(), SolveError> {
 /// `v` with the sign that makes its largest-magnitude entry positive (the
 /// same shapes on every run).
 fn oriented(mut v: Vec<f64>) -> Vec<f64> {
-    let big = v.iter().fold(0.0f64, |b, x| if x.abs() > b.abs() { *x } else { b });
+    let big = v
+        .iter()
+        .fold(0.0f64, |b, x| if x.abs() > b.abs() { *x } else { b });
     if big < 0.0 {
         v.iter_mut().for_each(|x| *x = -*x);
     }

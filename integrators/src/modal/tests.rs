@@ -36,8 +36,13 @@ fn cantilever(elements: usize, nodes_per_element: usize, tip_load: f64) -> Mecha
         .unwrap();
     b.fix(beam.start(), &Dof::ALL).unwrap();
     if tip_load != 0.0 {
-        b.load(beam.end(), Vector3::new(-tip_load, 0.0, 0.0), Vector3::zeros(), Schedule::ramp())
-            .unwrap();
+        b.load(
+            beam.end(),
+            Vector3::new(-tip_load, 0.0, 0.0),
+            Vector3::zeros(),
+            Schedule::ramp(),
+        )
+        .unwrap();
     }
     b.build()
 }
@@ -64,7 +69,10 @@ fn bending_errors(elements: usize, nodes_per_element: usize) -> [f64; 3] {
     let scale = 1e3f64.sqrt() / std::f64::consts::TAU;
     std::array::from_fn(|i| {
         let exact = CANTILEVER_BETA_L[i].powi(2) * scale;
-        assert!((f[2 * i] - f[2 * i + 1]).abs() < 1e-7 * exact, "pair {i}: {f:?}");
+        assert!(
+            (f[2 * i] - f[2 * i + 1]).abs() < 1e-7 * exact,
+            "pair {i}: {f:?}"
+        );
         f[2 * i] / exact - 1.0
     })
 }
@@ -75,18 +83,32 @@ fn bending_errors(elements: usize, nodes_per_element: usize) -> [f64; 3] {
 /// (`~½(βL)² EI/(GA L²) ≈ 2·10⁻⁷` for the first root).
 #[test]
 fn cantilever_bending_frequencies_converge_to_euler_bernoulli() {
-    let (q8, q16, q32) = (bending_errors(8, 3), bending_errors(16, 3), bending_errors(32, 3));
+    let (q8, q16, q32) = (
+        bending_errors(8, 3),
+        bending_errors(16, 3),
+        bending_errors(32, 3),
+    );
     for i in 0..3 {
-        assert!(q32[i].abs() < 5e-6, "3-node, 32 elements, root {i}: {}", q32[i]);
+        assert!(
+            q32[i].abs() < 5e-6,
+            "3-node, 32 elements, root {i}: {}",
+            q32[i]
+        );
     }
     for i in 1..3 {
         let order = (q8[i] / q16[i]).log2();
-        assert!((3.7..4.3).contains(&order), "3-node order, root {i}: {order}");
+        assert!(
+            (3.7..4.3).contains(&order),
+            "3-node order, root {i}: {order}"
+        );
     }
     let (l16, l32) = (bending_errors(16, 2), bending_errors(32, 2));
     for i in 0..3 {
         let order = (l16[i] / l32[i]).log2();
-        assert!((1.9..2.1).contains(&order), "2-node order, root {i}: {order}");
+        assert!(
+            (1.9..2.1).contains(&order),
+            "2-node order, root {i}: {order}"
+        );
     }
 }
 
@@ -121,4 +143,3 @@ fn clamped_free_column_buckles_at_eulers_load() {
         assert!((l - exact).abs() < 1e-4 * exact, "mode {k}: {l} vs {exact}");
     }
 }
-

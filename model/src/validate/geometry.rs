@@ -83,7 +83,7 @@ impl Ctx<'_> {
         beams: &[BeamSpec],
         solver: &SolverSpec,
     ) -> Res<()> {
-        if !matches!(solver.analysis, Analysis::Dynamic { .. }) {
+        if !solver.analysis.needs_mass() {
             return Ok(());
         }
         for beam in beams {

@@ -24,3 +24,6 @@ pub const MAX_EVERY: (i64, &str) = (1_000_000_000, "steps between stored records
 /// Bytes of a model `name`, which becomes the file name `<name>.h5` (file
 /// systems allow 255 bytes per name; studies add run suffixes).
 pub const MAX_NAME_BYTES: usize = 200;
+
+/// Most modes an analysis may ask for (each stored as nodes × 3 twice).
+pub const MAX_MODES: (i64, &str) = (10_000, "modes, each stored for every node");

@@ -368,6 +368,12 @@ impl Ctx<'_> {
 pub(crate) fn analysis_allows_sensitivity(model: &Model) -> Result<(), &'static str> {
     match model.solver.analysis {
         Analysis::Static { .. } | Analysis::ArcLength { .. } => {}
+        Analysis::Modal { .. } | Analysis::Buckling { .. } => {
+            return Err(
+                "sensitivities of modes and buckling loads are not computed; remove \
+                 `sensitivity` from [output], or run a static or dynamic analysis",
+            )
+        }
         Analysis::Dynamic {
             integrator: IntegratorKind::Newmark | IntegratorKind::GeneralizedAlpha { .. },
             ..

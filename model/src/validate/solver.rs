@@ -10,6 +10,9 @@ use flexmech_integrators::dynamics::generalized_alpha::DEFAULT_RHO_INF;
 /// `max_arc_steps` when the file gives none: this many per `load_steps`.
 const DEFAULT_ARC_STEPS_PER_LOAD_STEP: usize = 100;
 
+/// `modes` when the file gives none.
+const DEFAULT_MODES: usize = 10;
+
 impl Ctx<'_> {
     pub(super) fn solver(&self, raw: Option<&S<RawSolver>>) -> Res<SolverSpec> {
         let Some(entry) = raw else {
@@ -17,12 +20,25 @@ impl Ctx<'_> {
         };
         let hs = entry.span();
         let s = entry.get_ref();
-        let dynamic = self.analysis_is_dynamic(s)?;
-        let analysis = if dynamic {
-            self.dynamic_analysis(s, &hs)?
-        } else {
-            self.static_analysis(s)?
+        let analysis = match self.analysis_name(s)? {
+            "dynamic" => self.dynamic_analysis(s, &hs)?,
+            "modal" | "buckling" => self.linearised_analysis(s)?,
+            _ => self.static_analysis(s)?,
         };
+        if let (Some(m), false) = (
+            &s.modes,
+            matches!(analysis, Analysis::Modal { .. } | Analysis::Buckling { .. }),
+        ) {
+            return Err(self.at(
+                "solver.modes",
+                m,
+                format!(
+                    "`modes` belongs to analysis = \"modal\" or \"buckling\", but this \
+                     analysis is {}; remove `modes`, or set the analysis",
+                    analysis.name()
+                ),
+            ));
+        }
         let tolerance = match &s.tolerance {
             Some(t) => self.positive(t, "solver.tolerance")?,
             None => SolverSpec::default().tolerance,
@@ -48,21 +64,79 @@ impl Ctx<'_> {
         })
     }
 
-    /// `solver.analysis`: whether it is "dynamic" (absent: static).
-    fn analysis_is_dynamic(&self, s: &RawSolver) -> Res<bool> {
-        Ok(match &s.analysis {
-            None => false,
-            Some(a) => match a.get_ref().as_str() {
-                "static" => false,
-                "dynamic" => true,
-                other => {
-                    return Err(self.at(
-                        "solver.analysis",
-                        a,
-                        format!("expected \"static\" or \"dynamic\", found \"{other}\""),
-                    ))
-                }
-            },
+    /// `solver.analysis`: "static" (also when absent), "dynamic", "modal"
+    /// or "buckling".
+    fn analysis_name(&self, s: &RawSolver) -> Res<&'static str> {
+        const NAMES: [&str; 4] = ["static", "dynamic", "modal", "buckling"];
+        let Some(a) = &s.analysis else {
+            return Ok("static");
+        };
+        match NAMES.iter().find(|n| **n == a.get_ref().as_str()) {
+            Some(n) => Ok(n),
+            None => Err(self.at(
+                "solver.analysis",
+                a,
+                format!(
+                    "expected one of {}, found \"{}\"",
+                    quoted_list(NAMES.iter().copied()),
+                    a.get_ref()
+                ),
+            )),
+        }
+    }
+
+    /// A modal or buckling analysis: `modes` (default 10); a modal one
+    /// also `load_steps` (its static preload path, default 10); neither
+    /// takes the keys of dynamics or of arc-length control.
+    fn linearised_analysis(&self, s: &RawSolver) -> Res<Analysis> {
+        let name = s.analysis.as_ref().map_or("", |a| a.get_ref().as_str());
+        let foreign = [
+            ("dt", s.dt.as_ref().map(S::span)),
+            ("t_end", s.t_end.as_ref().map(S::span)),
+            ("integrator", s.integrator.as_ref().map(S::span)),
+            ("rho_inf", s.rho_inf.as_ref().map(S::span)),
+            ("control", s.control.as_ref().map(S::span)),
+            ("max_arc_steps", s.max_arc_steps.as_ref().map(S::span)),
+            ("branch_switch", s.branch_switch.as_ref().map(S::span)),
+            (
+                "load_steps",
+                s.load_steps
+                    .as_ref()
+                    .map(S::span)
+                    .filter(|_| name == "buckling"),
+            ),
+            (
+                "mass",
+                s.mass.as_ref().map(S::span).filter(|_| name == "buckling"),
+            ),
+        ];
+        if let Some((key, span)) = foreign.iter().find(|(_, sp)| sp.is_some()) {
+            return Err(self.err(
+                format!("solver.{key}"),
+                span.clone(),
+                format!(
+                    "`{key}` does not belong to analysis = \"{name}\" (it takes `modes`{}); \
+                     remove `{key}`",
+                    if name == "modal" {
+                        ", `load_steps` for the static state it is about, and `mass`"
+                    } else {
+                        ": it multiplies the model's loads about the undeformed state"
+                    }
+                ),
+            ));
+        }
+        let modes = match &s.modes {
+            Some(m) => self.int_in(m, "solver.modes", 1, limits::MAX_MODES)?,
+            None => DEFAULT_MODES,
+        };
+        Ok(if name == "buckling" {
+            Analysis::Buckling { modes }
+        } else {
+            let load_steps = match &s.load_steps {
+                Some(l) => self.int_in(l, "solver.load_steps", 1, limits::MAX_LOAD_STEPS)?,
+                None => 10,
+            };
+            Analysis::Modal { modes, load_steps }
         })
     }
 
@@ -308,7 +382,10 @@ impl Ctx<'_> {
                 "full" => (false, false),
                 "exact" => (false, true),
                 "modified" => match analysis {
-                    Analysis::Static { .. } | Analysis::ArcLength { .. } => {
+                    Analysis::Static { .. }
+                    | Analysis::ArcLength { .. }
+                    | Analysis::Modal { .. }
+                    | Analysis::Buckling { .. } => {
                         return Err(self.at(
                             "solver.newton",
                             m,

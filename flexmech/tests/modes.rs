@@ -1,0 +1,222 @@
+//! Linearised analysis from model files: vibration modes (`analysis =
+//! "modal"`) against the closed forms of beam theory, and linear buckling
+//! (`analysis = "buckling"`) against Euler's column and the Argyris frame's
+//! published lateral buckling load. Results are read back from `/modes` and
+//! `/buckling`.
+
+use crate::common::{data, read};
+use flexmech::model::{load_model, parse_model};
+use flexmech::results::run_model;
+use std::f64::consts::{PI, TAU};
+use std::path::{Path, PathBuf};
+
+/// A straight beam of length 1 along x with `elements` 3-node elements,
+/// its `[solver]` and any extra tables.
+fn beam_model(section: &str, supports: &str, solver: &str, elements: usize) -> String {
+    format!(
+        r#"name = "beam"
+[[section]]
+name = "s"
+{section}
+[[beam]]
+name = "b"
+section = "s"
+start = [0.0, 0.0, 0.0]
+end = [1.0, 0.0, 0.0]
+e2 = [0.0, 1.0, 0.0]
+elements = {elements}
+nodes_per_element = 3
+{supports}
+[solver]
+{solver}
+"#
+    )
+}
+
+/// A slender section: `EI = 1e3`, `ρA = 1`; shear, axial and rotary
+/// inertia effects below 1e-6 of the bending frequencies.
+const SLENDER: &str = "EA = 1e10\nGA = [1e10, 1e10]\nGJ = 1e3\nEI = [1e3, 1e3]\nrhoA = 1.0\nrhoJ = [1e-9, 1e-9, 1e-9]";
+
+/// The 3-node element's discretisation error at these meshes: fourth order
+/// in the element size (the integrators' convergence test), 2·10⁻⁵ for the
+/// third bending root on 24 elements and 1.4·10⁻⁵ for the column's load on
+/// 16; axial and torsional modes converge faster.
+const DISCRETISATION: f64 = 3e-5;
+
+fn run(text: &str) -> (tempfile::TempDir, PathBuf) {
+    let model = parse_model(text, Path::new("beam.toml")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let summary = run_model(&model, dir.path()).unwrap();
+    (dir, summary.file)
+}
+
+fn assert_close(found: f64, exact: f64, tol: f64, what: &str) {
+    assert!(
+        (found - exact).abs() <= tol * exact.abs(),
+        "{what}: {found} vs {exact} (relative {:.2e})",
+        (found - exact).abs() / exact.abs()
+    );
+}
+
+/// Euler–Bernoulli: `f = (βL)² √(EI/ρA L⁴) / 2π`.
+fn bending(beta_l: f64) -> f64 {
+    beta_l * beta_l * 1e3f64.sqrt() / TAU
+}
+
+#[test]
+fn cantilever_modes_are_euler_bernoulli_with_unit_mass_norm() {
+    let text = beam_model(
+        SLENDER,
+        "[[support]]\nnode = \"b.start\"\nfixed = \"all\"",
+        "analysis = \"modal\"\nmodes = 6",
+        24,
+    );
+    let (_dir, file) = run(&text);
+    let f = read(&file, "/modes/frequency");
+    assert_eq!(f.len(), 6);
+    for (i, bl) in [1.875_104_068_7, 4.694_091_132_9, 7.854_757_438_2]
+        .iter()
+        .enumerate()
+    {
+        for k in [2 * i, 2 * i + 1] {
+            assert_close(f[k], bending(*bl), DISCRETISATION, &format!("mode {k}"));
+        }
+    }
+    // Unit mass norm: ∫ρA φ² = 1 puts the tip of the first mode at
+    // 2/√(ρA L) (the cantilever's φ(L)/‖φ‖ = 2).
+    let u = read(&file, "/modes/displacement");
+    let nodes = u.len() / (6 * 3);
+    let tip = 3 * (nodes - 1);
+    let tip_norm = (u[tip].powi(2) + u[tip + 1].powi(2) + u[tip + 2].powi(2)).sqrt();
+    assert_close(tip_norm, 2.0, 1e-5, "tip of mode 1");
+    assert_eq!(read(&file, "/modes/rotation").len(), u.len());
+}
+
+#[test]
+fn axial_and_torsional_cantilever_modes_are_exact_to_discretisation() {
+    // Stiff in bending: the lowest modes are axial, f = (2n−1)/4 √(EA/ρA),
+    // and torsional, f = (2n−1)/4 √(GJ/ρJ₁).
+    let section = "EA = 4.0\nGA = [1e6, 1e6]\nGJ = 9.0\nEI = [1e6, 1e6]\nrhoA = 1.0\nrhoJ = [1.0, 1e-3, 1e-3]";
+    let text = beam_model(
+        section,
+        "[[support]]\nnode = \"b.start\"\nfixed = \"all\"",
+        "analysis = \"modal\"\nmodes = 4",
+        24,
+    );
+    let (_dir, file) = run(&text);
+    let f = read(&file, "/modes/frequency");
+    let mut exact = vec![0.25 * 2.0, 0.75 * 2.0, 0.25 * 3.0, 0.75 * 3.0];
+    exact.sort_by(f64::total_cmp);
+    for (k, e) in exact.iter().enumerate() {
+        assert_close(f[k], *e, 2e-6, &format!("mode {k}"));
+    }
+}
+
+#[test]
+fn free_free_beam_has_six_rigid_modes_then_euler_bernoulli() {
+    let text = beam_model(SLENDER, "", "analysis = \"modal\"\nmodes = 8", 24);
+    let (_dir, file) = run(&text);
+    let f = read(&file, "/modes/frequency");
+    assert!(f[..6].iter().all(|v| *v == 0.0), "{f:?}");
+    assert_close(
+        f[6],
+        bending(4.730_040_744_9),
+        DISCRETISATION,
+        "first elastic",
+    );
+    assert_close(
+        f[7],
+        bending(4.730_040_744_9),
+        DISCRETISATION,
+        "first elastic, other plane",
+    );
+    assert_eq!(string_attr(&file, "/modes", "rigid_modes"), 6.0);
+}
+
+#[test]
+fn pinned_pinned_beam_has_frequencies_n_squared_pi_squared() {
+    let supports = "[[support]]\nnode = \"b.start\"\nfixed = [\"ux\", \"uy\", \"uz\", \"rx\"]\n\
+                    [[support]]\nnode = \"b.end\"\nfixed = [\"uy\", \"uz\"]";
+    let text = beam_model(SLENDER, supports, "analysis = \"modal\"\nmodes = 4", 24);
+    let (_dir, file) = run(&text);
+    let f = read(&file, "/modes/frequency");
+    for (k, n) in [1.0, 1.0, 2.0, 2.0].iter().enumerate() {
+        assert_close(f[k], bending(n * PI), DISCRETISATION, &format!("mode {k}"));
+    }
+}
+
+/// A numeric attribute of a group.
+fn string_attr(file: &Path, group: &str, name: &str) -> f64 {
+    let f = hdf5::File::open(file).unwrap();
+    f.group(group)
+        .unwrap()
+        .attr(name)
+        .unwrap()
+        .read_scalar::<f64>()
+        .unwrap()
+}
+
+#[test]
+fn clamped_free_column_buckles_at_euler_load_in_both_planes() {
+    let supports = "[[support]]\nnode = \"b.start\"\nfixed = \"all\"\n\
+                    [[load]]\nnode = \"b.end\"\nforce = [-1.0, 0.0, 0.0]";
+    let section = "EA = 1e10\nGA = [1e10, 1e10]\nGJ = 1e3\nEI = [1e3, 2e3]\nrhoA = 1.0\nrhoJ = [1e-3, 1e-3, 1e-3]";
+    let text = beam_model(section, supports, "analysis = \"buckling\"\nmodes = 2", 16);
+    let (_dir, file) = run(&text);
+    let l = read(&file, "/buckling/load_factor");
+    assert_close(l[0], PI * PI * 1e3 / 4.0, DISCRETISATION, "weak plane");
+    assert_close(l[1], PI * PI * 2e3 / 4.0, DISCRETISATION, "strong plane");
+}
+
+#[test]
+fn argyris_frame_buckling_load_is_the_published_one() {
+    // Published P_cr = 1.088 (Argyris et al. 1979; Simo & Vu-Quoc 1986); the
+    // file's load is P = 1.1 at load factor 1.
+    let path = data("benchmarks/argyris_frame.toml");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace(
+            "analysis = \"static\"",
+            "analysis = \"buckling\"\nmodes = 2",
+        )
+        .replace("load_steps = 220", "");
+    let model = parse_model(&text, &path).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let summary = run_model(&model, dir.path()).unwrap();
+    let p = read(&summary.file, "/buckling/load_factor")[0] * 1.1;
+    assert_close(p, 1.088, 5e-3, "lateral buckling load");
+    let _ = load_model;
+}
+
+#[test]
+fn linearised_analyses_refuse_keys_that_are_not_theirs() {
+    let cases = [
+        ("analysis = \"static\"\nmodes = 3", "solver.modes"),
+        (
+            "analysis = \"buckling\"\nload_steps = 3",
+            "solver.load_steps",
+        ),
+        ("analysis = \"modal\"\ndt = 0.1", "solver.dt"),
+        ("analysis = \"modes\"", "solver.analysis"),
+        ("analysis = \"modal\"\nmodes = 0", "solver.modes"),
+    ];
+    for (solver, key) in cases {
+        let text = beam_model(SLENDER, "", solver, 4);
+        let err = parse_model(&text, Path::new("beam.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(key) && err.contains("beam.toml"),
+            "{solver}: {err}"
+        );
+    }
+    // More modes than unknowns: refused when the run starts, with the count.
+    let text = beam_model(SLENDER, "", "analysis = \"modal\"\nmodes = 500", 2);
+    let model = parse_model(&text, Path::new("beam.toml")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let err = run_model(&model, dir.path()).unwrap_err().to_string();
+    assert!(
+        err.contains("solver.modes") && err.contains("30 unknowns"),
+        "{err}"
+    );
+}
