@@ -95,7 +95,7 @@ mod tests {
                 Vector3::y(),
                 2,
                 nodes_per_element,
-                sec.clone(),
+                sec,
             )
             .unwrap();
         }

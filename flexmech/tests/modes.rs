@@ -5,7 +5,7 @@
 //! `/buckling`.
 
 use crate::common::{data, read};
-use flexmech::model::{load_model, parse_model};
+use flexmech::model::parse_model;
 use flexmech::results::run_model;
 use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
@@ -105,7 +105,7 @@ fn axial_and_torsional_cantilever_modes_are_exact_to_discretisation() {
     );
     let (_dir, file) = run(&text);
     let f = read(&file, "/modes/frequency");
-    let mut exact = vec![0.25 * 2.0, 0.75 * 2.0, 0.25 * 3.0, 0.75 * 3.0];
+    let mut exact = [0.25 * 2.0, 0.75 * 2.0, 0.25 * 3.0, 0.75 * 3.0];
     exact.sort_by(f64::total_cmp);
     for (k, e) in exact.iter().enumerate() {
         assert_close(f[k], *e, 2e-6, &format!("mode {k}"));
@@ -130,7 +130,7 @@ fn free_free_beam_has_six_rigid_modes_then_euler_bernoulli() {
         DISCRETISATION,
         "first elastic, other plane",
     );
-    assert_eq!(string_attr(&file, "/modes", "rigid_modes"), 6.0);
+    assert_eq!(number_attr(&file, "/modes", "rigid_modes"), 6.0);
 }
 
 #[test]
@@ -146,7 +146,7 @@ fn pinned_pinned_beam_has_frequencies_n_squared_pi_squared() {
 }
 
 /// A numeric attribute of a group.
-fn string_attr(file: &Path, group: &str, name: &str) -> f64 {
+fn number_attr(file: &Path, group: &str, name: &str) -> f64 {
     let f = hdf5::File::open(file).unwrap();
     f.group(group)
         .unwrap()
@@ -185,7 +185,6 @@ fn argyris_frame_buckling_load_is_the_published_one() {
     let summary = run_model(&model, dir.path()).unwrap();
     let p = read(&summary.file, "/buckling/load_factor")[0] * 1.1;
     assert_close(p, 1.088, 5e-3, "lateral buckling load");
-    let _ = load_model;
 }
 
 #[test]

@@ -43,6 +43,9 @@ const SUBSPACE_PASSES: usize = 4;
 /// refused rather than reported.
 const MODE_RESIDUAL: f64 = 1e-6;
 
+/// Eigenvalues `μ` (descending) and their vectors.
+pub(crate) type Eigenpairs = (Vec<f64>, Vec<Vec<f64>>);
+
 /// Which solver found the eigenpairs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EigenSolver {
@@ -87,13 +90,13 @@ pub(crate) fn largest(
     (a, b): (&[f64], &[f64]),
     count: usize,
     solver: EigenSolver,
-) -> Result<(Vec<f64>, Vec<Vec<f64>>), PencilError> {
+) -> Result<Eigenpairs, PencilError> {
     let count = count.min(pattern.n());
     // Symmetric diagonal scaling `D A D`, `D = diag(A)^-½`: translations and
     // rotations in model units (and sections whose rotary inertia is
     // orders below their mass) otherwise cost digits in the factorisation.
     let d = pattern.diagonal(a);
-    if d.iter().any(|v| !(*v > 0.0)) {
+    if d.iter().any(|v| v.is_nan() || *v <= 0.0) {
         return Err(PencilError::NotDefinite);
     }
     let d: Vec<f64> = d.iter().map(|v| 1.0 / v.sqrt()).collect();
@@ -113,7 +116,7 @@ fn dense(
     pattern: &Pattern,
     (a, b): (&[f64], &[f64]),
     count: usize,
-) -> Result<(Vec<f64>, Vec<Vec<f64>>), PencilError> {
+) -> Result<Eigenpairs, PencilError> {
     let n = pattern.n();
     let am = pattern.dense(a);
     let llt = am.llt(Side::Lower).map_err(|_| PencilError::NotDefinite)?;
@@ -183,7 +186,7 @@ fn sparse(
     pattern: &Pattern,
     (a, b): (&[f64], &[f64]),
     count: usize,
-) -> Result<(Vec<f64>, Vec<Vec<f64>>), PencilError> {
+) -> Result<Eigenpairs, PencilError> {
     let n = pattern.n();
     let mut lu = SparseLu::new(pattern.symbolic.clone()).map_err(PencilError::Failed)?;
     lu.factor(a).map_err(|_| PencilError::NotDefinite)?;
@@ -270,7 +273,7 @@ fn a_orthonormal(
             }
         }
         let after = pattern.form(a, &v, &v);
-        if !(after > 0.0) {
+        if after.is_nan() || after <= 0.0 {
             return Err(PencilError::NotDefinite);
         }
         if after.sqrt() > DEPENDENT * before {
@@ -288,7 +291,7 @@ fn ritz(
     (a, b): (&[f64], &[f64]),
     basis: &[Vec<f64>],
     count: usize,
-) -> Result<(Vec<f64>, Vec<Vec<f64>>), PencilError> {
+) -> Result<Eigenpairs, PencilError> {
     let (n, m) = (pattern.n(), basis.len());
     if m < count {
         return Err(PencilError::Failed(format!(
@@ -325,7 +328,7 @@ fn ritz(
             .sum::<f64>()
             .sqrt();
         let scale = mu.abs() * ay.iter().map(|z| z * z).sum::<f64>().sqrt();
-        if !(res <= MODE_RESIDUAL * scale) {
+        if res.is_nan() || res > MODE_RESIDUAL * scale {
             return Err(PencilError::Failed(format!(
                 "eigenpair {} did not converge (relative residual {:.1e})",
                 m - k,

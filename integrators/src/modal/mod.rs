@@ -201,9 +201,9 @@ pub fn vibration_modes(
     );
     let reference =
         diagonal_sum(&lin.pattern, &k) / diagonal_sum(&lin.pattern, &m).max(f64::MIN_POSITIVE);
-    let (s, mu, vectors) = shifted_modes(&lin.pattern, (&k, &m), modes, reference, set.solver)?;
+    let (s, (mu, vectors)) = shifted_modes(&lin.pattern, (&k, &m), modes, reference, set.solver)?;
     for (mu, y) in mu.into_iter().zip(vectors) {
-        if !(mu > 0.0) {
+        if mu.is_nan() || mu <= 0.0 {
             return Err(SolveError::InvalidMechanism(format!(
                 "modal analysis: only {} of the {modes} modes asked have mass (a degree of \
                  freedom without mass or inertia: give the sections rhoA and rhoJ)",
@@ -221,7 +221,7 @@ pub fn vibration_modes(
     Ok(set)
 }
 
-/// The shift-invert solve: `(s, μ, y)` of `M y = μ (K + sM) y` with `s`
+/// The shift-invert solve: `(s, (μ, y))` of `M y = μ (K + sM) y` with `s`
 /// grown until `K + sM` is positive definite; then, where the lowest
 /// elastic `ω²` lies below that shift, solved once more with the shift at
 /// half of it (the error of `ω² = 1/μ − s` is `~ε s`, so the low modes keep
@@ -232,7 +232,7 @@ fn shifted_modes(
     modes: usize,
     reference: f64,
     solver: EigenSolver,
-) -> Result<(f64, Vec<f64>, Vec<Vec<f64>>), SolveError> {
+) -> Result<(f64, eigen::Eigenpairs), SolveError> {
     let mut s = SHIFT * reference;
     let (mu, y) = loop {
         match shift_solve(pattern, (k, m), s, modes, solver)? {
@@ -255,10 +255,10 @@ fn shifted_modes(
     if elastic > 0.0 && elastic < s && elastic.is_finite() {
         let refined = 0.5 * elastic;
         if let Some((mu, y)) = shift_solve(pattern, (k, m), refined, modes, solver)? {
-            return Ok((refined, mu, y));
+            return Ok((refined, (mu, y)));
         }
     }
-    Ok((s, mu, y))
+    Ok((s, (mu, y)))
 }
 
 /// One shift-invert solve with the shift `s`; `None` when `K + sM` is not
@@ -269,7 +269,7 @@ fn shift_solve(
     s: f64,
     modes: usize,
     solver: EigenSolver,
-) -> Result<Option<(Vec<f64>, Vec<Vec<f64>>)>, SolveError> {
+) -> Result<Option<eigen::Eigenpairs>, SolveError> {
     let a = Pattern::combine(k, s, m);
     match eigen::largest(pattern, (&a, m), modes, solver) {
         Ok(found) => Ok(Some(found)),
