@@ -1247,7 +1247,10 @@ fn bad_enumerations() {
     expect_err(
         &with("[solver]\nanalysis = \"quasi\"\n"),
         "solver.analysis",
-        &["\"static\" or \"dynamic\"", "\"quasi\""],
+        &[
+            "\"static\", \"dynamic\", \"modal\", \"buckling\"",
+            "\"quasi\"",
+        ],
     );
     expect_err(
         &with("[solver]\nmass = \"heavy\"\n"),
