@@ -30,6 +30,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 pub mod bench;
+mod modes;
 mod plot_study;
 pub mod reproduce;
 
@@ -79,6 +80,14 @@ enum Command {
     /// as quadratic cells, joints as points with their coordinates; times
     /// from /time.
     Export(ExportArgs),
+    /// Vibration modes about a stored step of a result file: the mechanism
+    /// held still in that pose with its stress state.
+    ///
+    /// Solves the stored model again up to the step (static load control
+    /// or dynamics: the same state to the last bit), writes
+    /// `<out>/<name>_modes.h5` with that step and `/modes` (see "Modes and
+    /// buckling" in MODEL_FORMAT.md) and prints the frequencies.
+    Modes(modes::ModesArgs),
     /// Draw the mechanism moving: an animated GIF (or MP4 with ffmpeg, or a
     /// PNG of one frame).
     Animate(AnimateArgs),
@@ -317,6 +326,7 @@ fn execute(cli: Cli, registry: &JointRegistry) -> ExitCode {
         Command::Reproduce(args) => reproduce_command(args),
         Command::Plot(args) => plot_command(args),
         Command::Export(args) => export_command(args),
+        Command::Modes(args) => modes::modes_command(args, registry),
         Command::Animate(args) => animate_command(args),
         Command::Bench(args) => bench_command(args),
         Command::Study(args) => study_command(args, registry),

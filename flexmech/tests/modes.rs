@@ -219,3 +219,117 @@ fn linearised_analyses_refuse_keys_that_are_not_theirs() {
         "{err}"
     );
 }
+
+/// The slider-crank of `data/benchmarks/slider_crank.toml` held at the crank
+/// angle `angle` (reached in `steps` static steps of equal angle), with the
+/// `[solver]` given.
+fn slider_crank_at(angle: f64, steps: usize, solver: &str) -> String {
+    let text = std::fs::read_to_string(data("benchmarks/slider_crank.toml")).unwrap();
+    let body = &text[..text.find("[[initial_velocity]]").unwrap()];
+    let body = body.replace(
+        "angle = { expr = \"2*pi*t\" }",
+        &format!("angle = {{ expr = \"{angle}*lambda\" }}"),
+    );
+    format!("{body}\n[solver]\n{solver}\nload_steps = {steps}\ntolerance = 1e-12\n")
+}
+
+/// Node index of `label` in a result file.
+fn node(file: &Path, label: &str) -> usize {
+    crate::common::read_strings(file, "/mesh/node_labels")
+        .iter()
+        .position(|l| l == label)
+        .unwrap()
+}
+
+#[test]
+fn slider_crank_modes_about_a_pose_equal_those_of_a_stored_static_step() {
+    let dir = tempfile::tempdir().unwrap();
+    // The pose at crank angle 0.4: a modal analysis about it, and the
+    // stored step at load factor 4/7 of a static run on to 0.7.
+    let modal = slider_crank_at(0.4, 4, "analysis = \"modal\"\nmodes = 6");
+    let (_d, modal_file) = run(&modal);
+    let f_modal = read(&modal_file, "/modes/frequency");
+    let stat = parse_model(
+        &slider_crank_at(0.7, 7, "analysis = \"static\""),
+        Path::new("sc.toml"),
+    )
+    .unwrap();
+    let summary = run_model(&stat, dir.path()).unwrap();
+    let t = read(&summary.file, "/time")[3];
+    let times = read(&summary.file, "/time");
+    assert!((t - 4.0 / 7.0).abs() < 1e-12, "{times:?}");
+    let registry = flexmech::model::JointRegistry::builtin();
+    let stored =
+        flexmech::results::modes_of_result(&summary.file, t, 6, &registry, dir.path()).unwrap();
+    let f_stored = read(&stored.file, "/modes/frequency");
+    for (a, b) in f_modal.iter().zip(&f_stored) {
+        assert_close(*b, *a, 1e-6, "stored step against the modal analysis");
+    }
+    assert!(
+        f_modal[0] > 0.0,
+        "the driven crank holds the mechanism: {f_modal:?}"
+    );
+    // Relation (1) in every mode: the revolutes' nodes move together and
+    // turn apart about z only; the slider moves along x without turning.
+    let u = read(&modal_file, "/modes/displacement");
+    let r = read(&modal_file, "/modes/rotation");
+    let nodes = u.len() / (6 * 3);
+    let at = |v: &[f64], k: usize, n: usize| {
+        [
+            v[3 * (k * nodes + n)],
+            v[3 * (k * nodes + n) + 1],
+            v[3 * (k * nodes + n) + 2],
+        ]
+    };
+    let scale = u.iter().chain(&r).fold(0.0f64, |m, v| m.max(v.abs()));
+    let pairs = [("crank.end", "rod.start"), ("block.start", "rod.end")];
+    for k in 0..6 {
+        for (m, s) in pairs {
+            let (um, us) = (
+                at(&u, k, node(&modal_file, m)),
+                at(&u, k, node(&modal_file, s)),
+            );
+            let (rm, rs) = (
+                at(&r, k, node(&modal_file, m)),
+                at(&r, k, node(&modal_file, s)),
+            );
+            for c in 0..3 {
+                assert!((um[c] - us[c]).abs() < 1e-12 * scale, "mode {k}, {m}/{s}");
+            }
+            for c in 0..2 {
+                assert!((rm[c] - rs[c]).abs() < 1e-12 * scale, "mode {k}, {m}/{s}");
+            }
+        }
+        let (ub, rb) = (
+            at(&u, k, node(&modal_file, "block.start")),
+            at(&r, k, node(&modal_file, "block.start")),
+        );
+        assert!(
+            ub[1].abs() < 1e-12 * scale && ub[2].abs() < 1e-12 * scale,
+            "mode {k}: {ub:?}"
+        );
+        assert!(
+            rb.iter().all(|v| v.abs() < 1e-12 * scale),
+            "mode {k}: {rb:?}"
+        );
+    }
+}
+
+#[test]
+fn modes_of_a_stored_step_are_refused_where_no_step_is_stored() {
+    let dir = tempfile::tempdir().unwrap();
+    let stat = parse_model(
+        &slider_crank_at(0.7, 7, "analysis = \"static\""),
+        Path::new("sc.toml"),
+    )
+    .unwrap();
+    let summary = run_model(&stat, dir.path()).unwrap();
+    let registry = flexmech::model::JointRegistry::builtin();
+    let err = flexmech::results::modes_of_result(&summary.file, 0.5, 6, &registry, dir.path())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("--time 0.5 is no stored step") && err.contains("nearest"),
+        "{err}"
+    );
+}

@@ -41,4 +41,6 @@ pub use mechanism::{
 pub use newton::NewtonSettings;
 pub use record::{Energies, JointRecord, Sensitivity, StepRecord};
 pub use sensitivity::Parameter;
-pub use statics::{solve_static, solve_static_with, StaticOutcome, StaticSettings};
+pub use statics::{
+    solve_static, solve_static_to, solve_static_with, StaticOutcome, StaticSettings,
+};

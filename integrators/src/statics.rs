@@ -76,6 +76,30 @@ pub fn solve_static_with(
     mech: &Mechanism,
     settings: &StaticSettings,
     params: &[Parameter],
+    on_step: impl FnMut(&StepRecord),
+) -> Result<StaticOutcome, SolveError> {
+    static_path(mech, settings, params, 1.0, on_step)
+}
+
+/// [`solve_static`] stopped at the load factor `end` (≤ 1): the same steps
+/// as the whole path up to there — every planned level and every halving
+/// the same — so a state a run stored is found again exactly (the modes
+/// about a stored step).
+pub fn solve_static_to(
+    mech: &Mechanism,
+    settings: &StaticSettings,
+    end: f64,
+    on_step: impl FnMut(&StepRecord),
+) -> Result<StaticOutcome, SolveError> {
+    static_path(mech, settings, &[], end.min(1.0), on_step)
+}
+
+/// The static path from 0 to the load factor `end`.
+fn static_path(
+    mech: &Mechanism,
+    settings: &StaticSettings,
+    params: &[Parameter],
+    end: f64,
     mut on_step: impl FnMut(&StepRecord),
 ) -> Result<StaticOutcome, SolveError> {
     if settings.load_steps == 0 {
@@ -101,7 +125,7 @@ pub fn solve_static_with(
     let driven = mech.has_drivers();
     // The state before the last converged step and that step's size.
     let mut previous: Option<(MechanismState, f64)> = None;
-    while lambda < 1.0 - TOLERANCES.end_of_run {
+    while lambda < end - TOLERANCES.end_of_run {
         let target = next_level(lambda, nominal, control.step());
         begin_step(&mut prob);
         if let (true, Some((before, before_step))) = (driven, &previous) {

@@ -100,6 +100,7 @@ pub mod restart;
 pub mod resultants;
 pub mod run;
 pub mod sink;
+pub mod stored_modes;
 pub mod table;
 mod writer;
 
@@ -112,4 +113,5 @@ pub use restart::{read_checkpoint, RestartError};
 pub use resultants::ResultantsMeta;
 pub use run::{restart_model, restart_state, run, run_model, run_model_to, RunError, RunSummary};
 pub use sink::{FileSink, Memory, OnStep, RunEnd, Sink, SinkError};
+pub use stored_modes::{modes_of_result, StoredModes};
 pub use writer::{rotation_vector, ResultError, ResultWriter, RunMeta};

@@ -65,6 +65,14 @@ pub enum RunError {
     /// (the result file is complete).
     #[error(transparent)]
     Export(#[from] crate::export::ExportError),
+    /// The modes about a stored step cannot be taken.
+    #[error("{}: cannot take modes: {why}", result.display())]
+    StoredModes {
+        /// The result file.
+        result: PathBuf,
+        /// Why, and what to do.
+        why: String,
+    },
     /// The result file to continue is not a run of this model.
     #[error(
         "{}: cannot continue {} with this model: {why}",
@@ -145,7 +153,7 @@ pub use crate::checks::ENERGY_BALANCE_WARNING;
 impl RunError {
     /// A sink's error as a run error: a result file's and an output
     /// directory's keep their own variants.
-    fn from_sink(e: SinkError) -> Self {
+    pub(crate) fn from_sink(e: SinkError) -> Self {
         let e = match e.downcast::<ResultError>() {
             Ok(r) => return Self::Result(*r),
             Err(e) => e,
@@ -388,7 +396,7 @@ pub fn restart_state(model: &Model, built: &Built, result: &Path) -> Result<Chec
 }
 
 /// What a run of `model` is, for its sink: labels, nodes, joints, mesh.
-fn run_meta(model: &Model, built: &Built) -> RunMeta {
+pub(crate) fn run_meta(model: &Model, built: &Built) -> RunMeta {
     let mech = &built.mechanism;
     let mesh = mesh_meta(model, built);
     let supports = mech
