@@ -333,3 +333,35 @@ fn modes_of_a_stored_step_are_refused_where_no_step_is_stored() {
         "{err}"
     );
 }
+
+/// Timoshenko's simply supported beam, mode `n`: the lower root `ω²` of
+/// `(ρI ρA/κGA) ω⁴ − (ρA + ρI k² + EI ρA k²/κGA) ω² + EI k⁴ = 0`, `k = nπ/L`
+/// (shear and rotary inertia; `w = sin kx`, `ψ = cos kx` exactly).
+fn timoshenko_pinned(n: f64, (ei, ga, rho_a, rho_i): (f64, f64, f64, f64)) -> f64 {
+    let k = n * PI;
+    let a = rho_i * rho_a / ga;
+    let b = rho_a + rho_i * k * k + ei * rho_a * k * k / ga;
+    let c = ei * k.powi(4);
+    let w2 = (b - (b * b - 4.0 * a * c).sqrt()) / (2.0 * a);
+    w2.sqrt() / TAU
+}
+
+#[test]
+fn stubby_pinned_beam_has_timoshenko_frequencies() {
+    // EI/(GA L²) = 0.01 and rotary inertia ρI/(ρA L²) = 0.01: the first
+    // mode lies 9 % and the second 28 % below Euler–Bernoulli's.
+    let section = "EA = 1e7\nGA = [1e5, 1e5]\nGJ = 1e6\nEI = [1e3, 1e3]\nrhoA = 1.0\nrhoJ = [2e-2, 1e-2, 1e-2]";
+    let supports = "[[support]]\nnode = \"b.start\"\nfixed = [\"ux\", \"uy\", \"uz\", \"rx\"]\n\
+                    [[support]]\nnode = \"b.end\"\nfixed = [\"uy\", \"uz\"]";
+    let text = beam_model(section, supports, "analysis = \"modal\"\nmodes = 4", 24);
+    let (_dir, file) = run(&text);
+    let f = read(&file, "/modes/frequency");
+    for (k, n) in [1.0, 1.0, 2.0, 2.0].iter().enumerate() {
+        let exact = timoshenko_pinned(*n, (1e3, 1e5, 1.0, 1e-2));
+        assert_close(f[k], exact, DISCRETISATION, &format!("mode {k}"));
+        assert!(
+            f[k] < 0.95 * bending(n * PI),
+            "mode {k} is not Euler–Bernoulli's"
+        );
+    }
+}
