@@ -221,6 +221,7 @@ fn base_file_parses_with_defaults() {
             mass: MassKind::Consistent,
             modified_newton: false,
             exact_tangent: false,
+            rotation: None,
         }
     );
     assert_eq!(m.output.every, 1);

@@ -365,3 +365,61 @@ fn stubby_pinned_beam_has_timoshenko_frequencies() {
         );
     }
 }
+
+/// Rayleigh–Ritz for a uniform cantilever of length 1 spinning about an
+/// axis through its root, perpendicular to it: bending stiffness `ei`,
+/// `ρA = 1`, the centrifugal tension `T(x) = Ω²(1 − x²)/2`, and `−Ω²` of
+/// in-plane softening for the lead-lag motion (`in_plane`). Basis `xᵖ`,
+/// `p = 2..=7`: `K = ei ∫φ″φ″ + ∫T φ′φ′ (− Ω² ∫φφ)`, `M = ∫φφ`; the lowest
+/// `ω²`.
+fn rayleigh_ritz_spinning(ei: f64, omega: f64, in_plane: bool) -> f64 {
+    use nalgebra::DMatrix;
+    let powers: Vec<f64> = (2..=7).map(f64::from).collect();
+    let n = powers.len();
+    let k = DMatrix::from_fn(n, n, |i, j| {
+        let (p, q) = (powers[i], powers[j]);
+        let bending = ei * p * (p - 1.0) * q * (q - 1.0) / (p + q - 3.0);
+        let tension = omega * omega * p * q / 2.0 * (1.0 / (p + q - 1.0) - 1.0 / (p + q + 1.0));
+        let soft = if in_plane {
+            omega * omega / (p + q + 1.0)
+        } else {
+            0.0
+        };
+        bending + tension - soft
+    });
+    let m = DMatrix::from_fn(n, n, |i, j| 1.0 / (powers[i] + powers[j] + 1.0));
+    let l = m.cholesky().unwrap().l();
+    let li = l.clone().try_inverse().unwrap();
+    let c = &li * k * li.transpose();
+    let c = (&c + c.transpose()) * 0.5;
+    c.symmetric_eigenvalues().min()
+}
+
+#[test]
+fn spinning_cantilever_flap_and_lag_frequencies_match_rayleigh_ritz() {
+    // Flap (out of the plane of rotation, z) with EI = 1e3; lead-lag (y)
+    // with EI = 4e3; the blade along x spins about z through its root.
+    let section = "EA = 1e9\nGA = [1e9, 1e9]\nGJ = 1e3\nEI = [1e3, 4e3]\nrhoA = 1.0\nrhoJ = [1e-6, 1e-9, 1e-9]";
+    let supports = "[[support]]\nnode = \"b.start\"\nfixed = \"all\"";
+    for omega in [0.0, 20.0, 60.0] {
+        let solver = format!(
+            "analysis = \"modal\"\nmodes = 2\nrotation = {{ axis = [0.0, 0.0, 1.0], rate = {omega} }}"
+        );
+        let (_dir, file) = run(&beam_model(section, supports, &solver, 24));
+        let f = read(&file, "/modes/frequency");
+        let flap = rayleigh_ritz_spinning(1e3, omega, false).sqrt() / TAU;
+        let lag = rayleigh_ritz_spinning(4e3, omega, true).sqrt() / TAU;
+        assert_close(f[0], flap, 1e-4, &format!("flap at Ω = {omega}"));
+        assert_close(f[1], lag, 1e-4, &format!("lead-lag at Ω = {omega}"));
+    }
+    // Southwell at small Ω: ω² = ω₀² + K Ω², K ≈ 1.193 for the first flap mode.
+    let (w0, w1) = (
+        rayleigh_ritz_spinning(1e3, 0.0, false),
+        rayleigh_ritz_spinning(1e3, 1.0, false),
+    );
+    assert!(
+        (w1 - w0 - 1.193).abs() < 2e-3,
+        "Southwell coefficient {}",
+        w1 - w0
+    );
+}

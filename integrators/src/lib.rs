@@ -13,6 +13,7 @@ pub mod dofs;
 pub mod dynamics;
 mod element_split;
 pub mod error;
+pub mod frame_spin;
 pub mod free_motion;
 mod geometry;
 pub mod joint_parameter;

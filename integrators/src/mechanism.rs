@@ -231,6 +231,9 @@ pub struct Mechanism {
     pub damping: Vec<f64>,
     /// What the model calls its nodes, beams and prescribed DOFs.
     pub names: Names,
+    /// A steady spin of the whole structure: statics and modes are then in
+    /// the frame turning with it (centrifugal loads, gyroscopic modes).
+    pub spin: Option<crate::frame_spin::FrameSpin>,
 }
 
 impl Mechanism {
@@ -250,6 +253,7 @@ impl Mechanism {
             bodies: Vec::new(),
             damping: Vec::new(),
             names: Names::default(),
+            spin: None,
         }
     }
 

@@ -21,13 +21,14 @@
 use crate::assembly::Assembler;
 use crate::constraints::{MechanismState, Topology};
 use crate::dofs::DofMap;
+use crate::frame_spin::FrameSpin;
 use crate::free_motion::FreeMotion;
 use crate::linsolve::TangentRef;
 use crate::mechanism::Mechanism;
 use crate::newton::NewtonSystem;
 use crate::record::StepRecord;
 use flexmech_core::rotation::skew;
-use flexmech_core::Configuration;
+use flexmech_core::{Configuration, Inertia};
 
 /// How the joints reduce the nodal residuals to the unknowns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -121,6 +122,8 @@ pub struct ReducedSystem<'m, T> {
     scratch: Vec<f64>,
     /// Absolute residual norm below which the residual is round-off.
     pub floor: f64,
+    /// The mechanism's steady spin with the inertia it acts on.
+    spin: Option<(FrameSpin, Inertia)>,
     /// The scheme's terms.
     pub terms: T,
 }
@@ -148,6 +151,10 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
             abs: vec![0.0; 6 * nodes],
             scratch: vec![0.0; n_eq],
             floor: mech.round_off_floor(),
+            spin: (mech.spin.clone()).map(|s| {
+                let inertia = mech.inertia(s.mass);
+                (s, inertia)
+            }),
             terms,
         }
     }
@@ -205,6 +212,11 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
         if !mech.follower_loads.is_empty() {
             self.follower_terms(reduction, tangent);
         }
+        if let Some((spin, inertia)) = &self.spin {
+            let blocks = tangent.then_some((&mut self.asm, &self.topo.dofs));
+            let residual = (&mut self.nodal[..], &mut self.abs[..]);
+            spin.add_steady(inertia, &self.end.config, self.load_time, residual, blocks);
+        }
         self.reduce(&self.nodal, r);
         if tangent && joints {
             let blocks = match reduction {
@@ -225,6 +237,14 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
 }
 
 impl<T: StepTerms> ReducedSystem<'_, T> {
+    /// Adds the gyroscopic matrix of the mechanism's spin at the end state to
+    /// the tangent values (zeroed by the caller); nothing without a spin.
+    pub(crate) fn add_gyroscopic(&mut self) {
+        if let Some((spin, inertia)) = &self.spin {
+            spin.add_gyroscopic(inertia, &self.end.config, &mut self.asm, &self.topo.dofs);
+        }
+    }
+
     /// The follower loads in the nodal residual (`g −= f`) and, with
     /// `tangent`, their load stiffness: at the end of the step
     /// (`f = s R₁ f₀`, [`Reduction::Variation`]) or as the mean of both ends

@@ -9,6 +9,7 @@ use flexmech_integrators::builder::{
     Beam, BeamDef, BuildError, Dof, JointDef, JointId, MechanismBuilder, NodeId,
 };
 use flexmech_integrators::dynamics::Motion;
+use flexmech_integrators::frame_spin::FrameSpin;
 use flexmech_integrators::{Mechanism, Names, Parameter, Schedule};
 use nalgebra::{Matrix3, Vector3};
 
@@ -300,7 +301,13 @@ pub fn build(model: &Model) -> Result<Built, ModelError> {
     let (joints, ground_nodes) = add_joints(model, &mut b, &beam_nodes)?;
     let body_nodes = add_rigid_bodies(model, &mut b, &beam_nodes)?;
     add_prescribed(model, &mut b, &beam_nodes, &joints)?;
-    let mechanism = b.build();
+    let mut mechanism = b.build();
+    mechanism.spin = model.solver.rotation.map(|r| FrameSpin {
+        axis: v(r.axis),
+        origin: v(r.origin),
+        rate: r.rate,
+        mass: model.solver.mass,
+    });
     let beam_nodes = beam_nodes
         .into_iter()
         .map(|nodes| nodes.into_iter().map(NodeId::index).collect())

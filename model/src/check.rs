@@ -292,6 +292,13 @@ impl Checker<'_> {
                 self.positive("solver.t_end", &[t_end])?;
             }
         }
+        if let Some(r) = s.rotation {
+            let v = [r.axis.as_slice(), &r.origin, &[r.rate]].concat();
+            self.finite("solver.rotation", &v)?;
+            if r.axis.iter().all(|v| *v == 0.0) {
+                return Err(self.fail("solver.rotation.axis", "must be a nonzero vector"));
+            }
+        }
         if self.model.output.every == 0 {
             return Err(self.fail("output.every", "must be at least 1"));
         }

@@ -234,6 +234,16 @@ pub(crate) struct RawSolver {
     pub max_arc_steps: Option<S<i64>>,
     pub branch_switch: Option<S<bool>>,
     pub modes: Option<S<i64>>,
+    pub rotation: Option<S<RawRotation>>,
+}
+
+/// `[solver] rotation`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawRotation {
+    pub axis: Option<S<Vec3>>,
+    pub origin: Option<S<Vec3>>,
+    pub rate: Option<S<Num>>,
 }
 
 /// `[output]`.

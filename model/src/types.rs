@@ -266,6 +266,18 @@ impl Analysis {
     }
 }
 
+/// `[solver] rotation = { axis, origin, rate }`: the structure spins
+/// steadily; statics and modes are in the frame turning with it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rotation {
+    /// The spin axis (unit).
+    pub axis: [f64; 3],
+    /// A point of the axis.
+    pub origin: [f64; 3],
+    /// The spin rate Ω, radians per unit of model time.
+    pub rate: f64,
+}
+
 /// `[solver]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SolverSpec {
@@ -286,6 +298,8 @@ pub struct SolverSpec {
     /// iterate, also in the energy–momentum scheme, whose `"full"` Newton
     /// starts with a cheaper tangent (dynamic analyses).
     pub exact_tangent: bool,
+    /// A steady spin of the frame (static and modal analyses).
+    pub rotation: Option<Rotation>,
 }
 
 impl Default for SolverSpec {
@@ -301,6 +315,7 @@ impl Default for SolverSpec {
             mass: MassKind::Consistent,
             modified_newton: false,
             exact_tangent: false,
+            rotation: None,
         }
     }
 }

@@ -318,6 +318,13 @@ impl Model {
         put("tolerance", Value::Float(s.tolerance));
         put("max_iterations", int(s.max_iterations));
         put("max_halvings", int(s.max_halvings));
+        if let Some(r) = s.rotation {
+            let mut rot = Table::new();
+            rot.insert("axis".into(), vec3(r.axis));
+            rot.insert("origin".into(), vec3(r.origin));
+            rot.insert("rate".into(), Value::Float(r.rate));
+            put("rotation", Value::Table(rot));
+        }
         t
     }
 

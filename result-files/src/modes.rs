@@ -40,10 +40,21 @@ pub(crate) fn write(file: &File, set: &ModeSet, joints: &[String]) -> hdf5::Resu
             .write_raw(&set.eigenvalues)?;
     }
     let nodes = set.displacement.first().map_or(0, Vec::len);
-    for (name, per_mode) in [
+    let mut shapes = vec![
         ("displacement", &set.displacement),
         ("rotation", &set.rotation),
-    ] {
+    ];
+    if let Some(c) = &set.complex {
+        shapes.push(("displacement_imag", &c.displacement));
+        shapes.push(("rotation_imag", &c.rotation));
+        for (name, values) in [("damping_ratio", &c.damping_ratio), ("whirl", &c.whirl)] {
+            g.new_dataset::<f64>()
+                .shape([count])
+                .create(name)?
+                .write_raw(values)?;
+        }
+    }
+    for (name, per_mode) in shapes {
         let flat: Vec<f64> = per_mode
             .iter()
             .flat_map(|m| m.iter().flat_map(|v| [v.x, v.y, v.z]))

@@ -97,6 +97,13 @@ impl<'m> Simulation<'m> {
                 "dt and t_end must be positive".into(),
             ));
         }
+        if mech.spin.is_some() {
+            return Err(SolveError::InvalidMechanism(
+                "a steady spin of the frame is for statics and modes; a dynamic run spins \
+                 the structure itself (initial velocities, drivers)"
+                    .into(),
+            ));
+        }
         if scheme_refuses_damping(integrator) && !mech.damped_elements().is_empty() {
             return Err(SolveError::InvalidMechanism(format!(
                 "structural damping runs with integrator \"newmark\" or \"generalized-alpha\", \

@@ -83,6 +83,19 @@ impl<'m> Linearisation<'m> {
         asm.values.clone()
     }
 
+    /// The gyroscopic matrix of the mechanism's spin at the state (zero
+    /// without a spin; see [`crate::frame_spin`]).
+    pub fn gyroscopic(&mut self) -> Vec<f64> {
+        self.sys.asm.values.iter_mut().for_each(|v| *v = 0.0);
+        self.sys.add_gyroscopic();
+        self.sys.asm.values.clone()
+    }
+
+    /// The spin axis of the mechanism, if it spins.
+    pub fn spin_axis(&self) -> Option<Vector3<f64>> {
+        self.sys.mech.spin.as_ref().map(|s| s.axis)
+    }
+
     /// The nodal displacements and spatial rotation vectors (`N q` at every
     /// node) and the joints' released coordinates (zero where driven) of
     /// the reduced vector `q`.

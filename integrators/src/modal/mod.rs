@@ -13,6 +13,7 @@
 
 pub mod buckling;
 pub mod eigen;
+mod gyroscopic;
 mod linearise;
 mod pencil;
 
@@ -34,7 +35,7 @@ use pencil::{Pattern, SYMMETRIC};
 /// The shift `s` of `(K + sM)⁻¹M` as a part of the mesh's stiffness-to-mass
 /// ratio `ω_ref² = Σ|Kᵢᵢ| / Σ|Mᵢᵢ|` (of the order of its highest `ω²`):
 /// above every rigid mode, below or near the low elastic ones.
-const SHIFT: f64 = 1e-6;
+pub(crate) const SHIFT: f64 = 1e-6;
 
 /// Factor by which the shift grows when `K + sM` is not positive definite
 /// (a state past a stability limit: some `ω² < −s`).
@@ -81,6 +82,22 @@ pub struct ModeSet {
     pub unknowns: usize,
     /// Relative asymmetry of the tangent, whose symmetric part was used.
     pub asymmetry: f64,
+    /// Complex modes (a spinning mechanism): their imaginary parts, damping
+    /// ratios and whirl.
+    pub complex: Option<ComplexParts>,
+}
+
+/// What complex modes add to real ones.
+#[derive(Debug, Clone, Default)]
+pub struct ComplexParts {
+    /// Per mode, every node's displacement, imaginary part.
+    pub displacement: Vec<Vec<Vector3<f64>>>,
+    /// Per mode, every node's rotation vector, imaginary part.
+    pub rotation: Vec<Vec<Vector3<f64>>>,
+    /// Per mode, `ζ = −Re λ/|λ|`.
+    pub damping_ratio: Vec<f64>,
+    /// Per mode, +1 forward (orbits turn with the spin), −1 backward, 0 none.
+    pub whirl: Vec<f64>,
 }
 
 impl ModeSet {
@@ -116,6 +133,7 @@ impl ModeSet {
             solver,
             unknowns,
             asymmetry,
+            complex: None,
         }
     }
 }
@@ -140,6 +158,7 @@ pub fn is_loaded(mech: &Mechanism) -> bool {
         || !mech.load_fields.is_empty()
         || mech.gravity != Vector3::zeros()
         || mech.has_drivers()
+        || mech.spin.as_ref().is_some_and(|s| s.rate != 0.0)
 }
 
 /// The modal analysis of `mech`: the static path to load factor 1 where it
@@ -193,14 +212,17 @@ pub fn vibration_modes(
         )));
     }
     let m = lin.mass(mass);
+    let reference =
+        diagonal_sum(&lin.pattern, &k) / diagonal_sum(&lin.pattern, &m).max(f64::MIN_POSITIVE);
+    if mech.spin.as_ref().is_some_and(|s| s.rate != 0.0) {
+        return gyroscopic::spinning_modes(&mut lin, (&k, &m), modes, reference, asymmetry);
+    }
     let mut set = ModeSet::empty(
         ModeKind::Vibration,
         EigenSolver::for_unknowns(n),
         n,
         asymmetry,
     );
-    let reference =
-        diagonal_sum(&lin.pattern, &k) / diagonal_sum(&lin.pattern, &m).max(f64::MIN_POSITIVE);
     let (s, (mu, vectors)) = shifted_modes(&lin.pattern, (&k, &m), modes, reference, set.solver)?;
     for (mu, y) in mu.into_iter().zip(vectors) {
         if mu.is_nan() || mu <= 0.0 {

@@ -53,7 +53,9 @@ impl Ctx<'_> {
         };
         let mass = self.mass_kind(s)?;
         let (modified_newton, exact_tangent) = self.newton_kind(s, &analysis)?;
+        let rotation = self.rotation(s, &analysis)?;
         Ok(SolverSpec {
+            rotation,
             analysis,
             tolerance,
             max_iterations,
@@ -353,6 +355,56 @@ impl Ctx<'_> {
                 }
             },
         })
+    }
+
+    /// `solver.rotation = { axis, origin, rate }` of a static or modal
+    /// analysis (`origin` defaults to the global origin).
+    fn rotation(&self, s: &RawSolver, analysis: &Analysis) -> Res<Option<Rotation>> {
+        let Some(r) = &s.rotation else {
+            return Ok(None);
+        };
+        if matches!(
+            analysis,
+            Analysis::Dynamic { .. } | Analysis::Buckling { .. }
+        ) {
+            return Err(self.at(
+                "solver.rotation",
+                r,
+                format!(
+                    "a steady spin of the frame belongs to static and modal analyses, but this \
+                     analysis is {}; remove `rotation`{}",
+                    analysis.name(),
+                    if analysis.name() == "dynamic" {
+                        " (a dynamic run spins the structure itself: initial velocities, drivers)"
+                    } else {
+                        ""
+                    }
+                ),
+            ));
+        }
+        let (raw, span) = (r.get_ref(), r.span());
+        let axis = self.need(
+            &raw.axis,
+            "solver.rotation.axis",
+            &span,
+            "the spin axis, e.g. axis = [0.0, 0.0, 1.0]",
+        )?;
+        let axis = self.direction(axis, "solver.rotation.axis")?;
+        let origin = raw
+            .origin
+            .as_ref()
+            .map_or([0.0; 3], |o| super::v3(o.get_ref()));
+        let rate = self.need(
+            &raw.rate,
+            "solver.rotation.rate",
+            &span,
+            "the spin rate in radians per unit of time, e.g. rate = 10.0",
+        )?;
+        Ok(Some(Rotation {
+            axis,
+            origin,
+            rate: rate.get_ref().0,
+        }))
     }
 
     /// `solver.mass`: consistent (the default) or lumped.
