@@ -107,6 +107,7 @@ fn study() -> Result<StudySpec, Box<dyn std::error::Error>> {
         component: Component::Index(2),
         reduce: Reduce::Final,
         derivative: Vec::new(),
+        mode: None,
     });
     Ok(StudySpec::from_fn(
         "cantilever-stiffness",

@@ -423,3 +423,51 @@ fn spinning_cantilever_flap_and_lag_frequencies_match_rayleigh_ritz() {
         w1 - w0
     );
 }
+
+#[test]
+fn a_study_over_the_spin_rate_gives_the_campbell_diagram() {
+    use flexmech::studies::{load_study, run_study, StudyOptions};
+    let dir = tempfile::tempdir().unwrap();
+    let section = "EA = 1e9\nGA = [1e9, 1e9]\nGJ = 1e3\nEI = [1e3, 4e3]\nrhoA = 1.0\nrhoJ = [1e-6, 1e-9, 1e-9]";
+    let solver =
+        "analysis = \"modal\"\nmodes = 2\nrotation = { axis = [0.0, 0.0, 1.0], rate = 0.0 }";
+    let model = beam_model(
+        section,
+        "[[support]]\nnode = \"b.start\"\nfixed = \"all\"",
+        solver,
+        12,
+    );
+    std::fs::write(dir.path().join("blade.toml"), model).unwrap();
+    let study = "name = \"campbell\"\nmodel = \"blade.toml\"\n[grid]\n\
+                 \"solver.rotation.rate\" = [0.0, 30.0, 60.0]\n[output]\nfigures = [\n\
+                 { name = \"flap\", dataset = \"/modes/frequency\", mode = 1 },\n\
+                 { name = \"lag\", dataset = \"/modes/frequency\", mode = 2 },\n]\n";
+    let file = dir.path().join("campbell.toml");
+    std::fs::write(&file, study).unwrap();
+    let spec = load_study(&file).unwrap();
+    let options = StudyOptions {
+        out: dir.path().join("out"),
+        shard: None,
+        progress: false,
+    };
+    let report = run_study(&spec, &options).unwrap();
+    assert_eq!((report.runs, report.failed), (3, 0));
+    let text = std::fs::read_to_string(&report.csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    for (row, omega) in lines.zip([0.0, 30.0, 60.0]) {
+        let cells: Vec<&str> = row.split(',').collect();
+        let value = |name: &str| cells[col(name)].parse::<f64>().unwrap();
+        // The 12-element blade is within 1e-4 of Rayleigh–Ritz.
+        let flap = rayleigh_ritz_spinning(1e3, omega, false).sqrt() / TAU;
+        let lag = rayleigh_ritz_spinning(4e3, omega, true).sqrt() / TAU;
+        assert_close(value("flap"), flap, 1e-4, &format!("flap at Ω = {omega}"));
+        assert_close(value("lag"), lag, 1e-4, &format!("lag at Ω = {omega}"));
+    }
+    assert!(
+        report.charts.iter().any(|c| c.ends_with("flap.png")),
+        "{:?}",
+        report.charts
+    );
+}

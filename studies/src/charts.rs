@@ -202,6 +202,10 @@ fn figure_chart(
             chart.series.extend(tangents(&points, first));
         }
     }
+    let swept = layout.x_key.map(|i| spec.grid[i].key.as_str());
+    chart
+        .series
+        .extend(speed_lines(figure, swept, &chart.series));
     // Drifts span decades: a logarithmic axis when every value allows it.
     chart.log_y =
         *figure == Figure::EnergyDrift && chart.series.iter().flat_map(|s| &s.y).all(|&y| y > 0.0);
@@ -255,4 +259,44 @@ fn tangents(points: &[(f64, f64, f64)], labelled: bool) -> Vec<Series> {
         out.push(s);
     }
     out
+}
+
+/// The swept key of a Campbell diagram: the spin rate of the frame.
+const SPIN_RATE_KEY: &str = "solver.rotation.rate";
+/// Multiples of the spin rate drawn on a Campbell diagram.
+const SPEED_MULTIPLES: [f64; 3] = [1.0, 2.0, 3.0];
+
+/// A Campbell diagram's speed lines `f = nΩ/2π` (n = 1, 2, 3) over the swept
+/// rates of `series`, grey and dashed: when `figure` is a mode of
+/// `/modes/frequency` swept over `solver.rotation.rate` (their crossings
+/// with the frequencies are the critical speeds).
+fn speed_lines(figure: &Figure, swept: Option<&str>, series: &[Series]) -> Vec<Series> {
+    let Figure::Dataset(d) = figure else {
+        return Vec::new();
+    };
+    if d.mode.is_none() || d.dataset != "/modes/frequency" || swept != Some(SPIN_RATE_KEY) {
+        return Vec::new();
+    }
+    let xs = series.iter().flat_map(|s| s.x.iter().copied());
+    let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+        (a.min(x), b.max(x))
+    });
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Vec::new();
+    }
+    SPEED_MULTIPLES
+        .iter()
+        .map(|n| {
+            let f = |omega: f64| n * omega / std::f64::consts::TAU;
+            let mut s = Series::new(format!("{n}× speed"), vec![lo, hi], vec![f(lo), f(hi)]);
+            s.color = Some(Color {
+                r: 150,
+                g: 150,
+                b: 150,
+            });
+            s.marker = Some(Marker::None);
+            s.dash = Some(Dash::Dashed);
+            s
+        })
+        .collect()
 }

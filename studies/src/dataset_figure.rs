@@ -15,6 +15,11 @@
 //! `max`, `min`, `max-abs`, `mean`, `final` (the last stored step) or `initial`.
 //! NaN values are left out of `max`, `min`, `max-abs` and `mean`.
 //!
+//! `mode = k` (instead of `reduce`) takes the `k`-th value, counted from 1,
+//! of a dataset with one value per mode — `/modes/frequency`,
+//! `/modes/damping_ratio`, `/buckling/load_factor` of modal and buckling
+//! runs: over `solver.rotation.rate`, a Campbell diagram.
+//!
 //! `derivative = ["section.rod.EI[0]", ...]` adds, per key path, the
 //! figure's exact derivative by that model value as the summary column
 //! `d(<name>)|d(<key>)`: the runs write `/sensitivity/<key>/…` (the study
@@ -128,6 +133,10 @@ pub struct DatasetFigure {
     pub reduce: Reduce,
     /// Key paths of model values to write the figure's derivatives by.
     pub derivative: Vec<String>,
+    /// `mode = k`: the `k`-th value (from 1, the lowest mode) of a dataset
+    /// with one value per mode (`/modes/frequency`, `/buckling/load_factor`,
+    /// …) instead of a reduction over the stored steps.
+    pub mode: Option<usize>,
 }
 
 impl DatasetFigure {
@@ -140,10 +149,19 @@ impl DatasetFigure {
             ));
         };
         for key in t.keys() {
-            if !["name", "dataset", "component", "reduce", "derivative"].contains(&key.as_str()) {
+            if ![
+                "name",
+                "dataset",
+                "component",
+                "reduce",
+                "derivative",
+                "mode",
+            ]
+            .contains(&key.as_str())
+            {
                 return Err(format!(
                     "unknown key `{key}` in a dataset figure; it takes name, dataset, reduce and \
-                     optionally component and derivative"
+                     optionally component and derivative (or mode instead of reduce)"
                 ));
             }
         }
@@ -164,6 +182,9 @@ impl DatasetFigure {
         }
         let dataset = text("dataset", "/nodes/arm.end/displacement")?;
         let dataset = format!("/{}", dataset.trim_start_matches('/'));
+        if let Some(k) = mode_index(t.get("mode"))? {
+            return Self::of_mode(t, name, dataset, k);
+        }
         let reduce_name = text("reduce", "max-abs")?;
         let reduce = Reduce::ALL
             .iter()
@@ -203,6 +224,34 @@ impl DatasetFigure {
             component,
             reduce,
             derivative,
+            mode: None,
+        })
+    }
+
+    /// The figure `mode = k` of `dataset` (no reduction, component or
+    /// derivative with it).
+    fn of_mode(
+        t: &toml::map::Map<String, Value>,
+        name: String,
+        dataset: String,
+        k: usize,
+    ) -> Result<Self, String> {
+        if let Some(key) = ["reduce", "component", "derivative"]
+            .iter()
+            .find(|key| t.contains_key(**key))
+        {
+            return Err(format!(
+                "`mode = {k}` picks one value of a dataset with one value per mode; `{key}` \
+                 does not go with it: remove `{key}`"
+            ));
+        }
+        Ok(Self {
+            name,
+            dataset,
+            component: Component::Index(0),
+            reduce: Reduce::Final,
+            derivative: Vec::new(),
+            mode: Some(k),
         })
     }
 
@@ -246,6 +295,9 @@ impl DatasetFigure {
 
     /// A one-line meaning, for descriptions and chart axes.
     pub fn description(&self) -> String {
+        if let Some(k) = self.mode {
+            return format!("mode {k} of {}", self.dataset);
+        }
         let part = match self.component {
             Component::Norm => "|·|".to_string(),
             Component::Index(i) => format!("[{i}]"),
@@ -255,6 +307,18 @@ impl DatasetFigure {
 
     /// Its value for the run in `result`.
     pub fn value(&self, result: &ResultReader) -> Result<f64, ReadError> {
+        if let Some(k) = self.mode {
+            let shape = result.shape(&self.dataset)?;
+            return match shape.as_slice() {
+                [n] if k <= *n => Ok(result.values(&self.dataset)?[k - 1]),
+                _ => Err(ReadError::Shape {
+                    path: result.path().to_path_buf(),
+                    dataset: self.dataset.clone(),
+                    shape,
+                    expected: "N, one value per mode, with the figure's mode <= N",
+                }),
+            };
+        }
         let (values, width) = self.rows(result, &self.dataset)?;
         let column: Vec<f64> = match (width, self.component) {
             (0, _) => values,
@@ -285,6 +349,17 @@ impl DatasetFigure {
                 expected: "T or T×k with the chosen component (T = stored steps)",
             }),
         }
+    }
+}
+
+/// `mode = k` of a figure (from 1), if given.
+fn mode_index(value: Option<&Value>) -> Result<Option<usize>, String> {
+    match value {
+        None => Ok(None),
+        Some(Value::Integer(k)) if *k >= 1 => Ok(Some(*k as usize)),
+        Some(v) => Err(format!(
+            "`mode` counts the modes from 1 (the lowest), found {v}"
+        )),
     }
 }
 
