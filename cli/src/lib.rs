@@ -212,6 +212,11 @@ struct ExportArgs {
     /// initial bounding-box diagonal).
     #[arg(long)]
     width: Option<f64>,
+    /// Write mode k (from 1) of a modal or buckling result as one cycle
+    /// about its stored state (`<stem>_mode<k>.pvd`; the phase 0 to 1 as
+    /// time) instead of the stored steps.
+    #[arg(long, value_name = "K")]
+    mode: Option<usize>,
 }
 
 /// The arguments of `flexmech animate`.
@@ -247,6 +252,10 @@ struct AnimateArgs {
     /// For a .png: the time of the frame (default: the last step).
     #[arg(long)]
     time: Option<f64>,
+    /// Draw mode k (from 1) of a modal or buckling result, one cycle about
+    /// its stored state, instead of the stored steps.
+    #[arg(long, value_name = "K")]
+    mode: Option<usize>,
 }
 
 /// The arguments of `flexmech bench`.
@@ -531,8 +540,17 @@ fn plot_command(args: PlotArgs) -> ExitCode {
 
 /// `flexmech export`: a result file as a ParaView series; prints the `.pvd`.
 fn export_command(args: ExportArgs) -> ExitCode {
-    let ExportArgs { result, vtk, width } = args;
-    match flexmech_results::export::export_vtk(&result, &vtk, width) {
+    let ExportArgs {
+        result,
+        vtk,
+        width,
+        mode,
+    } = args;
+    let written = match mode {
+        Some(k) => flexmech_results::export::export_mode_vtk(&result, &vtk, width, k),
+        None => flexmech_results::export::export_vtk(&result, &vtk, width),
+    };
+    match written {
         Ok(pvd) => {
             println!("{}", pvd.display());
             ExitCode::SUCCESS
@@ -555,6 +573,7 @@ fn animate_command(args: AnimateArgs) -> ExitCode {
         max_frames,
         track,
         time,
+        mode,
     } = args;
     let view = match (azimuth, elevation) {
         (Some(azimuth), Some(elevation)) => Some(View::Angles { azimuth, elevation }),
@@ -578,6 +597,7 @@ fn animate_command(args: AnimateArgs) -> ExitCode {
         max_frames,
         track,
         time,
+        mode,
     };
     match animate(&result, &out, &opts) {
         Ok(file) => {

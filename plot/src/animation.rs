@@ -85,6 +85,9 @@ pub struct AnimationOptions {
     pub track: Vec<String>,
     /// For a PNG: the time of the frame (the nearest stored step; None: the last).
     pub time: Option<f64>,
+    /// Draw mode `k` (from 1) of a modal or buckling result, one cycle
+    /// about its stored state, instead of the stored steps.
+    pub mode: Option<usize>,
 }
 
 impl Default for AnimationOptions {
@@ -96,6 +99,7 @@ impl Default for AnimationOptions {
             max_frames: 250,
             track: Vec::new(),
             time: None,
+            mode: None,
         }
     }
 }
@@ -335,7 +339,10 @@ pub fn animate(result: &Path, out: &Path, opts: &AnimationOptions) -> Result<Pat
             why: format!("{}: write a .gif, .mp4 or .png file", out.display()),
         });
     }
-    let frames = Frames::read(result)?;
+    let frames = match opts.mode {
+        Some(k) => flexmech_results::export::mode_frames(result, k)?,
+        None => Frames::read(result)?,
+    };
     if frames.steps() == 0 {
         return Err(ExportError::Option {
             option: "RESULT",

@@ -3,8 +3,10 @@
 //! `flexmech animate`), both drawn from the same [`Frames`].
 
 pub mod frames;
+pub mod mode_frames;
 pub mod paraview;
 pub mod vtu;
 
 pub use frames::Frames;
-pub use paraview::{export_vtk, ExportError};
+pub use mode_frames::mode_frames;
+pub use paraview::{export_mode_vtk, export_vtk, ExportError};

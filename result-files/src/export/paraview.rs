@@ -271,6 +271,37 @@ fn joints_grid(f: &Frames, k: usize) -> Option<Grid> {
 /// `width` is the ribbon width (None: [`default_width`]). Returns the
 /// `.pvd` file.
 pub fn export_vtk(result: &Path, dir: &Path, width: Option<f64>) -> Result<PathBuf, ExportError> {
+    let frames = Frames::read(result)?;
+    let stem = result
+        .file_stem()
+        .map_or_else(|| "result".to_owned(), |s| s.to_string_lossy().into_owned());
+    write_series(&frames, &stem, dir, width)
+}
+
+/// [`export_vtk`] of mode `mode` (from 1) of a modal or buckling result:
+/// one cycle about its stored state ([`super::mode_frames`]), the phase
+/// (0 to 1) as the series' time, written as `<dir>/<stem>_mode<k>.pvd`.
+pub fn export_mode_vtk(
+    result: &Path,
+    dir: &Path,
+    width: Option<f64>,
+    mode: usize,
+) -> Result<PathBuf, ExportError> {
+    let frames = super::mode_frames(result, mode)?;
+    let stem = result
+        .file_stem()
+        .map_or_else(|| "result".to_owned(), |s| s.to_string_lossy().into_owned());
+    write_series(&frames, &format!("{stem}_mode{mode}"), dir, width)
+}
+
+/// Writes `frames` as the series `<dir>/<stem>.pvd` with its `.vtu` files
+/// under `<dir>/<stem>/`.
+fn write_series(
+    frames: &Frames,
+    stem: &str,
+    dir: &Path,
+    width: Option<f64>,
+) -> Result<PathBuf, ExportError> {
     if let Some(w) = width {
         if !(w.is_finite() && w > 0.0) {
             return Err(ExportError::Option {
@@ -279,20 +310,16 @@ pub fn export_vtk(result: &Path, dir: &Path, width: Option<f64>) -> Result<PathB
             });
         }
     }
-    let frames = Frames::read(result)?;
-    let stem = result
-        .file_stem()
-        .map_or_else(|| "result".to_owned(), |s| s.to_string_lossy().into_owned());
-    let sub = dir.join(&stem);
+    let sub = dir.join(stem);
     std::fs::create_dir_all(&sub).map_err(io(&sub))?;
-    let width = width.unwrap_or_else(|| default_width(&frames));
-    let ribbon = Ribbon::new(&frames);
+    let width = width.unwrap_or_else(|| default_width(frames));
+    let ribbon = Ribbon::new(frames);
     let mut entries = Vec::new();
     for k in 0..frames.steps() {
         let time = frames.time[k];
         let name = format!("{stem}_{k:06}.vtu");
         let path = sub.join(&name);
-        beams_grid(&frames, &ribbon, k, width)
+        beams_grid(frames, &ribbon, k, width)
             .write(&path)
             .map_err(io(&path))?;
         entries.push(Entry {
@@ -300,7 +327,7 @@ pub fn export_vtk(result: &Path, dir: &Path, width: Option<f64>) -> Result<PathB
             part: 0,
             file: format!("{stem}/{name}"),
         });
-        if let Some(g) = joints_grid(&frames, k) {
+        if let Some(g) = joints_grid(frames, k) {
             let name = format!("{stem}_joints_{k:06}.vtu");
             let path = sub.join(&name);
             g.write(&path).map_err(io(&path))?;
