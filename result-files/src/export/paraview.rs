@@ -279,7 +279,7 @@ pub fn export_vtk(result: &Path, dir: &Path, width: Option<f64>) -> Result<PathB
 }
 
 /// [`export_vtk`] of mode `mode` (from 1) of a modal or buckling result:
-/// one cycle about its stored state ([`super::mode_frames`]), the phase
+/// one cycle about its stored state ([`super::mode_frames()`]), the phase
 /// (0 to 1) as the series' time, written as `<dir>/<stem>_mode<k>.pvd`.
 pub fn export_mode_vtk(
     result: &Path,
