@@ -222,6 +222,7 @@ fn base_file_parses_with_defaults() {
             modified_newton: false,
             exact_tangent: false,
             rotation: None,
+            eigensolver: None,
         }
     );
     assert_eq!(m.output.every, 1);

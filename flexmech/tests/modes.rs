@@ -198,6 +198,22 @@ fn linearised_analyses_refuse_keys_that_are_not_theirs() {
         ("analysis = \"modal\"\ndt = 0.1", "solver.dt"),
         ("analysis = \"modes\"", "solver.analysis"),
         ("analysis = \"modal\"\nmodes = 0", "solver.modes"),
+        (
+            "analysis = \"static\"\neigensolver = \"dense\"",
+            "solver.eigensolver",
+        ),
+        (
+            "analysis = \"modal\"\neigensolver = \"lanczos\"",
+            "solver.eigensolver",
+        ),
+        (
+            "analysis = \"modal\"\nrotation = { rate = 3.0 }",
+            "solver.rotation.axis",
+        ),
+        (
+            "analysis = \"buckling\"\nrotation = { axis = [0.0, 0.0, 1.0], rate = 3.0 }",
+            "solver.rotation",
+        ),
     ];
     for (solver, key) in cases {
         let text = beam_model(SLENDER, "", solver, 4);
@@ -518,4 +534,31 @@ fn a_mode_is_written_as_a_paraview_cycle_and_drawn_as_a_gif() {
     assert_eq!(frames, 41);
     let err = export_mode_vtk(&file, &dir.path().join("vtk"), None, 4).unwrap_err();
     assert!(err.to_string().contains("modes 1 to 3, not 4"), "{err}");
+}
+
+#[test]
+fn the_sparse_eigensolver_gives_the_dense_ones_frequencies() {
+    let model = |solver: &str| {
+        beam_model(
+            SLENDER,
+            "[[support]]\nnode = \"b.start\"\nfixed = \"all\"",
+            &format!("analysis = \"modal\"\nmodes = 10\neigensolver = \"{solver}\""),
+            24,
+        )
+    };
+    let (_a, dense) = run(&model("dense"));
+    let (_b, sparse) = run(&model("sparse"));
+    let (d, s) = (
+        read(&dense, "/modes/frequency"),
+        read(&sparse, "/modes/frequency"),
+    );
+    for (k, (x, y)) in d.iter().zip(&s).enumerate() {
+        assert_close(*y, *x, 1e-7, &format!("mode {k}"));
+    }
+    assert_eq!(
+        crate::common::reader(&sparse)
+            .string_attr("integrator")
+            .as_deref(),
+        Some("static")
+    );
 }

@@ -235,6 +235,7 @@ pub(crate) struct RawSolver {
     pub branch_switch: Option<S<bool>>,
     pub modes: Option<S<i64>>,
     pub rotation: Option<S<RawRotation>>,
+    pub eigensolver: Option<S<String>>,
 }
 
 /// `[solver] rotation`.

@@ -193,6 +193,9 @@ pub struct RigidBodySpec {
 /// files and Rust (`IntegratorKind::name` gives the model-file name).
 pub use flexmech_integrators::dynamics::Integrator as IntegratorKind;
 
+/// The eigensolvers of modal and buckling analyses: the solvers' own enum.
+pub use flexmech_integrators::modal::EigenSolver;
+
 /// How translational mass is distributed: the solvers' own enum.
 pub use flexmech_core::MassKind;
 
@@ -300,6 +303,9 @@ pub struct SolverSpec {
     pub exact_tangent: bool,
     /// A steady spin of the frame (static and modal analyses).
     pub rotation: Option<Rotation>,
+    /// `eigensolver = "dense" | "sparse"` of a modal or buckling analysis
+    /// (`None`, `"auto"`: by the unknowns).
+    pub eigensolver: Option<EigenSolver>,
 }
 
 impl Default for SolverSpec {
@@ -316,6 +322,7 @@ impl Default for SolverSpec {
             modified_newton: false,
             exact_tangent: false,
             rotation: None,
+            eigensolver: None,
         }
     }
 }

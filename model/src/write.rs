@@ -318,6 +318,9 @@ impl Model {
         put("tolerance", Value::Float(s.tolerance));
         put("max_iterations", int(s.max_iterations));
         put("max_halvings", int(s.max_halvings));
+        if let Some(e) = s.eigensolver {
+            put("eigensolver", Value::String(e.name().into()));
+        }
         if let Some(r) = s.rotation {
             let mut rot = Table::new();
             rot.insert("axis".into(), vec3(r.axis));

@@ -12,7 +12,9 @@ use flexmech_integrators::arc_length::{solve_arc_length_with, ArcLengthSettings}
 use flexmech_integrators::constraints::initial_state;
 use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
 use flexmech_integrators::measure::static_record;
-use flexmech_integrators::modal::{buckling_modes, solve_modal, ModalSettings, ModeSet};
+use flexmech_integrators::modal::{
+    buckling_modes, solve_modal, ModalSettings, ModeRequest, ModeSet,
+};
 use flexmech_integrators::{
     solve_static_with, Mechanism, NewtonSettings, SolveError, StaticSettings, StepRecord,
 };
@@ -529,8 +531,11 @@ fn solve(
         }
         Analysis::Modal { modes, load_steps } => {
             let settings = ModalSettings {
-                modes,
-                mass: model.solver.mass,
+                request: ModeRequest {
+                    modes,
+                    mass: model.solver.mass,
+                    solver: model.solver.eigensolver,
+                },
                 preload: StaticSettings {
                     load_steps,
                     newton,
@@ -546,7 +551,7 @@ fn solve(
             let state = initial_state(mech);
             let fext = vec![0.0; 6 * mech.mesh.node_count()];
             keeper.push(&static_record(mech, &state, &fext, 0.0, 0.0, None));
-            let outcome = buckling_modes(mech, modes);
+            let outcome = buckling_modes(mech, modes, model.solver.eigensolver);
             (outcome.map(|set| keeper.modes(&set)), 0.0)
         }
         Analysis::Dynamic {

@@ -15,7 +15,7 @@ use crate::sink::{FileSink, RunEnd, Sink};
 use crate::{layout, Merit, ResultReader};
 use flexmech_integrators::constraints::MechanismState;
 use flexmech_integrators::dynamics::Simulation;
-use flexmech_integrators::modal::{vibration_modes, ModeSet};
+use flexmech_integrators::modal::{vibration_modes, ModeRequest, ModeSet};
 use flexmech_integrators::{solve_static_to, StaticSettings, StepRecord};
 use flexmech_model::{build, parse_model_with, Analysis, Built, JointRegistry, Model};
 use std::path::{Path, PathBuf};
@@ -64,8 +64,13 @@ pub fn modes_of_result(
     let built = build(&model)?;
     let (state, record) = state_at(&model, &built, time).map_err(refuse)?;
     let mech = &built.mechanism;
-    let set = vibration_modes(mech, &state, time, modes, model.solver.mass, true)
-        .map_err(|e| refuse(e.to_string()))?;
+    let request = ModeRequest {
+        modes,
+        mass: model.solver.mass,
+        solver: None,
+    };
+    let set =
+        vibration_modes(mech, &state, time, &request, true).map_err(|e| refuse(e.to_string()))?;
     let file = out_dir.join(format!("{}_modes.h5", model.name));
     let mut sink = FileSink::new(&file);
     let meta = run_meta(&model, &built);

@@ -22,8 +22,13 @@ use crate::mechanism::Mechanism;
 
 /// The `modes` lowest positive buckling load factors of `mech` under its
 /// loads (at load factor 1) and their modes, each scaled to a largest nodal
-/// displacement of 1 (largest rotation where no node moves).
-pub fn buckling_modes(mech: &Mechanism, modes: usize) -> Result<ModeSet, SolveError> {
+/// displacement of 1 (largest rotation where no node moves); `solver`
+/// `None` chooses by the unknowns.
+pub fn buckling_modes(
+    mech: &Mechanism,
+    modes: usize,
+    solver: Option<EigenSolver>,
+) -> Result<ModeSet, SolveError> {
     if mech.has_drivers() {
         return Err(SolveError::InvalidMechanism(
             "buckling analysis multiplies the model's loads; prescribed motions and driven \
@@ -63,7 +68,7 @@ pub fn buckling_modes(mech: &Mechanism, modes: usize) -> Result<ModeSet, SolveEr
              {asym_g:.1e}; follower loads): use dead loads"
         )));
     }
-    let solver = EigenSolver::for_unknowns(n);
+    let solver = solver.unwrap_or(EigenSolver::for_unknowns(n));
     let (mu, vectors) = match eigen::largest(&lin0.pattern, (&k0, &b), modes, solver) {
         Ok(r) => r,
         Err(PencilError::NotDefinite) => return Err(unsupported()),

@@ -39,9 +39,10 @@ const DEPENDENT: f64 = 1e-8;
 /// space.
 const SUBSPACE_PASSES: usize = 4;
 
-/// Relative residual `‖By − μAy‖ / ‖Ay‖` above which a sparse mode is
-/// refused rather than reported.
-const MODE_RESIDUAL: f64 = 1e-6;
+/// Backward error `‖By − μAy‖ / ((|μ|‖A‖ + ‖B‖)‖y‖)` (Frobenius norms)
+/// above which a sparse mode is refused rather than reported: the pair is
+/// then not the exact one of any pencil that close to this one.
+const MODE_RESIDUAL: f64 = 1e-10;
 
 /// Eigenvalues `μ` (descending) and their vectors.
 pub(crate) type Eigenpairs = (Vec<f64>, Vec<Vec<f64>>);
@@ -285,7 +286,7 @@ fn a_orthonormal(
 }
 
 /// Rayleigh–Ritz on the `A`-orthonormal `basis`: the `count` largest
-/// eigenvalues of `VᵀBV`, their vectors `V u`, each checked by its residual.
+/// eigenvalues of `VᵀBV`, their vectors `V u`, each checked by its backward error.
 fn ritz(
     pattern: &Pattern,
     (a, b): (&[f64], &[f64]),
@@ -313,6 +314,8 @@ fn ritz(
     let (s, u) = (evd.S(), evd.U());
     let (mut values, mut vectors) = (Vec::new(), Vec::new());
     let (mut ay, mut by) = (vec![0.0; n], vec![0.0; n]);
+    let frobenius = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let (norm_a, norm_b) = (frobenius(a), frobenius(b));
     for k in (m - count..m).rev() {
         let mut y = vec![0.0; n];
         for (r, q) in basis.iter().enumerate() {
@@ -327,10 +330,10 @@ fn ritz(
             .map(|(x, z)| (x - mu * z).powi(2))
             .sum::<f64>()
             .sqrt();
-        let scale = mu.abs() * ay.iter().map(|z| z * z).sum::<f64>().sqrt();
+        let scale = (mu.abs() * norm_a + norm_b) * frobenius(&y);
         if res.is_nan() || res > MODE_RESIDUAL * scale {
             return Err(PencilError::Failed(format!(
-                "eigenpair {} did not converge (relative residual {:.1e})",
+                "eigenpair {} did not converge (backward error {:.1e})",
                 m - k,
                 res / scale
             )));

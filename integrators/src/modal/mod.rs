@@ -138,13 +138,23 @@ impl ModeSet {
     }
 }
 
-/// Settings of a modal analysis.
+/// What a linearisation is asked for: how many modes, with which mass,
+/// by which solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ModalSettings {
+pub struct ModeRequest {
     /// How many of the lowest modes.
     pub modes: usize,
     /// Translational mass distribution.
     pub mass: MassKind,
+    /// The eigensolver (`None`: by the unknowns, [`EigenSolver::for_unknowns`]).
+    pub solver: Option<EigenSolver>,
+}
+
+/// Settings of a modal analysis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModalSettings {
+    /// The modes asked for.
+    pub request: ModeRequest,
     /// The static path to the state the modes are about, where the
     /// mechanism is loaded or driven.
     pub preload: StaticSettings,
@@ -181,7 +191,7 @@ pub fn solve_modal(
         on_step(&static_record(mech, &state, &fext, 0.0, 0.0, None));
         (state, 0.0)
     };
-    vibration_modes(mech, &state, load, settings.modes, settings.mass, false)
+    vibration_modes(mech, &state, load, &settings.request, false)
 }
 
 /// The `modes` lowest vibration modes of `mech` linearised at `state` with
@@ -195,10 +205,10 @@ pub fn vibration_modes(
     mech: &Mechanism,
     state: &MechanismState,
     load_time: f64,
-    modes: usize,
-    mass: MassKind,
+    request: &ModeRequest,
     symmetric_part: bool,
 ) -> Result<ModeSet, SolveError> {
+    let (modes, mass) = (request.modes, request.mass);
     let mut lin = Linearisation::at(mech, state, Some(load_time))?;
     let n = lin.unknowns();
     check_count(modes, n)?;
@@ -219,7 +229,7 @@ pub fn vibration_modes(
     }
     let mut set = ModeSet::empty(
         ModeKind::Vibration,
-        EigenSolver::for_unknowns(n),
+        request.solver.unwrap_or(EigenSolver::for_unknowns(n)),
         n,
         asymmetry,
     );

@@ -49,8 +49,11 @@ fn cantilever(elements: usize, nodes_per_element: usize, tip_load: f64) -> Mecha
 
 fn settings(modes: usize) -> ModalSettings {
     ModalSettings {
-        modes,
-        mass: MassKind::Consistent,
+        request: ModeRequest {
+            modes,
+            mass: MassKind::Consistent,
+            solver: None,
+        },
         preload: StaticSettings {
             load_steps: 1,
             newton: NewtonSettings::default(),
@@ -132,7 +135,7 @@ fn sparse_solver_equals_the_dense_one() {
 #[test]
 fn clamped_free_column_buckles_at_eulers_load() {
     let mech = cantilever(16, 3, 1.0);
-    let set = buckling_modes(&mech, 4).unwrap();
+    let set = buckling_modes(&mech, 4, None).unwrap();
     let exact = std::f64::consts::PI.powi(2) * 1e3 / 4.0;
     for k in 0..2 {
         let l = set.eigenvalues[k];

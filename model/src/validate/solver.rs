@@ -54,8 +54,10 @@ impl Ctx<'_> {
         let mass = self.mass_kind(s)?;
         let (modified_newton, exact_tangent) = self.newton_kind(s, &analysis)?;
         let rotation = self.rotation(s, &analysis)?;
+        let eigensolver = self.eigensolver(s, &analysis)?;
         Ok(SolverSpec {
             rotation,
+            eigensolver,
             analysis,
             tolerance,
             max_iterations,
@@ -405,6 +407,35 @@ impl Ctx<'_> {
             origin,
             rate: rate.get_ref().0,
         }))
+    }
+
+    /// `solver.eigensolver` of a modal or buckling analysis: "auto" (the
+    /// default: dense up to 600 unknowns), "dense" or "sparse".
+    fn eigensolver(&self, s: &RawSolver, analysis: &Analysis) -> Res<Option<EigenSolver>> {
+        let Some(e) = &s.eigensolver else {
+            return Ok(None);
+        };
+        if !matches!(analysis, Analysis::Modal { .. } | Analysis::Buckling { .. }) {
+            return Err(self.at(
+                "solver.eigensolver",
+                e,
+                format!(
+                    "`eigensolver` belongs to analysis = \"modal\" or \"buckling\", but this \
+                     analysis is {}; remove `eigensolver`",
+                    analysis.name()
+                ),
+            ));
+        }
+        match e.get_ref().as_str() {
+            "auto" => Ok(None),
+            "dense" => Ok(Some(EigenSolver::Dense)),
+            "sparse" => Ok(Some(EigenSolver::Sparse)),
+            other => Err(self.at(
+                "solver.eigensolver",
+                e,
+                format!("expected \"auto\", \"dense\" or \"sparse\", found \"{other}\""),
+            )),
+        }
     }
 
     /// `solver.mass`: consistent (the default) or lumped.
