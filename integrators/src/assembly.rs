@@ -13,7 +13,7 @@
 
 use crate::dofs::DofMap;
 use faer::sparse::SymbolicSparseColMat;
-use flexmech_core::{Configuration, Element, Mesh};
+use flexmech_core::{Configuration, Element, Inertia, Mesh};
 use nalgebra::{DMatrix, DVector, Matrix3};
 use rayon::prelude::*;
 
@@ -445,6 +445,19 @@ impl Assembler {
     pub fn add_block(&mut self, b: usize, m: &DMatrix<f64>) {
         for (&p, &v) in self.blocks[b].pos.iter().zip(m.as_slice()) {
             self.values[p] += v;
+        }
+    }
+
+    /// Adds the mass `inertia` at the nodal rotations `rot` through the node
+    /// maps: `m_ij I` on the translations, `R J₀ Rᵀ` on the spatial spins
+    /// (the reduced `NᵀMN` of the initial accelerations and of the modes).
+    pub fn add_mass(&mut self, dofs: &DofMap, inertia: &Inertia, rot: &[Matrix3<f64>]) {
+        for &(i, j, m) in &inertia.mass {
+            self.add_node_block(dofs, (i, 0), (j, 0), &(Matrix3::identity() * m));
+        }
+        for (i, j0) in inertia.rotational.iter().enumerate() {
+            let r = rot[i];
+            self.add_node_block(dofs, (i, 3), (i, 3), &(r * j0 * r.transpose()));
         }
     }
 

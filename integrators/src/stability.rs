@@ -23,6 +23,27 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Par, Side};
 
+/// For each stored entry `(i, j)` of a structurally symmetric pattern, the
+/// index of `(j, i)`; an error when the pattern is not symmetric.
+pub(crate) fn transpose_positions(
+    pattern: &SymbolicSparseColMat<usize>,
+) -> Result<Vec<usize>, String> {
+    let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
+    let mut transpose = vec![usize::MAX; row_idx.len()];
+    for j in 0..pattern.ncols() {
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            let i = row_idx[k];
+            let range = col_ptr[i]..col_ptr[i + 1];
+            let p = row_idx[range.clone()]
+                .iter()
+                .position(|&r| r == j)
+                .ok_or("the tangent's pattern is not symmetric")?;
+            transpose[k] = range.start + p;
+        }
+    }
+    Ok(transpose)
+}
+
 /// Counts negative pivots of the symmetric part of matrices of one pattern.
 pub struct InertiaCount {
     pattern: SymbolicSparseColMat<usize>,
@@ -38,20 +59,8 @@ impl InertiaCount {
     /// Symbolic analysis of a structurally symmetric pattern (the assembled
     /// tangent's: every block couples a set of equations both ways).
     pub fn new(pattern: SymbolicSparseColMat<usize>) -> Result<Self, String> {
-        let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
-        let n = pattern.nrows();
-        let mut transpose = vec![usize::MAX; row_idx.len()];
-        for j in 0..n {
-            for k in col_ptr[j]..col_ptr[j + 1] {
-                let i = row_idx[k];
-                let range = col_ptr[i]..col_ptr[i + 1];
-                let found = row_idx[range.clone()].iter().position(|&r| r == j);
-                match found {
-                    Some(p) => transpose[k] = range.start + p,
-                    None => return Err("the tangent's pattern is not symmetric".into()),
-                }
-            }
-        }
+        let transpose = transpose_positions(&pattern)?;
+        let row_idx = pattern.row_idx();
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
             ..Default::default()

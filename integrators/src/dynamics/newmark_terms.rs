@@ -536,13 +536,7 @@ pub(super) fn initial_accelerations(
         vec![0.0; topo.dofs.n_eq],
     );
     asm.values.iter_mut().for_each(|v| *v = 0.0);
-    for &(i, j, m) in &inertia.mass {
-        asm.add_node_block(&topo.dofs, (i, 0), (j, 0), &(Matrix3::identity() * m));
-    }
-    for (i, j0) in inertia.rotational.iter().enumerate() {
-        let r = state.config.rot[i];
-        asm.add_node_block(&topo.dofs, (i, 3), (i, 3), &(r * j0 * r.transpose()));
-    }
+    asm.add_mass(&topo.dofs, inertia, &state.config.rot);
     let mut q = vec![0.0; topo.dofs.n_eq];
     topo.dofs.reduce(residual, &mut q);
     if let Some((eq, value)) = extra {

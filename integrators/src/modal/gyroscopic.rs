@@ -63,12 +63,12 @@ pub(crate) fn quadratic(
         .self_adjoint_eigen(Side::Lower)
         .map_err(|e| PencilError::Failed(format!("Hermitian eigen-decomposition failed: {e:?}")))?;
     let (s, u) = (evd.S(), evd.U());
+    let lkc = Mat::<c64>::from_fn(n, n, |i, j| c64::new(lk[(i, j)], 0.0));
     let mut pairs: Vec<(c64, Vec<c64>)> = (0..2 * n)
         .filter(|&p| s[p].re < 0.0)
         .map(|p| {
             let omega = -s[p].re;
             let mut top = Mat::<c64>::from_fn(n, 1, |i, _| u[(i, p)]);
-            let lkc = Mat::<c64>::from_fn(n, n, |i, j| c64::new(lk[(i, j)], 0.0));
             lkc.transpose().solve_upper_triangular_in_place(&mut top);
             let phi = (0..n).map(|i| top[(i, 0)] * d[i]).collect();
             (c64::new(0.0, omega), phi)

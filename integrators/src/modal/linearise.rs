@@ -9,7 +9,7 @@ use crate::mechanism::Mechanism;
 use crate::statics::{static_system, StaticTerms};
 use crate::system::ReducedSystem;
 use flexmech_core::MassKind;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 /// A mode expanded to the nodes: displacements, spatial rotation vectors
 /// (both per node) and each joint's released coordinates.
@@ -73,13 +73,7 @@ impl<'m> Linearisation<'m> {
         let inertia = mech.inertia(kind);
         let (asm, topo) = (&mut self.sys.asm, &self.sys.topo);
         asm.values.iter_mut().for_each(|v| *v = 0.0);
-        for &(i, j, m) in &inertia.mass {
-            asm.add_node_block(&topo.dofs, (i, 0), (j, 0), &(Matrix3::identity() * m));
-        }
-        for (i, j0) in inertia.rotational.iter().enumerate() {
-            let r = self.sys.end.config.rot[i];
-            asm.add_node_block(&topo.dofs, (i, 3), (i, 3), &(r * j0 * r.transpose()));
-        }
+        asm.add_mass(&topo.dofs, &inertia, &self.sys.end.config.rot);
         asm.values.clone()
     }
 

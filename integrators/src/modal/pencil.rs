@@ -23,19 +23,7 @@ impl Pattern {
     /// The pattern `symbolic` (structurally symmetric: every block of the
     /// assembly couples a set of equations both ways).
     pub fn new(symbolic: SymbolicSparseColMat<usize>) -> Result<Self, String> {
-        let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
-        let mut transpose = vec![0; row_idx.len()];
-        for j in 0..symbolic.ncols() {
-            for k in col_ptr[j]..col_ptr[j + 1] {
-                let i = row_idx[k];
-                let range = col_ptr[i]..col_ptr[i + 1];
-                let p = row_idx[range.clone()]
-                    .iter()
-                    .position(|&r| r == j)
-                    .ok_or("the tangent's pattern is not symmetric")?;
-                transpose[k] = range.start + p;
-            }
-        }
+        let transpose = crate::stability::transpose_positions(&symbolic)?;
         Ok(Self {
             symbolic,
             transpose,
