@@ -382,6 +382,7 @@ fn record(step: usize) -> StepRecord {
         velocities: Vec::new(),
         angular_velocities: Vec::new(),
         sensitivities: Vec::new(),
+        critical: None,
     }
 }
 

@@ -223,6 +223,7 @@ fn base_file_parses_with_defaults() {
             exact_tangent: false,
             rotation: None,
             eigensolver: None,
+            stop: None,
         }
     );
     assert_eq!(m.output.every, 1);

@@ -148,6 +148,7 @@ fn record(step: usize) -> StepRecord {
         velocities: (0..N_NODES).map(|i| velocity(step, i, 1.0)).collect(),
         angular_velocities: (0..N_NODES).map(|i| velocity(step, i, -2.0)).collect(),
         sensitivities: Vec::new(),
+        critical: None,
     }
 }
 

@@ -4,7 +4,7 @@
 //! `warnings` attribute) instead of completing silently on the unstable
 //! branch. Checked against a published buckling load and an analytic one.
 
-use crate::common::{read, read_integers, reader};
+use crate::common::{read, read_integers, read_strings, reader};
 use flexmech::model::{load_model, parse_model};
 use flexmech::results::run_model;
 use std::path::{Path, PathBuf};
@@ -57,6 +57,25 @@ fn the_argyris_frame_reports_lateral_buckling_at_the_published_load() {
     assert_eq!(summary.warnings.len(), 1, "{:?}", summary.warnings);
     assert!(summary.warnings[0].starts_with("stability"));
     assert!(warnings_attr(&summary.file).contains("unstable from load factor"));
+    // Located by bisection inside that bracket: a bifurcation (the load
+    // does no work on the lateral mode) within 0.5 % of the published load,
+    // named with the nearest linear buckling load in the warning.
+    let located = read(&summary.file, "/stability/critical_load_factor");
+    let kinds = read_strings(&summary.file, "/stability/critical_kind");
+    assert_eq!(kinds, ["bifurcation"]);
+    let p = located[0] * p_max;
+    assert!(
+        (p / PUBLISHED - 1.0).abs() < 5e-3 && stable < p && p <= unstable,
+        "located {p}"
+    );
+    let bracket = read(&summary.file, "/stability/critical_bracket")[0];
+    assert!(bracket < 1e-5, "bracket {bracket}");
+    assert!(
+        summary.warnings[0].contains("bifurcation at"),
+        "{:?}",
+        summary.warnings
+    );
+    assert!(summary.warnings[0].contains("nearest linear buckling load factor"));
 }
 
 /// A column clamped at its base under a dead axial force ramped to `p`.
@@ -112,6 +131,31 @@ fn an_euler_column_turns_unstable_at_its_critical_load() {
     );
     assert_eq!(count, 2);
     assert!(!summary.warnings.is_empty());
+    // The located bifurcation equals the same mesh's linear buckling load:
+    // the perfect column's prebuckling state is a uniform shortening by
+    // P/EA = 2.5e-5, so the two differ by that order only.
+    let located = read(&summary.file, "/stability/critical_load_factor")[0] * 3.0;
+    assert_eq!(read(&summary.file, "/stability/negative_after"), [2.0]);
+    let buckling = parse_model(
+        &column(3.0, 60).replace(
+            "analysis = \"static\"\nload_steps = 60",
+            "analysis = \"buckling\"\nmodes = 2",
+        ),
+        Path::new("column.toml"),
+    )
+    .unwrap();
+    let linear = read(
+        &run_model(&buckling, dir.path()).unwrap().file,
+        "/buckling/load_factor",
+    )[0] * 3.0;
+    assert!(
+        (located / linear - 1.0).abs() < 2e-4,
+        "located {located}, linear {linear}"
+    );
+    assert!(
+        (located / p_cr - 1.0).abs() < 5e-3,
+        "located {located} vs {p_cr}"
+    );
     // Below P_cr: stable all the way, no warning.
     let model = parse_model(&column(2.3, 10), Path::new("column.toml")).unwrap();
     let summary = run_model(&model, dir.path()).unwrap();

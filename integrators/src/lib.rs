@@ -9,6 +9,7 @@ pub mod assembly;
 pub mod band_lu;
 pub mod builder;
 pub mod constraints;
+pub mod critical;
 pub mod dofs;
 pub mod dynamics;
 mod element_split;
@@ -43,5 +44,5 @@ pub use newton::NewtonSettings;
 pub use record::{Energies, JointRecord, Sensitivity, StepRecord};
 pub use sensitivity::Parameter;
 pub use statics::{
-    solve_static, solve_static_to, solve_static_with, StaticOutcome, StaticSettings,
+    solve_static, solve_static_to, solve_static_with, PathEnd, StaticOutcome, StaticSettings,
 };

@@ -113,6 +113,7 @@ pub fn static_record(
         velocities: Vec::new(),
         angular_velocities: Vec::new(),
         sensitivities: Vec::new(),
+        critical: None,
     }
 }
 

@@ -88,6 +88,10 @@ pub struct StepRecord {
     /// Statics with sensitivities (`statics::solve_static_with`): one per
     /// parameter, in the order given; empty otherwise.
     pub sensitivities: Vec<Sensitivity>,
+    /// Statics: the critical point (limit or bifurcation) located between
+    /// the previous step and this one, where the stability count changed
+    /// (see [`crate::critical`]); `None` otherwise.
+    pub critical: Option<crate::critical::CriticalPoint>,
 }
 
 /// The exact derivatives of one step's results with respect to one

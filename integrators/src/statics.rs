@@ -43,6 +43,37 @@ pub struct StaticOutcome {
     pub state: MechanismState,
     /// Converged steps (including those after halvings).
     pub steps: usize,
+    /// Why the path ended.
+    pub end: PathEnd,
+}
+
+/// Why a static path ended (all of them complete runs; a path that could
+/// not go on is an error instead).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PathEnd {
+    /// The path reached its last load factor (1, or an arc-length run's
+    /// `stop.load_factor`).
+    Reached {
+        /// The load factor reached.
+        load_factor: f64,
+    },
+    /// An arc-length path used its step budget (`max_arc_steps`).
+    Budget {
+        /// Steps taken.
+        steps: usize,
+        /// The load factor of the last step.
+        load_factor: f64,
+    },
+    /// A node's displacement reached the arc-length run's
+    /// `stop.displacement`.
+    Displacement {
+        /// The node (mesh index).
+        node: usize,
+        /// Its displacement `|x − X|` at the last step.
+        displacement: f64,
+        /// The load factor of the last step.
+        load_factor: f64,
+    },
 }
 
 /// The static terms: the beams' internal forces at the iterate; no inertia;
@@ -125,6 +156,7 @@ fn static_path(
     let driven = mech.has_drivers();
     // The state before the last converged step and that step's size.
     let mut previous: Option<(MechanismState, f64)> = None;
+    let mut count = initial_count(&mut prob, &mut inertia, &mut r);
     while lambda < end - TOLERANCES.end_of_run {
         let target = next_level(lambda, nominal, control.step());
         begin_step(&mut prob);
@@ -159,6 +191,14 @@ fn static_path(
                     Some(follower),
                 );
                 step.sensitivities = sensitivities.at(&prob, lambda)?;
+                step.critical = locate_on_load_path(
+                    &mut prob,
+                    (&mut lu, &mut inertia),
+                    (lambda - dt, count),
+                    &step,
+                    &settings.newton,
+                );
+                count = step.negative_pivots;
                 on_step(&step);
                 control.succeeded();
             }
@@ -172,7 +212,67 @@ fn static_path(
             }
         }
     }
-    Ok(StaticOutcome::reached(prob, steps))
+    let end = PathEnd::Reached {
+        load_factor: lambda,
+    };
+    Ok(StaticOutcome::reached(prob, steps, end))
+}
+
+/// The stability count of the state now in `sys` (its loads at λ = 0):
+/// the count the path starts from.
+pub(crate) fn initial_count(
+    sys: &mut ReducedSystem<'_, StaticTerms>,
+    inertia: &mut InertiaCount,
+    scratch: &mut [f64],
+) -> Option<usize> {
+    sys.fext.iter_mut().for_each(|f| *f = 0.0);
+    sys.mech.external_forces(0.0, &mut sys.fext);
+    sys.load_time = 0.0;
+    sys.update_tangent(scratch);
+    inertia.negative_eigenvalues(&sys.asm.values)
+}
+
+/// The critical point a load step from `sys.start` (load factor `lambda0`,
+/// `count` negative eigenvalues) to `step` crossed, when the count changed:
+/// bisection on the load factor, each point solved by Newton from the
+/// step's start (a bifurcation: load control cannot pass a limit point).
+fn locate_on_load_path(
+    sys: &mut ReducedSystem<'_, StaticTerms>,
+    (lu, inertia): (&mut SparseLu, &mut InertiaCount),
+    (lambda0, count): (f64, Option<usize>),
+    step: &StepRecord,
+    newton: &NewtonSettings,
+) -> Option<crate::critical::CriticalPoint> {
+    let (Some(before), Some(after)) = (count, step.negative_pivots) else {
+        return None;
+    };
+    if before == after {
+        return None;
+    }
+    let (mech, start) = (sys.mech, sys.start.clone());
+    let n = sys.topo.dofs.n_eq;
+    let (mut r, mut dq, mut scratch) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut f_ref = vec![0.0; 6 * mech.mesh.node_count()];
+    mech.external_forces(1.0, &mut f_ref);
+    let set_load = |sys: &mut ReducedSystem<'_, StaticTerms>, lambda: f64| {
+        mech.external_forces(lambda, &mut sys.fext);
+        sys.load_time = lambda;
+    };
+    crate::critical::locate(
+        sys,
+        (inertia, lu, &mut scratch),
+        (&start, lambda0, before),
+        (step.time, after),
+        &f_ref,
+        |sys, lu, s| {
+            let lambda = lambda0 + s * (step.time - lambda0);
+            sys.topo.impose(mech, &mut sys.end, lambda);
+            set_load(sys, lambda);
+            newton::solve(sys, lu, newton, &mut r, &mut dq).map(|_| lambda)
+        },
+        set_load,
+    )
+    .map(|(point, _)| point)
 }
 
 /// The load factor the step from `lambda` aims at, with the step control's
@@ -210,11 +310,12 @@ fn refuse_if_unsupported(
 
 impl StaticOutcome {
     /// The outcome at the last converged state of `sys`, after `steps` steps.
-    pub(crate) fn reached(sys: ReducedSystem<'_, StaticTerms>, steps: usize) -> Self {
+    pub(crate) fn reached(sys: ReducedSystem<'_, StaticTerms>, steps: usize, end: PathEnd) -> Self {
         Self {
             config: sys.end.config.clone(),
             state: sys.end,
             steps,
+            end,
         }
     }
 }

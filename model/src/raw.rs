@@ -236,6 +236,23 @@ pub(crate) struct RawSolver {
     pub modes: Option<S<i64>>,
     pub rotation: Option<S<RawRotation>>,
     pub eigensolver: Option<S<String>>,
+    pub stop: Option<S<RawStop>>,
+}
+
+/// `[solver] stop`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawStop {
+    pub load_factor: Option<S<Num>>,
+    pub displacement: Option<S<RawDisplacementStop>>,
+}
+
+/// `[solver] stop.displacement`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawDisplacementStop {
+    pub node: Option<S<String>>,
+    pub max: Option<S<Num>>,
 }
 
 /// `[solver] rotation`.

@@ -281,6 +281,29 @@ pub struct Rotation {
     pub rate: f64,
 }
 
+/// `[solver] stop = { load_factor, displacement = { node, max } }`: where
+/// an arc-length path ends before its budget.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PathStopSpec {
+    /// The path ends where the load factor first reaches this (default 1,
+    /// the model's loads).
+    pub load_factor: Option<f64>,
+    /// The path ends after the first step at which this node's
+    /// displacement reaches `max`.
+    pub displacement: Option<DisplacementStop>,
+}
+
+/// `stop.displacement = { node, max }`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DisplacementStop {
+    /// The node's label as the file gives it.
+    pub label: String,
+    /// The node.
+    pub node: NodeRef,
+    /// The displacement `|x − X|` at which the path ends.
+    pub max: f64,
+}
+
 /// `[solver]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SolverSpec {
@@ -306,6 +329,9 @@ pub struct SolverSpec {
     /// `eigensolver = "dense" | "sparse"` of a modal or buckling analysis
     /// (`None`, `"auto"`: by the unknowns).
     pub eigensolver: Option<EigenSolver>,
+    /// `stop = { … }` of an arc-length path (`None`: at load factor 1 or
+    /// the budget).
+    pub stop: Option<PathStopSpec>,
 }
 
 impl Default for SolverSpec {
@@ -323,6 +349,7 @@ impl Default for SolverSpec {
             exact_tangent: false,
             rotation: None,
             eigensolver: None,
+            stop: None,
         }
     }
 }

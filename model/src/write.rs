@@ -321,6 +321,19 @@ impl Model {
         if let Some(e) = s.eigensolver {
             put("eigensolver", Value::String(e.name().into()));
         }
+        if let Some(stop) = &s.stop {
+            let mut st = Table::new();
+            if let Some(l) = stop.load_factor {
+                st.insert("load_factor".into(), Value::Float(l));
+            }
+            if let Some(d) = &stop.displacement {
+                let mut dt = Table::new();
+                dt.insert("node".into(), Value::String(d.label.clone()));
+                dt.insert("max".into(), Value::Float(d.max));
+                st.insert("displacement".into(), Value::Table(dt));
+            }
+            put("stop", Value::Table(st));
+        }
         if let Some(r) = s.rotation {
             let mut rot = Table::new();
             rot.insert("axis".into(), vec3(r.axis));

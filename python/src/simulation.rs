@@ -242,6 +242,8 @@ impl PySimulation {
             } else {
                 Vec::new()
             },
+            end_reason: None,
+            critical: Vec::new(),
         })
     }
 

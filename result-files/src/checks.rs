@@ -4,7 +4,9 @@
 //! gives a warning (stderr, the summary line and the result file's root
 //! attribute `warnings`) when the result is doubtful.
 
+use flexmech_integrators::critical::CriticalPoint;
 use flexmech_integrators::dynamics::Integrator;
+use flexmech_integrators::modal::buckling_modes;
 use flexmech_integrators::{Mechanism, StepRecord};
 use flexmech_model::{Analysis, Model, PrescribedSpec};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -129,6 +131,9 @@ pub(crate) struct Stability {
     unstable: Option<(f64, usize)>,
     /// A step whose count is undefined (an exactly zero pivot).
     undefined: Option<f64>,
+    /// The load factor where the path became stable again after its last
+    /// unstable step (on a branch it switched to, past a limit point).
+    stable_again: Option<f64>,
 }
 
 impl Stability {
@@ -138,16 +143,22 @@ impl Stability {
             conservative,
             unstable: None,
             undefined: None,
+            stable_again: None,
         }
     }
 
     /// Takes in a converged step.
     pub(crate) fn push(&mut self, s: &StepRecord) {
         match s.negative_pivots {
-            Some(0) => {}
+            Some(0) => {
+                if self.unstable.is_some() {
+                    self.stable_again.get_or_insert(s.time);
+                }
+            }
             Some(n) => {
                 let (_, most) = self.unstable.get_or_insert((s.time, n));
                 *most = (*most).max(n);
+                self.stable_again = None;
             }
             None => {
                 self.undefined.get_or_insert(s.time);
@@ -159,6 +170,14 @@ impl Stability {
     pub(crate) fn warning(&self) -> Option<String> {
         if !self.conservative {
             return None;
+        }
+        if let (Some((lambda, most)), Some(again)) = (self.unstable, self.stable_again) {
+            return Some(format!(
+                "stability: the path passed unstable equilibria from load factor {lambda:.4} \
+                 (up to {most} negative eigenvalue(s) of the tangent, \
+                 /solver/negative_pivots) and is stable again from load factor {again:.4} on: \
+                 it crossed a limit point or left a bifurcation onto another branch"
+            ));
         }
         if let Some((lambda, most)) = self.unstable {
             return Some(format!(
@@ -231,7 +250,59 @@ impl RunChecks {
             .chain(self.stability.as_ref().and_then(Stability::warning))
             .collect()
     }
+
+    /// [`RunChecks::warnings`] of a static path of `mech` that located
+    /// `critical` points: the stability warning names them and the
+    /// nearest linear buckling load factor.
+    pub fn warnings_with(&self, mech: &Mechanism, critical: &[CriticalPoint]) -> Vec<String> {
+        let mut warnings = self.warnings();
+        let unstable = self.stability.as_ref().and_then(|s| s.unstable);
+        if let (Some(w), Some((lambda, _))) = (warnings.last_mut(), unstable) {
+            if w.starts_with("stability:") {
+                w.push_str(&nearest_critical(mech, critical, lambda));
+            }
+        }
+        warnings
+    }
 }
+
+/// The stability warning's last words: the critical points located on the
+/// path and the linear buckling load factor (`analysis = "buckling"`,
+/// about the undeformed state) nearest the first of them (or the first
+/// unstable load factor `lambda`).
+fn nearest_critical(mech: &Mechanism, critical: &[CriticalPoint], lambda: f64) -> String {
+    let mut text = String::new();
+    if !critical.is_empty() {
+        let list: Vec<String> = critical
+            .iter()
+            .map(|p| format!("{} at {:.6}", p.kind.name(), p.load_factor))
+            .collect();
+        text.push_str(&format!(
+            "; critical points located (/stability): {}",
+            list.join(", ")
+        ));
+    }
+    let at = critical.first().map_or(lambda, |p| p.load_factor);
+    match buckling_modes(mech, NEAREST_BUCKLING_MODES, None) {
+        Ok(set) => {
+            let nearest = set
+                .values()
+                .into_iter()
+                .min_by(|a, b| (a - at).abs().total_cmp(&(b - at).abs()));
+            if let Some(b) = nearest {
+                text.push_str(&format!(
+                    "; the nearest linear buckling load factor (analysis = \"buckling\", about \
+                     the undeformed state) is {b:.6}"
+                ));
+            }
+        }
+        Err(e) => text.push_str(&format!("; no linear buckling estimate: {e}")),
+    }
+    text
+}
+
+/// Buckling load factors computed to name the nearest one.
+const NEAREST_BUCKLING_MODES: usize = 3;
 
 /// Whether the stability count of a static `model` is a stability
 /// statement (see [`Stability`]): no applied nodal moment, no prescribed

@@ -219,6 +219,13 @@ pub const SENSITIVITY: &str = "/sensitivity";
 pub const MODES: &str = "/modes";
 /// Buckling modes of `analysis = "buckling"`.
 pub const BUCKLING: &str = "/buckling";
+/// Critical points located on a static path.
+pub const STABILITY: &str = "/stability";
+/// `/stability/critical_load_factor`: the located points' load factors.
+pub const STABILITY_CRITICAL_LOAD_FACTOR: &str = "/stability/critical_load_factor";
+/// Root attribute of a completed static path: why it ended (the load
+/// factor reached, the arc-length budget, a `stop` of the model).
+pub const ATTR_END_REASON: &str = "end_reason";
 
 /// Path of the group of sensitivity key `key`: `/sensitivity/<key>`.
 pub fn sensitivity_group(key: &str) -> String {

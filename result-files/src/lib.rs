@@ -90,6 +90,7 @@
 
 pub mod checks;
 pub mod contents;
+mod critical;
 pub mod export;
 pub mod layout;
 pub mod merit;

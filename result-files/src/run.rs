@@ -8,13 +8,15 @@ use crate::sink::{FileSink, OutputDirError, RunEnd, Sink, SinkError};
 use crate::{
     layout, read_checkpoint, Merit, MeshMeta, RestartError, ResultError, ResultantsMeta, RunMeta,
 };
-use flexmech_integrators::arc_length::{solve_arc_length_with, ArcLengthSettings};
+use flexmech_integrators::arc_length::{solve_arc_length_with, ArcLengthSettings, PathStop};
 use flexmech_integrators::constraints::initial_state;
+use flexmech_integrators::critical::CriticalPoint;
 use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
 use flexmech_integrators::measure::static_record;
 use flexmech_integrators::modal::{
     buckling_modes, solve_modal, ModalSettings, ModeRequest, ModeSet,
 };
+use flexmech_integrators::PathEnd;
 use flexmech_integrators::{
     solve_static_with, Mechanism, NewtonSettings, SolveError, StaticSettings, StepRecord,
 };
@@ -130,6 +132,10 @@ pub struct RunSummary {
     /// What the run's checks found doubtful in the completed result (also in
     /// the file's root attribute `warnings`).
     pub warnings: Vec<String>,
+    /// Why a static path ended (root attribute `end_reason`).
+    pub end_reason: Option<String>,
+    /// The critical points located on a static path (`/stability`).
+    pub critical: Vec<CriticalPoint>,
 }
 
 impl std::fmt::Display for RunSummary {
@@ -143,6 +149,19 @@ impl std::fmt::Display for RunSummary {
             self.wall_time_s,
             self.file.display()
         )?;
+        if let Some(reason) = &self.end_reason {
+            write!(f, "\nended: {reason}")?;
+        }
+        for p in &self.critical {
+            write!(
+                f,
+                "\ncritical point: {} at load factor {:.6} (negative eigenvalues {} -> {})",
+                p.kind.name(),
+                p.load_factor,
+                p.negative_before,
+                p.negative_after
+            )?;
+        }
         for w in &self.warnings {
             write!(f, "\nwarning: {w}")?;
         }
@@ -186,6 +205,8 @@ struct Keeper<'a> {
     written: usize,
     pending: Option<StepRecord>,
     error: Option<SinkError>,
+    /// The critical points the static steps located.
+    critical: Vec<CriticalPoint>,
 }
 
 impl Keeper<'_> {
@@ -193,6 +214,7 @@ impl Keeper<'_> {
     fn push(&mut self, step: &StepRecord) -> bool {
         self.checks.push(self.mech, step);
         self.merit.push(step);
+        self.critical.extend(step.critical);
         self.count += 1;
         self.iterations += step.iterations;
         if self.error.is_some() {
@@ -253,7 +275,7 @@ impl Keeper<'_> {
 
     /// The warnings of a completed run's checks.
     fn warnings(&self) -> Vec<String> {
-        self.checks.warnings()
+        self.checks.warnings_with(self.mech, &self.critical)
     }
 }
 
@@ -478,6 +500,7 @@ fn run_with(
         written: 0,
         pending: None,
         error: None,
+        critical: Vec::new(),
     };
     let start = Instant::now();
     let (outcome, setup) = solve(model, &built, restart, &mut keeper, start);
@@ -494,7 +517,7 @@ fn solve(
     restart: Option<&Checkpoint>,
     keeper: &mut Keeper<'_>,
     start: Instant,
-) -> (Result<(), SolveError>, f64) {
+) -> (Result<Option<String>, SolveError>, f64) {
     let mech = &built.mechanism;
     let newton = static_newton(model);
     let max_halvings = model.solver.max_halvings;
@@ -509,7 +532,7 @@ fn solve(
             let outcome = solve_static_with(mech, &settings, &params, |s| {
                 keeper.push(s);
             });
-            (outcome.map(|_| ()), 0.0)
+            (outcome.map(|o| end_reason(model, o.end)), 0.0)
         }
         Analysis::ArcLength {
             load_steps,
@@ -522,12 +545,13 @@ fn solve(
                 max_halvings,
                 max_steps,
                 branch_switch,
+                stop: path_stop(model, built),
             };
             let params = built.sensitivity_parameters(model);
             let outcome = solve_arc_length_with(mech, &settings, &params, |s| {
                 keeper.push(s);
             });
-            (outcome.map(|_| ()), 0.0)
+            (outcome.map(|o| end_reason(model, o.end)), 0.0)
         }
         Analysis::Modal { modes, load_steps } => {
             let settings = ModalSettings {
@@ -545,14 +569,14 @@ fn solve(
             let outcome = solve_modal(mech, &settings, |s| {
                 keeper.push(s);
             });
-            (outcome.map(|set| keeper.modes(&set)), 0.0)
+            (outcome.map(|set| keeper.modes(&set)).map(|()| None), 0.0)
         }
         Analysis::Buckling { modes } => {
             let state = initial_state(mech);
             let fext = vec![0.0; 6 * mech.mesh.node_count()];
             keeper.push(&static_record(mech, &state, &fext, 0.0, 0.0, None));
             let outcome = buckling_modes(mech, modes, model.solver.eigensolver);
-            (outcome.map(|set| keeper.modes(&set)), 0.0)
+            (outcome.map(|set| keeper.modes(&set)).map(|()| None), 0.0)
         }
         Analysis::Dynamic {
             integrator,
@@ -560,9 +584,43 @@ fn solve(
             t_end,
         } => {
             let settings = model.solver.stepping(dt, t_end);
-            solve_dynamic(model, built, restart, keeper, start, (integrator, settings))
+            let (outcome, setup) =
+                solve_dynamic(model, built, restart, keeper, start, (integrator, settings));
+            (outcome.map(|()| None), setup)
         }
     }
+}
+
+/// The arc-length path's stop of `model` (`[solver] stop`; λ = 1 without).
+fn path_stop(model: &Model, built: &Built) -> PathStop {
+    let stop = model.solver.stop.clone().unwrap_or_default();
+    PathStop {
+        load_factor: stop.load_factor.unwrap_or(1.0),
+        displacement: stop.displacement.map(|d| (built.node(d.node), d.max)),
+    }
+}
+
+/// The words of a static path's end, for the result's `end_reason`.
+fn end_reason(model: &Model, end: PathEnd) -> Option<String> {
+    Some(match end {
+        PathEnd::Reached { load_factor } => format!("reached load factor {load_factor}"),
+        PathEnd::Budget { steps, load_factor } => format!(
+            "the step budget: {steps} steps (solver.max_arc_steps) taken at load factor \
+             {load_factor:.6}"
+        ),
+        PathEnd::Displacement {
+            displacement,
+            load_factor,
+            ..
+        } => {
+            let d = model.solver.stop.as_ref()?.displacement.as_ref()?;
+            format!(
+                "node {} displaced {displacement:.6} >= {} (solver.stop.displacement) at \
+                 load factor {load_factor:.6}",
+                d.label, d.max
+            )
+        }
+    })
 }
 
 /// The time steps of a dynamic run, each kept one followed by its restart
@@ -619,7 +677,7 @@ fn solve_dynamic(
 fn end(
     model: &Model,
     keeper: Keeper<'_>,
-    outcome: Result<(), SolveError>,
+    outcome: Result<Option<String>, SolveError>,
     wall: f64,
     setup: f64,
 ) -> Result<RunSummary, RunError> {
@@ -631,6 +689,7 @@ fn end(
         count,
         iterations,
         written,
+        critical,
         ..
     } = keeper;
     if let Some(e) = error {
@@ -641,9 +700,11 @@ fn end(
     }
     let file = sink.file().map(Path::to_path_buf).unwrap_or_default();
     match outcome {
-        Ok(()) => {
+        Ok(end_reason) => {
             let mut end = RunEnd::new(layout::STATUS_COMPLETED.into(), wall, &merit);
             end.warnings = warnings;
+            end.end_reason = end_reason;
+            end.critical = critical;
             sink.finish(&end).map_err(RunError::from_sink)?;
             Ok(RunSummary {
                 file,
@@ -654,12 +715,15 @@ fn end(
                 wall_time_s: wall,
                 setup_time_s: setup,
                 warnings: end.warnings,
+                end_reason: end.end_reason,
+                critical: end.critical,
             })
         }
         Err(error) => {
             let status = layout::failed_status(&error.to_string());
-            sink.finish(&RunEnd::new(status, wall, &merit))
-                .map_err(RunError::from_sink)?;
+            let mut end = RunEnd::new(status, wall, &merit);
+            end.critical = critical;
+            sink.finish(&end).map_err(RunError::from_sink)?;
             Err(RunError::Solve {
                 model: model.name.clone(),
                 path: model.path.clone(),

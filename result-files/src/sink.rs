@@ -42,6 +42,10 @@ pub struct RunEnd {
     pub merit: Merit,
     /// What the run's checks found doubtful in a completed run.
     pub warnings: Vec<String>,
+    /// Why a completed static path ended (root attribute `end_reason`).
+    pub end_reason: Option<String>,
+    /// The critical points located on a static path (`/stability`).
+    pub critical: Vec<flexmech_integrators::critical::CriticalPoint>,
 }
 
 impl RunEnd {
@@ -51,6 +55,8 @@ impl RunEnd {
             wall_time_s,
             merit: merit.clone(),
             warnings: Vec::new(),
+            end_reason: None,
+            critical: Vec::new(),
         }
     }
 }
@@ -249,6 +255,7 @@ impl Sink for FileSink {
         if !end.warnings.is_empty() {
             writer.warn(&end.warnings.join("; "))?;
         }
+        writer.path_end(end.end_reason.as_deref(), &end.critical)?;
         writer.finish(&end.status, end.wall_time_s)?;
         Ok(())
     }

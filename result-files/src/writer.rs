@@ -1411,6 +1411,23 @@ impl ResultWriter {
             .ctx(&self.path, || "writing the modes".to_owned())
     }
 
+    /// Writes how a static path ended: the root attribute `end_reason`
+    /// (when given) and `/stability` with the located critical points.
+    pub fn path_end(
+        &mut self,
+        reason: Option<&str>,
+        critical: &[flexmech_integrators::critical::CriticalPoint],
+    ) -> Result<(), ResultError> {
+        self.flush()?;
+        if let Some(reason) = reason {
+            set_str_attr(&self.file, names::ATTR_END_REASON, reason).ctx(&self.path, || {
+                format!("writing root attribute {}", names::ATTR_END_REASON)
+            })?;
+        }
+        super::critical::write(&self.file, critical)
+            .ctx(&self.path, || "writing /stability".to_owned())
+    }
+
     /// Sets the root attribute `warnings`: what the run's checks found
     /// doubtful in a result that completed (e.g. an energy balance off by more
     /// than its threshold). Absent when there is nothing to say.

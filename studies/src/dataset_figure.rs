@@ -18,7 +18,9 @@
 //! `mode = k` (instead of `reduce`) takes the `k`-th value, counted from 1,
 //! of a dataset with one value per mode — `/modes/frequency`,
 //! `/modes/damping_ratio`, `/buckling/load_factor` of modal and buckling
-//! runs: over `solver.rotation.rate`, a Campbell diagram.
+//! runs: over `solver.rotation.rate`, a Campbell diagram — or the `k`-th
+//! critical point of a static path, `/stability/critical_load_factor` (NaN
+//! for a run that located fewer).
 //!
 //! `derivative = ["section.rod.EI[0]", ...]` adds, per key path, the
 //! figure's exact derivative by that model value as the summary column
@@ -308,6 +310,10 @@ impl DatasetFigure {
     /// Its value for the run in `result`.
     pub fn value(&self, result: &ResultReader) -> Result<f64, ReadError> {
         if let Some(k) = self.mode {
+            if self.dataset.starts_with(STABILITY_PREFIX) && located_fewer(result, &self.dataset, k)
+            {
+                return Ok(f64::NAN);
+            }
             let shape = result.shape(&self.dataset)?;
             return match shape.as_slice() {
                 [n] if k <= *n => Ok(result.values(&self.dataset)?[k - 1]),
@@ -350,6 +356,20 @@ impl DatasetFigure {
             }),
         }
     }
+}
+
+/// The group of a static path's located critical points: written only
+/// when the path crossed one, one entry per point.
+const STABILITY_PREFIX: &str = "/stability/";
+
+/// Whether the run in `result` located fewer than `k` critical points
+/// (no `/stability` at all when it crossed none): the `k`-th point's figure
+/// is NaN then, as a run's is where its path stops short of it.
+fn located_fewer(result: &ResultReader, dataset: &str, k: usize) -> bool {
+    if !result.has(dataset) {
+        return true;
+    }
+    matches!(result.shape(dataset).as_deref(), Ok([n]) if k > *n)
 }
 
 /// `mode = k` of a figure (from 1), if given.

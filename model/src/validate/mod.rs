@@ -385,7 +385,7 @@ pub(crate) fn validate(
     let initial_velocities = cx.initial_velocities(&raw.initial_velocity, &beams)?;
     let rigid_bodies = cx.rigid_bodies(&raw.rigid_body, &beams)?;
     let rust_loads = cx.rust_loads(&raw.rust_load, &beams)?;
-    let solver = cx.solver(raw.solver.as_ref())?;
+    let solver = cx.solver(raw.solver.as_ref(), &beams)?;
     cx.massive(&raw.section, &sections, &beams, &solver)?;
     let output = cx.output(raw.output.as_ref(), &beams)?;
     let mut model = Model {

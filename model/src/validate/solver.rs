@@ -14,7 +14,7 @@ const DEFAULT_ARC_STEPS_PER_LOAD_STEP: usize = 100;
 const DEFAULT_MODES: usize = 10;
 
 impl Ctx<'_> {
-    pub(super) fn solver(&self, raw: Option<&S<RawSolver>>) -> Res<SolverSpec> {
+    pub(super) fn solver(&self, raw: Option<&S<RawSolver>>, beams: &[BeamSpec]) -> Res<SolverSpec> {
         let Some(entry) = raw else {
             return Ok(SolverSpec::default());
         };
@@ -55,7 +55,9 @@ impl Ctx<'_> {
         let (modified_newton, exact_tangent) = self.newton_kind(s, &analysis)?;
         let rotation = self.rotation(s, &analysis)?;
         let eigensolver = self.eigensolver(s, &analysis)?;
+        let stop = self.stop(s, &analysis, beams)?;
         Ok(SolverSpec {
+            stop,
             rotation,
             eigensolver,
             analysis,
@@ -406,6 +408,67 @@ impl Ctx<'_> {
             axis,
             origin,
             rate: rate.get_ref().0,
+        }))
+    }
+
+    /// `solver.stop` of an arc-length path: `load_factor` (positive) and
+    /// `displacement = { node, max }` (a node of the mesh, `max` positive).
+    fn stop(
+        &self,
+        s: &RawSolver,
+        analysis: &Analysis,
+        beams: &[BeamSpec],
+    ) -> Res<Option<PathStopSpec>> {
+        let Some(st) = &s.stop else {
+            return Ok(None);
+        };
+        if !matches!(analysis, Analysis::ArcLength { .. }) {
+            return Err(self.at(
+                "solver.stop",
+                st,
+                format!(
+                    "`stop` ends an arc-length path (control = \"arc-length\"), but this \
+                     analysis is {}{}; set control = \"arc-length\", or remove `stop`",
+                    analysis.name(),
+                    if matches!(analysis, Analysis::Static { .. }) {
+                        " with load control (it ends at load factor 1)"
+                    } else {
+                        ""
+                    }
+                ),
+            ));
+        }
+        let raw = st.get_ref();
+        let load_factor = match &raw.load_factor {
+            Some(l) => Some(self.positive(l, "solver.stop.load_factor")?),
+            None => None,
+        };
+        let displacement = match &raw.displacement {
+            None => None,
+            Some(d) => {
+                let span = d.span();
+                let node = self.need(
+                    &d.get_ref().node,
+                    "solver.stop.displacement.node",
+                    &span,
+                    "the node whose displacement ends the path, e.g. node = \"beam.end\"",
+                )?;
+                let max = self.need(
+                    &d.get_ref().max,
+                    "solver.stop.displacement.max",
+                    &span,
+                    "the displacement |x − X| at which the path ends, e.g. max = 0.5",
+                )?;
+                Some(DisplacementStop {
+                    label: node.get_ref().clone(),
+                    node: self.node(node, "solver.stop.displacement.node", beams)?,
+                    max: self.positive(max, "solver.stop.displacement.max")?,
+                })
+            }
+        };
+        Ok(Some(PathStopSpec {
+            load_factor,
+            displacement,
         }))
     }
 
