@@ -418,6 +418,9 @@ fn print_run(path: &Path, s: &flexmech_results::RunSummary) {
     if let Some(reason) = &s.end_reason {
         println!("  ended: {reason}");
     }
+    if let Some((kind, values)) = &s.modes {
+        println!("  {}", flexmech_results::run::mode_line(*kind, values));
+    }
     for p in &s.critical {
         println!(
             "  critical point: {} at load factor {:.6} (negative eigenvalues {} -> {}; /stability)",

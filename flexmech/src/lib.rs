@@ -147,6 +147,8 @@ pub mod book {
     pub mod getting_started {}
     #[doc = include_str!("../../docs/book/joints.md")]
     pub mod joints {}
+    #[doc = include_str!("../../docs/book/linearised.md")]
+    pub mod linearised {}
     #[doc = include_str!("../../docs/book/layout.md")]
     pub mod layout {}
     #[doc = include_str!("../../docs/book/model-files.md")]

@@ -3,7 +3,9 @@
 pub use crate::{data, App};
 
 pub use flexmech_core::{cst, Scalar};
+pub use flexmech_integrators::critical::{CriticalKind, CriticalPoint};
 pub use flexmech_integrators::dynamics::{Integrator, Simulation};
+pub use flexmech_integrators::modal::{ModeKind, ModeSet};
 pub use flexmech_joints::model_joint::{direction, perpendicular_slide, positive};
 pub use flexmech_joints::{DependentJoint, ModelJoint, ParamError};
 pub use flexmech_model::{

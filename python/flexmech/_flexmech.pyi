@@ -171,6 +171,10 @@ class Model:
         """Statics in ``load_steps`` load steps (``control="arc-length"``...)."""
     def dynamic(self, integrator: str, dt: float, t_end: float, **keys: _Value) -> Model:
         """Time integration with ``integrator`` in steps of ``dt`` to ``t_end``."""
+    def modal(self, modes: int, **keys: _Value) -> Model:
+        """The ``modes`` lowest vibration modes (``analysis = "modal"``), under ``/modes``."""
+    def buckling(self, modes: int, **keys: _Value) -> Model:
+        """The ``modes`` lowest linear buckling load factors (``analysis = "buckling"``)."""
     def solver(self, key: Optional[str] = None, value: Optional[_Value] = None, **keys: _Value) -> Model:
         """``[solver]`` keys: ``solver("tolerance", 1e-8)`` or ``solver(tolerance=1e-8)``."""
     def output(self, key: Optional[str] = None, value: Optional[_Value] = None, **keys: _Value) -> Model:

@@ -171,6 +171,46 @@ class Result(Mapping[str, np.ndarray]):
         labels = self._data.get("/mesh/node_labels")
         return [] if labels is None else list(labels)
 
+    # -- linearised analyses and critical points ---------------------------
+    @property
+    def frequencies(self) -> np.ndarray:
+        """``/modes/frequency`` of a modal run: the natural frequencies in
+        cycles per unit of model time, ascending (rigid modes 0)."""
+        return self["/modes/frequency"]
+
+    @property
+    def load_factors(self) -> np.ndarray:
+        """``/buckling/load_factor`` of a buckling run, ascending."""
+        return self["/buckling/load_factor"]
+
+    def mode(self, k: int) -> Tuple[np.ndarray, np.ndarray]:
+        """Mode ``k`` (from 1, the lowest) of a modal or buckling run: its
+        nodal displacements and rotation vectors, each (nodes × 3) in
+        ``/configuration`` order (modal: unit mass norm)."""
+        group = "/modes" if "/modes/displacement" in self._data else "/buckling"
+        u = self[f"{group}/displacement"]
+        if not 1 <= k <= u.shape[0]:
+            raise IndexError(f"mode {k}: this result has modes 1..{u.shape[0]} under {group}")
+        return u[k - 1], self[f"{group}/rotation"][k - 1]
+
+    @property
+    def critical_points(self) -> List[Tuple[str, float]]:
+        """The limit and bifurcation points a static path located
+        (``/stability``): ``[("bifurcation", 0.725), ...]`` in path order,
+        empty when it crossed none."""
+        if "/stability/critical_load_factor" not in self._data:
+            return []
+        kinds = self._data["/stability/critical_kind"]
+        factors = self._data["/stability/critical_load_factor"]
+        return [(str(k), float(f)) for k, f in zip(kinds, factors)]
+
+    @property
+    def end_reason(self) -> Optional[str]:
+        """Why a static path ended (root attribute ``end_reason``): its load
+        factor reached, a ``stop`` or the step budget; None for other runs."""
+        reason = self.attrs.get("end_reason")
+        return None if reason is None else str(reason)
+
     def __repr__(self) -> str:
         name = ""
         for line in self.model.splitlines():

@@ -775,6 +775,31 @@ impl PyModel {
         Ok(slf)
     }
 
+    /// The `modes` lowest vibration modes (`analysis = "modal"`): about the
+    /// initial state, or about the static equilibrium of the model's loads
+    /// and drivers; other `[solver]` keys by name (`mass="lumped"`,
+    /// `rotation={"axis": [0, 0, 1], "rate": 30.0}`). Results under `/modes`.
+    #[pyo3(signature = (modes, **keys))]
+    fn modal<'py>(
+        slf: Bound<'py, Self>,
+        modes: &Bound<'py, PyAny>,
+        keys: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, Self>> {
+        linearised(slf, "modal", modes, keys)
+    }
+
+    /// The `modes` lowest linear buckling load factors of the model's loads
+    /// (`analysis = "buckling"`), with their modes under `/buckling`; other
+    /// `[solver]` keys by name (`eigensolver="sparse"`).
+    #[pyo3(signature = (modes, **keys))]
+    fn buckling<'py>(
+        slf: Bound<'py, Self>,
+        modes: &Bound<'py, PyAny>,
+        keys: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, Self>> {
+        linearised(slf, "buckling", modes, keys)
+    }
+
     /// `[solver]` keys: `solver("tolerance", 1e-8)` or `solver(tolerance=1e-8)`.
     #[pyo3(signature = (key = None, value = None, **keys))]
     fn solver<'py>(
@@ -829,6 +854,22 @@ impl PyModel {
             }
         }
     }
+}
+
+/// `[solver]` of a linearised `analysis` ("modal" or "buckling") with
+/// `modes` and other keys.
+fn linearised<'py>(
+    slf: Bound<'py, PyModel>,
+    analysis: &str,
+    modes: &Bound<'py, PyAny>,
+    keys: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyModel>> {
+    let entry = Entry::new(slf.py(), "solver".into())
+        .text("analysis", analysis)
+        .value("modes", Some(modes))?
+        .extra(keys)?;
+    slf.borrow_mut().set_in("solver", entry.table);
+    Ok(slf)
 }
 
 /// `[name]` keys from `key`/`value` and keywords.

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use flexmech::integrators::dynamics::Checkpoint;
+use flexmech::integrators::modal::ModeSet;
 use flexmech::integrators::StepRecord;
 use flexmech::model::Model;
 use flexmech::results::{FileSink, RunEnd, RunError as RustRunError, RunMeta, Sink, SinkError};
@@ -83,6 +84,10 @@ impl<S: Sink> Sink for Watched<S> {
 
     fn checkpoint(&mut self, state: &Checkpoint) -> Result<(), SinkError> {
         self.inner.checkpoint(state)
+    }
+
+    fn modes(&mut self, set: &ModeSet, joints: &[String]) -> Result<(), SinkError> {
+        self.inner.modes(set, joints)
     }
 
     fn finish(&mut self, end: &RunEnd) -> Result<(), SinkError> {

@@ -14,7 +14,7 @@ use flexmech_integrators::critical::CriticalPoint;
 use flexmech_integrators::dynamics::{Checkpoint, DynamicSettings, Simulation};
 use flexmech_integrators::measure::static_record;
 use flexmech_integrators::modal::{
-    buckling_modes, solve_modal, ModalSettings, ModeRequest, ModeSet,
+    buckling_modes, solve_modal, ModalSettings, ModeKind, ModeRequest, ModeSet,
 };
 use flexmech_integrators::PathEnd;
 use flexmech_integrators::{
@@ -136,6 +136,9 @@ pub struct RunSummary {
     pub end_reason: Option<String>,
     /// The critical points located on a static path (`/stability`).
     pub critical: Vec<CriticalPoint>,
+    /// A modal or buckling run's values as written: the frequencies
+    /// (`/modes/frequency`) or the load factors (`/buckling/load_factor`).
+    pub modes: Option<(ModeKind, Vec<f64>)>,
 }
 
 impl std::fmt::Display for RunSummary {
@@ -151,6 +154,9 @@ impl std::fmt::Display for RunSummary {
         )?;
         if let Some(reason) = &self.end_reason {
             write!(f, "\nended: {reason}")?;
+        }
+        if let Some((kind, values)) = &self.modes {
+            write!(f, "\n{}", mode_line(*kind, values))?;
         }
         for p in &self.critical {
             write!(
@@ -207,6 +213,8 @@ struct Keeper<'a> {
     error: Option<SinkError>,
     /// The critical points the static steps located.
     critical: Vec<CriticalPoint>,
+    /// The values of the modes written, with their kind.
+    modes: Option<(ModeKind, Vec<f64>)>,
 }
 
 impl Keeper<'_> {
@@ -264,6 +272,7 @@ impl Keeper<'_> {
     /// Hands the modes of a modal or buckling analysis to the sink, after
     /// the last step.
     fn modes(&mut self, set: &ModeSet) {
+        self.modes = Some((set.kind, set.values()));
         self.flush_last();
         if self.error.is_none() {
             let joints: Vec<String> = self.mech.joints.iter().map(|j| j.name.clone()).collect();
@@ -501,6 +510,7 @@ fn run_with(
         pending: None,
         error: None,
         critical: Vec::new(),
+        modes: None,
     };
     let start = Instant::now();
     let (outcome, setup) = solve(model, &built, restart, &mut keeper, start);
@@ -600,6 +610,24 @@ fn path_stop(model: &Model, built: &Built) -> PathStop {
     }
 }
 
+/// The summary's line of a modal (`Vibration`) or buckling run's `values`:
+/// the lowest few, with the dataset that holds them all.
+pub fn mode_line(kind: ModeKind, values: &[f64]) -> String {
+    const SHOWN: usize = 4;
+    let shown: Vec<String> = values.iter().take(SHOWN).map(|v| format!("{v:.6}")).collect();
+    let more = if values.len() > SHOWN { ", …" } else { "" };
+    match kind {
+        ModeKind::Vibration => format!(
+            "lowest frequencies: {}{more} (/modes/frequency)",
+            shown.join(", ")
+        ),
+        ModeKind::Buckling => format!(
+            "lowest buckling load factors: {}{more} (/buckling/load_factor)",
+            shown.join(", ")
+        ),
+    }
+}
+
 /// The words of a static path's end, for the result's `end_reason`.
 fn end_reason(model: &Model, end: PathEnd) -> Option<String> {
     Some(match end {
@@ -690,6 +718,7 @@ fn end(
         iterations,
         written,
         critical,
+        modes,
         ..
     } = keeper;
     if let Some(e) = error {
@@ -717,6 +746,7 @@ fn end(
                 warnings: end.warnings,
                 end_reason: end.end_reason,
                 critical: end.critical,
+                modes,
             })
         }
         Err(error) => {
