@@ -2,7 +2,7 @@
 //! Straight beams and circular arcs are meshed into equal elements; node
 //! numbering is global and contiguous per beam.
 
-use crate::element::BeamElement;
+use crate::element::{BeamElement, Strains};
 use crate::rotation::{exp, log};
 use crate::section::Section;
 use crate::Scalar;
@@ -206,10 +206,20 @@ impl Element {
         r: &mut [f64],
         k: &mut [f64],
     ) -> f64 {
-        match self {
-            Element::Linear(e) => damping_of(e, start, end, c, r, k),
-            Element::Quadratic(e) => damping_of(e, start, end, c, r, k),
-        }
+        // ψ is c times the strain energy of the element whose stress-free
+        // strains are the step start's (its strains are then the change
+        // Δε): the damping force and tangent are c times that element's
+        // internal force and tangent, in closed form (the hyper-dual
+        // Hessian of ψ is their oracle in the tests).
+        let (psi, strains0) = match self {
+            Element::Linear(e) => damping_value(e, start, end, c),
+            Element::Quadratic(e) => damping_value(e, start, end, c),
+        };
+        let lowered: Vec<Strains<f64>> = strains0.iter().map(|s| (-s.0, -s.1)).collect();
+        self.prestrained(&lowered)
+            .residual_tangent(end.0, end.1, r, k);
+        r.iter_mut().chain(k.iter_mut()).for_each(|v| *v *= c);
+        2.0 * psi
     }
 
     /// The energy Kelvin–Voigt damping dissipates over a step from `start`
@@ -270,37 +280,47 @@ impl Element {
     }
 }
 
-/// [`Element::damping_residual_tangent`] for an element of `N` nodes
-/// (`6N` = 12 or 18 hyper-dual lanes).
-fn damping_of<const N: usize>(
+/// The damping pseudo-potential `ψ` of an `N`-node element over the step
+/// `start → end` (see [`BeamElement::damping_potential`]) and the step
+/// start's strains.
+fn damping_value<const N: usize>(
+    e: &BeamElement<N>,
+    start: (&[Vector3<f64>], &[Matrix3<f64>]),
+    end: (&[Vector3<f64>], &[Matrix3<f64>]),
+    c: f64,
+) -> (f64, [Strains<f64>; 2]) {
+    let (xs, rs) = gather(&e.nodes, start.0, start.1);
+    let strains0 = e.strains(&xs, &rs);
+    let (xe, re) = gather(&e.nodes, end.0, end.1);
+    (e.damping_potential(&xe, &re, &strains0, c), strains0)
+}
+
+/// [`Element::damping_residual_tangent`]'s force and tangent by the
+/// hyper-dual gradient and Hessian of the damping
+/// pseudo-potential `ψ` (the oracle of the closed form).
+#[cfg(test)]
+fn damping_of_ad<const N: usize>(
     e: &BeamElement<N>,
     start: (&[Vector3<f64>], &[Matrix3<f64>]),
     end: (&[Vector3<f64>], &[Matrix3<f64>]),
     c: f64,
     r: &mut [f64],
     k: &mut [f64],
-) -> f64 {
+) {
     let (xs, rs) = gather(&e.nodes, start.0, start.1);
     let strains0 = e.strains(&xs, &rs);
     let (xe, re) = gather(&e.nodes, end.0, end.1);
-    let psi: f64 = e.damping_potential(&xe, &re, &strains0, c);
-    match N {
-        2 => {
-            let (g, h) = e.gradient_hessian_ad::<12>(&xe, &re, |x, q| {
-                e.damping_potential(x, q, &strains0, c)
-            });
-            r.copy_from_slice(g.as_slice());
-            k.copy_from_slice(h.as_slice());
-        }
-        _ => {
-            let (g, h) = e.gradient_hessian_ad::<18>(&xe, &re, |x, q| {
-                e.damping_potential(x, q, &strains0, c)
-            });
-            r.copy_from_slice(g.as_slice());
-            k.copy_from_slice(h.as_slice());
-        }
+    if N == 2 {
+        let (g, h) =
+            e.gradient_hessian_ad::<12>(&xe, &re, |x, q| e.damping_potential(x, q, &strains0, c));
+        r.copy_from_slice(g.as_slice());
+        k.copy_from_slice(h.as_slice());
+    } else {
+        let (g, h) =
+            e.gradient_hessian_ad::<18>(&xe, &re, |x, q| e.damping_potential(x, q, &strains0, c));
+        r.copy_from_slice(g.as_slice());
+        k.copy_from_slice(h.as_slice());
     }
-    2.0 * psi
 }
 
 /// [`Element::damping_dissipation`] for an element of `N` nodes.
@@ -513,6 +533,73 @@ mod tests {
             assert!((e.length - 100.0 * sweep / 8.0).abs() < 1e-12);
         } else {
             panic!("expected quadratic elements");
+        }
+    }
+
+    #[test]
+    fn closed_form_damping_equals_the_hyper_dual_hessian() {
+        // A bent, twisted state and a step from a nearby one, for 2- and
+        // 3-node elements: force and tangent against the AD oracle.
+        for nodes_per_element in [2, 3] {
+            let mut m = Mesh::default();
+            let section = Section::new([3.0, 2.0, 1.5], [0.7, 1.1, 0.9], 0.0, [0.0; 3]);
+            m.add_straight_beam(
+                Vector3::zeros(),
+                Vector3::new(1.0, 0.2, 0.1),
+                Vector3::z(),
+                1,
+                nodes_per_element,
+                section,
+            )
+            .unwrap();
+            let n = m.node_count();
+            let moved = |scale: f64| -> (Vec<Vector3<f64>>, Vec<Matrix3<f64>>) {
+                let x = (0..n)
+                    .map(|i| {
+                        m.positions[i]
+                            + scale * Vector3::new(0.01 * i as f64, 0.03 * (i * i) as f64, -0.02)
+                    })
+                    .collect();
+                let rot = (0..n)
+                    .map(|i| {
+                        let v = scale * Vector3::new(0.1 * i as f64, -0.05, 0.07 * i as f64);
+                        *nalgebra::Rotation3::new(v).matrix()
+                    })
+                    .collect();
+                (x, rot)
+            };
+            let (xs, rs) = moved(0.8);
+            let (xe, re) = moved(1.0);
+            let d = 6 * n;
+            let (mut r, mut k) = (vec![0.0; d], vec![0.0; d * d]);
+            let (mut r_ad, mut k_ad) = (vec![0.0; d], vec![0.0; d * d]);
+            let c = 2.5;
+            m.elements[0].damping_residual_tangent((&xs, &rs), (&xe, &re), c, &mut r, &mut k);
+            match &m.elements[0] {
+                Element::Linear(e) => {
+                    damping_of_ad(e, (&xs, &rs), (&xe, &re), c, &mut r_ad, &mut k_ad)
+                }
+                Element::Quadratic(e) => {
+                    damping_of_ad(e, (&xs, &rs), (&xe, &re), c, &mut r_ad, &mut k_ad)
+                }
+            }
+            let scale = |v: &[f64]| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            let diff = |a: &[f64], b: &[f64]| {
+                a.iter()
+                    .zip(b)
+                    .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+            };
+            assert!(scale(&r) > 1e-3 && scale(&k) > 1e-3);
+            assert!(
+                diff(&r, &r_ad) <= 1e-12 * scale(&r_ad),
+                "force {nodes_per_element}: {}",
+                diff(&r, &r_ad)
+            );
+            assert!(
+                diff(&k, &k_ad) <= 1e-12 * scale(&k_ad),
+                "tangent {nodes_per_element}: {}",
+                diff(&k, &k_ad)
+            );
         }
     }
 

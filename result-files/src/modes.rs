@@ -54,6 +54,13 @@ pub(crate) fn write(file: &File, set: &ModeSet, joints: &[String]) -> hdf5::Resu
                 .write_raw(values)?;
         }
     }
+    if let (Some(d), None) = (&set.damping, &set.complex) {
+        g.new_dataset::<f64>()
+            .shape([count])
+            .create("damping_ratio")?
+            .write_raw(&d.ratio)?;
+        scalar(&g, "damping_coupling", d.coupling)?;
+    }
     for (name, per_mode) in shapes {
         let flat: Vec<f64> = per_mode
             .iter()

@@ -310,6 +310,17 @@ impl ResultReader {
             .ok()
     }
 
+    /// A scalar real attribute of the group `group` (None when absent).
+    pub fn group_f64_attr(&self, group: &str, attr: &str) -> Option<f64> {
+        self.file
+            .group(group)
+            .ok()?
+            .attr(attr)
+            .ok()?
+            .read_scalar::<f64>()
+            .ok()
+    }
+
     /// The beams of `/resultants`: names and their Gauss points' offsets
     /// (beams + 1), from the attributes of `/resultants/force`.
     pub fn resultant_beams(&self) -> Result<(Vec<String>, Vec<u64>), ReadError> {

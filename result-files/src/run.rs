@@ -614,7 +614,11 @@ fn path_stop(model: &Model, built: &Built) -> PathStop {
 /// the lowest few, with the dataset that holds them all.
 pub fn mode_line(kind: ModeKind, values: &[f64]) -> String {
     const SHOWN: usize = 4;
-    let shown: Vec<String> = values.iter().take(SHOWN).map(|v| format!("{v:.6}")).collect();
+    let shown: Vec<String> = values
+        .iter()
+        .take(SHOWN)
+        .map(|v| format!("{v:.6}"))
+        .collect();
     let more = if values.len() > SHOWN { ", …" } else { "" };
     match kind {
         ModeKind::Vibration => format!(

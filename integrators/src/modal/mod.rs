@@ -12,6 +12,7 @@
 //! [`buckling`].
 
 pub mod buckling;
+mod damping;
 pub mod eigen;
 mod gyroscopic;
 mod linearise;
@@ -26,6 +27,7 @@ use crate::measure::static_record;
 use crate::mechanism::Mechanism;
 use crate::record::StepRecord;
 use crate::statics::{solve_static, StaticSettings};
+pub use damping::ModalDamping;
 use eigen::PencilError;
 use flexmech_core::MassKind;
 use linearise::{Expanded, Linearisation};
@@ -85,6 +87,9 @@ pub struct ModeSet {
     /// Complex modes (a spinning mechanism): their imaginary parts, damping
     /// ratios and whirl.
     pub complex: Option<ComplexParts>,
+    /// Structural damping projected on the (real) modes, where elements
+    /// are damped.
+    pub damping: Option<ModalDamping>,
 }
 
 /// What complex modes add to real ones.
@@ -134,6 +139,7 @@ impl ModeSet {
             unknowns,
             asymmetry,
             complex: None,
+            damping: None,
         }
     }
 }
@@ -225,6 +231,14 @@ pub fn vibration_modes(
     let reference =
         diagonal_sum(&lin.pattern, &k) / diagonal_sum(&lin.pattern, &m).max(f64::MIN_POSITIVE);
     if mech.spin.as_ref().is_some_and(|s| s.rate != 0.0) {
+        if !mech.damped_elements().is_empty() {
+            return Err(SolveError::InvalidMechanism(
+                "modal analysis: a spinning structure with structural damping: its complex \
+                 modes (gyroscopic and damping matrices together) are not computed; give the \
+                 sections damping = 0 for the modes"
+                    .into(),
+            ));
+        }
         return gyroscopic::spinning_modes(&mut lin, (&k, &m), modes, reference, asymmetry);
     }
     let mut set = ModeSet::empty(
@@ -250,6 +264,7 @@ pub fn vibration_modes(
         let phi = oriented(y.iter().map(|v| v / mu.sqrt()).collect());
         set.push(w2, lin.expand(&phi));
     }
+    set.damping = damping::modal_damping(mech, state, &set);
     Ok(set)
 }
 
