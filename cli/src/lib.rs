@@ -415,20 +415,8 @@ fn print_run(path: &Path, s: &flexmech_results::RunSummary) {
         s.wall_time_s,
         s.file.display()
     );
-    if let Some(reason) = &s.end_reason {
-        println!("  ended: {reason}");
-    }
-    if let Some((kind, values)) = &s.modes {
-        println!("  {}", flexmech_results::run::mode_line(*kind, values));
-    }
-    for p in &s.critical {
-        println!(
-            "  critical point: {} at load factor {:.6} (negative eigenvalues {} -> {}; /stability)",
-            p.kind.name(),
-            p.load_factor,
-            p.negative_before,
-            p.negative_after
-        );
+    for line in s.details() {
+        println!("  {line}");
     }
     for w in &s.warnings {
         eprintln!("warning: {}: {w}", path.display());

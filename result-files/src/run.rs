@@ -141,6 +141,32 @@ pub struct RunSummary {
     pub modes: Option<(ModeKind, Vec<f64>)>,
 }
 
+impl RunSummary {
+    /// The lines that follow the step count: why a static path ended, the
+    /// lowest frequencies or buckling load factors, the critical points.
+    pub fn details(&self) -> Vec<String> {
+        let mut lines: Vec<String> = self
+            .end_reason
+            .iter()
+            .map(|r| format!("ended: {r}"))
+            .collect();
+        if let Some((kind, values)) = &self.modes {
+            lines.push(mode_line(*kind, values));
+        }
+        lines.extend(self.critical.iter().map(|p| {
+            format!(
+                "critical point: {} at load factor {:.6} (negative eigenvalues {} -> {}; \
+                 /stability)",
+                p.kind.name(),
+                p.load_factor,
+                p.negative_before,
+                p.negative_after
+            )
+        }));
+        lines
+    }
+}
+
 impl std::fmt::Display for RunSummary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
@@ -152,21 +178,8 @@ impl std::fmt::Display for RunSummary {
             self.wall_time_s,
             self.file.display()
         )?;
-        if let Some(reason) = &self.end_reason {
-            write!(f, "\nended: {reason}")?;
-        }
-        if let Some((kind, values)) = &self.modes {
-            write!(f, "\n{}", mode_line(*kind, values))?;
-        }
-        for p in &self.critical {
-            write!(
-                f,
-                "\ncritical point: {} at load factor {:.6} (negative eigenvalues {} -> {})",
-                p.kind.name(),
-                p.load_factor,
-                p.negative_before,
-                p.negative_after
-            )?;
+        for line in self.details() {
+            write!(f, "\n{line}")?;
         }
         for w in &self.warnings {
             write!(f, "\nwarning: {w}")?;
