@@ -158,3 +158,80 @@ fn bathe_bolourchi_bend_at_intermediate_loads() {
         .collect();
     assert!(z[0] < z[1] && z[1] < z[2]);
 }
+
+/// `∫₀^φ f(√(1 − k² sin² t)) dt` by composite Simpson's rule (the
+/// integrands are smooth for k < 1: 4 000 intervals give round-off).
+fn elliptic(phi: f64, k: f64, f: impl Fn(f64) -> f64) -> f64 {
+    const INTERVALS: usize = 4000;
+    let h = phi / INTERVALS as f64;
+    let g = |t: f64| f((1.0 - k * k * t.sin().powi(2)).sqrt());
+    let inner: f64 = (1..INTERVALS)
+        .map(|i| g(i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 })
+        .sum();
+    (g(0.0) + inner + g(phi)) * h / 3.0
+}
+
+/// The exact elastica of a cantilever under a perpendicular dead tip force,
+/// `λ = PL²/EI`: `(w/L, u/L)` (Bisshopp & Drucker 1945; see
+/// `data/benchmarks/elastica.toml`), the tip rotation found by bisection.
+fn elastica(lambda: f64) -> (f64, f64) {
+    let parts = |theta0: f64| {
+        let k = ((1.0 + theta0.sin()) / 2.0).sqrt();
+        let phi1 = (1.0 / (2f64.sqrt() * k)).asin();
+        let half = std::f64::consts::FRAC_PI_2;
+        let f = elliptic(half, k, |d| 1.0 / d) - elliptic(phi1, k, |d| 1.0 / d);
+        let e = elliptic(half, k, |d| d) - elliptic(phi1, k, |d| d);
+        (f, e)
+    };
+    let (mut lo, mut hi) = (0.0, std::f64::consts::FRAC_PI_2 - 1e-12);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if parts(mid).0 < lambda.sqrt() {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let theta0 = 0.5 * (lo + hi);
+    let (_, e) = parts(theta0);
+    let w = 1.0 - 2.0 / lambda.sqrt() * e;
+    let u = 1.0 - (2.0 * theta0.sin() / lambda).sqrt();
+    (w, u)
+}
+
+#[test]
+fn the_elastica_follows_the_exact_solution_to_lambda_16() {
+    // The exact solution as evaluated here, against Mattiasson's published
+    // table (five digits: half a unit of the last digit).
+    let published = [
+        (1.0, 0.30172, 0.05643),
+        (2.0, 0.49346, 0.16064),
+        (5.0, 0.71379, 0.38763),
+        (10.0, 0.81061, 0.55500),
+    ];
+    for (lambda, w, u) in published {
+        let (we, ue) = elastica(lambda);
+        assert!(
+            (we - w).abs() <= 5e-6 && (ue - u).abs() <= 5e-6,
+            "λ = {lambda}: ({we}, {ue})"
+        );
+    }
+    // The run at every stored load factor. Sixteen 3-node elements: the
+    // discretisation error of the tip is ~1e-6 of L (fourth order in the
+    // element size); the stiff axial and shear terms add 1e-7.
+    let (file, _dir) = solve(load_model(&data("elastica.toml")).unwrap());
+    assert_eq!(status(&file), "completed");
+    let lambda: Vec<f64> = common::read(&file, "/time")
+        .iter()
+        .map(|t| 16.0 * t)
+        .collect();
+    let d = read(&file, "/nodes/rod.end/displacement", 3);
+    let mut worst = 0.0f64;
+    for (l, d) in lambda.iter().zip(&d).filter(|(l, _)| **l > 0.0) {
+        let (w, u) = elastica(*l);
+        worst = worst.max((-d[2] - w).abs()).max((-d[0] - u).abs());
+    }
+    eprintln!("elastica: largest tip error over λ ∈ (0, 16]: {worst:.2e} L");
+    assert!(worst < 1e-5, "{worst}");
+    assert_eq!(lambda.last(), Some(&16.0));
+}
