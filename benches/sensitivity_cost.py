@@ -31,7 +31,7 @@ def main() -> None:
     rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 7
     default = os.environ.get("FLEXMECH_BIN", str(ROOT / "target/release/flexmech"))
     binary = sys.argv[2] if len(sys.argv) > 2 else default
-    text = (ROOT / "data/benchmarks/four_bar.toml").read_text()
+    text = (ROOT / "data/benchmarks/four_bar_tacs.toml").read_text()
     text = text.replace("resultants = true", "resultants = false")
     with tempfile.TemporaryDirectory() as tmp:
         files = {}

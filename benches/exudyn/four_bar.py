@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Exudyn twin of data/benchmarks/four_bar.toml (flexmech's flexible four-bar).
+"""Exudyn twin of data/benchmarks/four_bar_tacs.toml (flexmech's flexible four-bar).
 
 Bar 1 from A = (0, 0, 0) to B = (0, 0.12, 0), bar 2 from B to C = (0.24, 0.12, 0),
 bar 3 from C to D = (0.24, 0, 0); revolutes about z at A and D (to the ground) and B,

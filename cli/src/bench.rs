@@ -212,7 +212,7 @@ pub struct Mechanism {
 pub const MECHANISMS: [Mechanism; 2] = [
     Mechanism {
         name: "four-bar",
-        text: include_str!("../../data/benchmarks/four_bar.toml"),
+        text: include_str!("../../data/benchmarks/four_bar_tacs.toml"),
     },
     Mechanism {
         name: "slider-crank",

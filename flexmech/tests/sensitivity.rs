@@ -510,7 +510,7 @@ fn dynamic_sensitivities_of_the_four_bar_equal_central_differences() {
     // The four-bar's first 1.5 s through its revolutes and the drive:
     // d(out-of-plane displacement)/d(section stiffness).
     both_integrators_agree(
-        "benchmarks/four_bar.toml",
+        "benchmarks/four_bar_tacs.toml",
         1.5,
         &["section.bar8.EI[0]", "section.bar16.GJ"],
     );
@@ -1042,7 +1042,7 @@ fn sensitivities_with_the_papers_energy_momentum_scheme() {
     let cases: [(&str, f64, &[&str]); 3] = [
         ("benchmarks/spin_up.toml", 2.0, &["section.blade.EI[1]"]),
         (
-            "benchmarks/four_bar.toml",
+            "benchmarks/four_bar_tacs.toml",
             1.5,
             &["section.bar8.EI[0]", "section.bar16.GJ"],
         ),
@@ -1111,7 +1111,7 @@ fn sensitivities_with_the_conserving_schemes_through_joints() {
     // (the tip force, the distributed load, both sections' EI₂, the arm's ρA).
     let cases: [(&str, f64, &[&str]); 3] = [
         (
-            "benchmarks/four_bar.toml",
+            "benchmarks/four_bar_tacs.toml",
             1.5,
             &["section.bar8.EI[0]", "section.bar16.GJ"],
         ),

@@ -3,7 +3,7 @@ same model: paired rounds, alternating which goes first, median ratio.
 
     python python/benchmarks/run_vs_cli.py [MODEL] [ROUNDS] [FLEXMECH_BIN]
 
-Defaults: data/benchmarks/four_bar.toml, 15 rounds, target/debug/flexmech
+Defaults: data/benchmarks/four_bar_tacs.toml, 15 rounds, target/debug/flexmech
 (the workspace's dev profile, the profile the package is built with). The
 Python side counts loading the model file and the run (its result read back
 into NumPy arrays; with out=DIR also the file kept), not the interpreter's
@@ -26,7 +26,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def main() -> None:
-    model_path = sys.argv[1] if len(sys.argv) > 1 else str(ROOT / "data/benchmarks/four_bar.toml")
+    model_path = sys.argv[1] if len(sys.argv) > 1 else str(ROOT / "data/benchmarks/four_bar_tacs.toml")
     rounds = int(sys.argv[2]) if len(sys.argv) > 2 else 15
     binary = sys.argv[3] if len(sys.argv) > 3 else str(ROOT / "target/debug/flexmech")
     tmp = pathlib.Path(tempfile.mkdtemp(prefix="flexmech-bench-"))

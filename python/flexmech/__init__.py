@@ -3,7 +3,7 @@ exact beams joined by joints — with the Rust solvers of the flexmech
 workspace.
 
 >>> import flexmech
->>> model = flexmech.Model.load("data/benchmarks/four_bar.toml")
+>>> model = flexmech.Model.load("data/benchmarks/four_bar_tacs.toml")
 >>> result = flexmech.run(model)                 # in memory
 >>> result["/nodes/C/position"].shape            # T×3, the result file's names
 >>> flexmech.run(model, out="results")           # results/<name>.h5, as `flexmech run`

@@ -13,7 +13,7 @@ import flexmech
 from conftest import _same, differences, h5_contents, run_cli
 
 MODELS = [
-    "data/benchmarks/four_bar.toml",  # generalized-alpha, revolutes, a drive
+    "data/benchmarks/four_bar_tacs.toml",  # generalized-alpha, revolutes, a drive
     "data/paper/screw_driven.toml",  # the paper's driven screw, energy-momentum
     "data/statics/follower_tip_force.toml",  # statics, follower load
     "data/dynamics/body_pendulum.toml",  # a rigid body on an offset

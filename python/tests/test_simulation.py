@@ -10,7 +10,7 @@ import flexmech
 from conftest import differences, h5_contents, run_cli
 
 PAPER = "data/paper/screw_driven.toml"  # energy-momentum, driven screw, dt = 0.01
-FOUR_BAR = "data/benchmarks/four_bar.toml"  # generalized-alpha, dt = 0.01
+FOUR_BAR = "data/benchmarks/four_bar_tacs.toml"  # generalized-alpha, dt = 0.01
 
 
 def _last_row(result, name):
