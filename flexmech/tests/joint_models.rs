@@ -242,3 +242,84 @@ fn a_released_translation_that_is_not_finite_is_a_clear_error() {
         "{err}"
     );
 }
+
+/// A cantilever (along x, clamped at the origin) whose tip carries a ball
+/// joint on an arm `a = (0, 0.1, 0)`; the ball's slave is the top of a post
+/// pinned at its foot (ux, uy, rz held), pulled down at the foot by `F`.
+/// The ball passes the force at the arm's end: the cantilever's tip twists
+/// by `φ = −a F L / GJ` and deflects by `−F L³ / 3EI` (linear theory; the
+/// loads are small enough for it to hold to 1e-3).
+const BALL_ON_ARM: &str = r#"
+name = "ball-on-arm"
+[[section]]
+name = "s"
+EA = 1.0e8
+GA = [1.0e8, 1.0e8]
+GJ = 100.0
+EI = [1.0e4, 1.0e4]
+[[beam]]
+name = "cantilever"
+section = "s"
+start = [0.0, 0.0, 0.0]
+end = [1.0, 0.0, 0.0]
+e2 = [0.0, 1.0, 0.0]
+elements = 4
+nodes_per_element = 3
+[[beam]]
+name = "post"
+section = "s"
+start = [1.0, 0.1, 0.0]
+end = [1.0, 0.1, -0.5]
+e2 = [1.0, 0.0, 0.0]
+elements = 2
+[[support]]
+node = "cantilever.start"
+fixed = "all"
+[[support]]
+node = "post.end"
+fixed = ["ux", "uy", "rz"]
+[[joint]]
+name = "ball"
+type = "spherical"
+master = "cantilever.end"
+slave = "post.start"
+arm = [0.0, 0.1, 0.0]
+[[load]]
+node = "post.end"
+force = [0.0, 0.0, -1.0]
+[solver]
+analysis = "static"
+load_steps = 1
+[output]
+track = ["cantilever.end"]
+"#;
+
+#[test]
+fn a_ball_on_an_arm_passes_its_force_at_the_arm_s_end() {
+    let model = flexmech::model::parse_model(BALL_ON_ARM, Path::new("arm.toml")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let file = run_model(&model, dir.path()).unwrap().file;
+    let (f, a, l, gj, ei) = (1.0, 0.1, 1.0, 100.0, 1.0e4);
+    let r = read(&file, "/nodes/cantilever.end/rotation");
+    let twist = r[r.len() - 3];
+    let expected = -a * f * l / gj;
+    assert!(
+        (twist - expected).abs() < 1e-3 * expected.abs(),
+        "{twist} vs {expected}"
+    );
+    let u = read(&file, "/nodes/cantilever.end/displacement");
+    let w = -f * l.powi(3) / (3.0 * ei);
+    assert!(
+        (u[u.len() - 1] - w).abs() < 1e-3 * w.abs(),
+        "{} vs {w}",
+        u[u.len() - 1]
+    );
+    // The slave starts at the master plus the arm; elsewhere it is refused.
+    let moved = BALL_ON_ARM.replace("arm = [0.0, 0.1, 0.0]", "arm = [0.0, 0.2, 0.0]");
+    let model = flexmech::model::parse_model(&moved, Path::new("arm.toml")).unwrap();
+    let err = flexmech::model::build(&model).unwrap_err().to_string();
+    assert!(
+        err.contains("joint[0].slave") && err.contains("ball"),
+        "{err}"
+    );
+}

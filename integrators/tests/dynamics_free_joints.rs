@@ -24,7 +24,7 @@ fn kinds() -> Vec<(&'static str, Arc<dyn JointMap>)> {
     vec![
         ("rigid", Arc::new(Rigid)),
         ("revolute", Arc::new(Revolute { axis: z })),
-        ("spherical", Arc::new(Spherical)),
+        ("spherical", Arc::new(Spherical::default())),
         (
             "prismatic",
             Arc::new(Prismatic {

@@ -48,4 +48,4 @@ pub use revolute::Revolute;
 pub use rigid::Rigid;
 pub use rigid_link::RigidLink;
 pub use screw::Screw;
-pub use spherical::Spherical;
+pub use spherical::{Spherical, SphericalParams};

@@ -630,7 +630,7 @@ fn all_kinds(p: &Params, q: &Released) -> Vec<Kind> {
     let z = Vector3::zeros();
     kinds.push(Kind {
         name: "spherical".into(),
-        map: Box::new(Spherical),
+        map: Box::new(Spherical::default()),
         state: st,
         spherical: true,
         n_closed: Some(Box::new(move |r_m| {
