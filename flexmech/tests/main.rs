@@ -25,6 +25,7 @@ mod fuzz;
 mod fuzz_engine;
 mod ground_joints;
 mod joint_models;
+mod lee_frame;
 mod merit;
 mod model_files;
 mod modes;

@@ -68,6 +68,9 @@ const MODE_ITERATIONS: usize = 30;
 /// A critical mode whose cosine with the load stays below this is a
 /// bifurcation (the load does no work on it); above, a limit point.
 pub(crate) const BIFURCATION_COSINE: f64 = 0.1;
+/// Relative change of the load factor above which the path is taken to turn
+/// at a located point (the solves' own load factors agree far closer).
+const TURN_TOLERANCE: f64 = 1e-9;
 
 /// The path's step from `start` (load factor `lambda_start`, `count`
 /// negative eigenvalues) to the converged state now in `sys.end` (load
@@ -133,17 +136,33 @@ pub(crate) fn locate(
     sys.end = end;
     set_load(sys, lambda_end);
     sys.update_tangent(scratch);
+    let load_factor = 0.5 * (lo.1 + hi.1);
     let point = CriticalPoint {
-        load_factor: 0.5 * (lo.1 + hi.1),
-        kind: match cosine {
-            Some(c) if c < BIFURCATION_COSINE => CriticalKind::Bifurcation,
-            _ => CriticalKind::Limit,
-        },
+        load_factor,
+        kind: classify((lambda_start, load_factor, lambda_end), cosine),
         negative_before: count,
         negative_after: count_end,
         bracket: (hi.1 - lo.1).abs(),
     };
     located.then(|| (point, past.map(|state| (state, hi.1))))
+}
+
+/// A located point's kind. Where the path's load factor turns at the point
+/// (it rises to it and falls after, or the reverse: `(start, point, end)`
+/// of the step), a limit point; else by the critical mode's cosine with
+/// the load, a bifurcation below [`BIFURCATION_COSINE`]. (The cosine alone
+/// fails on fine meshes: a point load's share of a mode spread over many
+/// nodes shrinks as the nodes multiply.)
+fn classify((start, point, end): (f64, f64, f64), cosine: Option<f64>) -> CriticalKind {
+    let noise = TURN_TOLERANCE * (start.abs() + point.abs() + end.abs()).max(f64::MIN_POSITIVE);
+    let (rise, fall) = (point - start, end - point);
+    if rise * fall < 0.0 && rise.abs() > noise && fall.abs() > noise {
+        return CriticalKind::Limit;
+    }
+    match cosine {
+        Some(c) if c < BIFURCATION_COSINE => CriticalKind::Bifurcation,
+        _ => CriticalKind::Limit,
+    }
 }
 
 /// The critical mode of the tangent now in `sys` (its assembled values):
@@ -192,4 +211,31 @@ fn mode_cosine(
 ) -> Option<f64> {
     let mode = critical_mode(sys, lu)?;
     Some(load_cosine(sys, &mode, f_ref))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_turning_load_factor_is_a_limit_point_whatever_the_cosine() {
+        // Rises to the point and falls after: a limit point even where a
+        // point load's cosine with a fine mesh's mode is small.
+        assert_eq!(classify((0.9, 1.0, 0.95), Some(0.01)), CriticalKind::Limit);
+        assert_eq!(
+            classify((-0.4, -0.5, -0.45), Some(0.01)),
+            CriticalKind::Limit
+        );
+        // A monotonic path: the cosine decides.
+        assert_eq!(
+            classify((0.9, 1.0, 1.1), Some(0.01)),
+            CriticalKind::Bifurcation
+        );
+        assert_eq!(classify((0.9, 1.0, 1.1), Some(0.5)), CriticalKind::Limit);
+        // A turn within the solves' noise is no turn.
+        assert_eq!(
+            classify((1.0, 1.0 + 1e-12, 1.0), Some(0.01)),
+            CriticalKind::Bifurcation
+        );
+    }
 }

@@ -4,7 +4,7 @@
 //! gives a warning (stderr, the summary line and the result file's root
 //! attribute `warnings`) when the result is doubtful.
 
-use flexmech_integrators::critical::CriticalPoint;
+use flexmech_integrators::critical::{CriticalKind, CriticalPoint};
 use flexmech_integrators::dynamics::Integrator;
 use flexmech_integrators::modal::buckling_modes;
 use flexmech_integrators::{Mechanism, StepRecord};
@@ -267,9 +267,9 @@ impl RunChecks {
 }
 
 /// The stability warning's last words: the critical points located on the
-/// path and the linear buckling load factor (`analysis = "buckling"`,
-/// about the undeformed state) nearest the first of them (or the first
-/// unstable load factor `lambda`).
+/// path and — unless every one is a limit point — the linear buckling load
+/// factor (`analysis = "buckling"`, about the undeformed state) nearest the
+/// first of them (or the first unstable load factor `lambda`).
 fn nearest_critical(mech: &Mechanism, critical: &[CriticalPoint], lambda: f64) -> String {
     let mut text = String::new();
     if !critical.is_empty() {
@@ -281,6 +281,11 @@ fn nearest_critical(mech: &Mechanism, critical: &[CriticalPoint], lambda: f64) -
             "; critical points located (/stability): {}",
             list.join(", ")
         ));
+    }
+    // Limit points only: a linear buckling load (a bifurcation of the
+    // linear prestress) says nothing about them.
+    if !critical.is_empty() && critical.iter().all(|p| p.kind == CriticalKind::Limit) {
+        return text;
     }
     let at = critical.first().map_or(lambda, |p| p.load_factor);
     match buckling_modes(mech, NEAREST_BUCKLING_MODES, None) {

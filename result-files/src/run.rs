@@ -208,8 +208,8 @@ impl RunError {
     }
 }
 
-/// Between the solver and the sink: keeps every `every`-th step and always
-/// the last one, and watches every converged step (energy balance,
+/// Between the solver and the sink: keeps the first record, every
+/// `every`-th after it and always the last one, and watches every converged step (energy balance,
 /// stability, figures of merit).
 struct Keeper<'a> {
     sink: &'a mut dyn Sink,
@@ -241,7 +241,9 @@ impl Keeper<'_> {
         if self.error.is_some() {
             return false;
         }
-        if self.count.is_multiple_of(self.every) {
+        // The first record (the initial state) and every `every`-th after it:
+        // times 0, every·Δt, 2·every·Δt, … (and the last, flushed at the end).
+        if (self.count - 1).is_multiple_of(self.every) {
             self.pending = None;
             self.give(step)
         } else {
