@@ -196,6 +196,10 @@ fn linearised_analyses_refuse_keys_that_are_not_theirs() {
             "solver.load_steps",
         ),
         ("analysis = \"modal\"\ndt = 0.1", "solver.dt"),
+        (
+            "analysis = \"buckling\"\nstop = { load_factor = 0.5 }",
+            "solver.stop",
+        ),
         ("analysis = \"modes\"", "solver.analysis"),
         ("analysis = \"modal\"\nmodes = 0", "solver.modes"),
         (

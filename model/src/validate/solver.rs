@@ -104,6 +104,7 @@ impl Ctx<'_> {
             ("control", s.control.as_ref().map(S::span)),
             ("max_arc_steps", s.max_arc_steps.as_ref().map(S::span)),
             ("branch_switch", s.branch_switch.as_ref().map(S::span)),
+            ("stop", s.stop.as_ref().map(S::span)),
             (
                 "load_steps",
                 s.load_steps
