@@ -30,6 +30,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 pub mod bench;
+pub mod benchmarks;
 mod modes;
 mod plot_study;
 pub mod reproduce;
@@ -155,6 +156,11 @@ struct ReproduceArgs {
     /// Also a PDF of every chart, from its PGFPlots copy (needs pdflatex).
     #[arg(long)]
     pdf: bool,
+    /// The benchmark set of data/benchmarks/ instead of the paper's
+    /// examples: a chart per benchmark beside its reference and the table
+    /// (DIR/benchmarks/).
+    #[arg(long, conflicts_with_all = ["models", "time_scale"])]
+    benchmarks: bool,
 }
 
 /// The arguments of `flexmech plot`.
@@ -461,7 +467,11 @@ fn reproduce_command(args: ReproduceArgs) -> ExitCode {
         time_scale,
         no_titles,
         pdf,
+        benchmarks,
     } = args;
+    if benchmarks {
+        return benchmarks_command(&out, !no_titles, pdf);
+    }
     let options = ReproduceOptions {
         out,
         models,
@@ -499,6 +509,29 @@ fn reproduce_command(args: ReproduceArgs) -> ExitCode {
         "ParaView series (open the .pvd): {}/<model>/<integrator>.pvd; animations: {}",
         options.out.display(),
         options.out.join("animations").display()
+    );
+    ExitCode::SUCCESS
+}
+
+/// `flexmech reproduce --benchmarks`: the benchmark table's rows and where
+/// the charts and the table went.
+fn benchmarks_command(out: &Path, titles: bool, pdf: bool) -> ExitCode {
+    let report = match benchmarks::reproduce_benchmarks(out, titles, pdf) {
+        Ok(report) => report,
+        Err(e) => return fail(e),
+    };
+    for r in &report.rows {
+        println!(
+            "{}: {}: reference {} ({}), flexmech {}, difference {}",
+            r.benchmark, r.quantity, r.reference, r.source, r.ours, r.difference
+        );
+    }
+    println!(
+        "{} charts in {}; table in {} and {}",
+        report.charts.len(),
+        out.join("benchmarks").display(),
+        report.table.0.display(),
+        report.table.1.display()
     );
     ExitCode::SUCCESS
 }

@@ -3,6 +3,7 @@
 //! analytic solutions and published values.
 
 use crate::common;
+use flexmech::cli::benchmarks::reference::{numbers, ELASTICA, PRINCETON};
 use flexmech::model::{load_model, parse_model, Model};
 use flexmech::results::run_model;
 use std::path::{Path, PathBuf};
@@ -203,13 +204,12 @@ fn elastica(lambda: f64) -> (f64, f64) {
 fn the_elastica_follows_the_exact_solution_to_lambda_16() {
     // The exact solution as evaluated here, against Mattiasson's published
     // table (five digits: half a unit of the last digit).
-    let published = [
-        (1.0, 0.30172, 0.05643),
-        (2.0, 0.49346, 0.16064),
-        (5.0, 0.71379, 0.38763),
-        (10.0, 0.81061, 0.55500),
-    ];
-    for (lambda, w, u) in published {
+    let published = numbers(ELASTICA);
+    assert_eq!(published.len(), 4);
+    for &[lambda, w, u] in published
+        .iter()
+        .map(|r| <&[f64; 3]>::try_from(&r[..]).unwrap())
+    {
         let (we, ue) = elastica(lambda);
         assert!(
             (we - w).abs() <= 5e-6 && (ue - u).abs() <= 5e-6,
@@ -236,55 +236,6 @@ fn the_elastica_follows_the_exact_solution_to_lambda_16() {
     assert_eq!(lambda.last(), Some(&16.0));
 }
 
-/// The Princeton beam's reference tip deflections (|y|, z) for β = 0, 15,
-/// …, 90° (`data/benchmarks/princeton_beam.toml`; the finite-element beam
-/// solution tabulated in a public test suite, see
-/// `data/benchmarks/SOURCES.md`).
-const PRINCETON: [(f64, [f64; 7], [f64; 7]); 2] = [
-    (
-        8.896,
-        [
-            1.071417630e-2,
-            1.061328706e-2,
-            1.011169630e-2,
-            8.837226265e-3,
-            6.604665004e-3,
-            3.538889001e-3,
-            0.0,
-        ],
-        [
-            0.0,
-            4.208232124e-2,
-            7.939482948e-2,
-            0.108987937,
-            0.129887616,
-            0.142194370,
-            0.146245978,
-        ],
-    ),
-    (
-        13.345,
-        [
-            1.606423724e-2,
-            1.645825752e-2,
-            1.665873206e-2,
-            1.518618440e-2,
-            1.157837500e-2,
-            6.248967384e-3,
-            0.0,
-        ],
-        [
-            0.0,
-            6.435812858e-2,
-            0.117735994,
-            0.156467239,
-            0.181861627,
-            0.196097131,
-            0.200677707,
-        ],
-    ),
-];
-
 #[test]
 fn the_princeton_beam_meets_the_reference_tip_deflections() {
     // Tolerance from the reference: its section's torsion constant and
@@ -297,23 +248,24 @@ fn the_princeton_beam_meets_the_reference_tip_deflections() {
     let text = std::fs::read_to_string(data("princeton_beam.toml")).unwrap();
     let line = "force = [0.0, -6.290421925435528, 6.290421925435528]";
     assert!(text.contains(line));
+    // The reference table (`data/benchmarks/reference/princeton_reference.csv`):
+    // force, β in degrees, the tip's −y and z.
+    let table = numbers(PRINCETON);
+    assert_eq!(table.len(), 14);
     let mut worst = 0.0f64;
-    for (force, ys, zs) in PRINCETON {
-        for (k, (y, z)) in ys.iter().zip(zs).enumerate() {
-            let beta = (15.0 * k as f64).to_radians();
-            let f = format!(
-                "force = [0.0, {:?}, {:?}]",
-                -force * beta.cos(),
-                force * beta.sin()
-            );
-            let model = parse_model(&text.replace(line, &f), &data("princeton_beam.toml")).unwrap();
-            let (file, _dir) = solve(model);
-            let u = tip_at(&file, "strip.end", 1.0);
-            let scale = (y * y + z * z).sqrt();
-            let error = (-u[1] - y).abs().max((u[2] - z).abs()) / scale;
-            eprintln!("F = {force}, β = {:>2}°: tip ({:.6}, {:.6}) vs ({y:.6}, {z:.6}): {error:.1e} of |u|", 15 * k, -u[1], u[2]);
-            worst = worst.max(error);
-        }
+    for row in &table {
+        let (force, beta, y, z) = (row[0], row[1].to_radians(), row[2], row[3]);
+        let f = format!(
+            "force = [0.0, {:?}, {:?}]",
+            -force * beta.cos(),
+            force * beta.sin()
+        );
+        let model = parse_model(&text.replace(line, &f), &data("princeton_beam.toml")).unwrap();
+        let (file, _dir) = solve(model);
+        let u = tip_at(&file, "strip.end", 1.0);
+        let scale = (y * y + z * z).sqrt();
+        let error = (-u[1] - y).abs().max((u[2] - z).abs()) / scale;
+        worst = worst.max(error);
     }
     assert!(worst < 1e-2, "{worst}");
 }

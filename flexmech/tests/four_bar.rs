@@ -18,6 +18,7 @@
 
 use std::path::Path;
 
+use flexmech::cli::benchmarks::reference::{numbers, FOUR_BAR};
 use flexmech::model::load_model;
 use flexmech::results::run_model_to;
 use flexmech::results::{layout, ResultReader};
@@ -357,36 +358,6 @@ fn the_misaligned_four_bar_matches_an_independent_code() {
     }
 }
 
-/// C's position (t, x, y, z) in the run stored by one of the 2016 paper's
-/// authors for the benchmark as they define it (`data/benchmarks/four_bar.toml`,
-/// public repository vspsonn/mb_sef_py, `examples/beam_fourbar/beam_fourbar.h5`,
-/// node 3), every 0.5 s but 7.5–8.3 s, where the mechanism passes its flat
-/// position and the two runs part for a few steps.
-const AUTHORS_C: [[f64; 4]; 22] = [
-    [0.496, 0.27518326, 0.11472635, -7.853969e-05],
-    [1.000, 0.30774841, 0.09904368, -5.653382e-04],
-    [1.496, 0.33380544, 0.07481426, -1.444882e-03],
-    [2.000, 0.35182354, 0.04340494, -2.669708e-03],
-    [2.496, 0.35964617, 0.00773322, -3.990223e-03],
-    [3.000, 0.33446813, 0.07387791, -3.334997e-03],
-    [3.496, 0.26504293, 0.11733174, -1.932316e-03],
-    [4.000, 0.20747256, 0.11550266, -8.106567e-04],
-    [4.496, 0.17226678, 0.09905637, -1.843616e-04],
-    [5.000, 0.15087137, 0.08034979, 2.460250e-05],
-    [5.496, 0.13803035, 0.06326285, -1.053994e-04],
-    [6.000, 0.12988278, 0.04768560, -5.168478e-04],
-    [6.496, 0.12486958, 0.03381363, -1.149521e-03],
-    [7.000, 0.12182724, 0.02074072, -1.965016e-03],
-    [8.496, 0.12878440, 0.04498221, -2.424101e-03],
-    [9.000, 0.14726883, 0.07614324, -1.576848e-03],
-    [9.496, 0.17368153, 0.10000536, -8.253948e-04],
-    [10.000, 0.20647322, 0.11522110, -2.589204e-04],
-    [10.496, 0.24172971, 0.11998753, 4.893260e-06],
-    [11.000, 0.27738094, 0.11402920, -9.702740e-05],
-    [11.496, 0.30916885, 0.09805664, -5.990075e-04],
-    [12.000, 0.33522534, 0.07299612, -1.514200e-03],
-];
-
 #[test]
 fn the_four_bar_as_its_authors_define_it_matches_their_run() {
     // Tolerances from the reference: the authors' run stores single
@@ -407,7 +378,14 @@ fn the_four_bar_as_its_authors_define_it_matches_their_run() {
         [c[3 * k], c[3 * k + 1], c[3 * k + 2]]
     };
     let (mut in_plane, mut out_of_plane) = (0.0f64, 0.0f64);
-    for [time, x, y, z] in AUTHORS_C {
+    // C's position (t, x, y, z) in the run stored by one of the 2016
+    // paper's authors (`data/benchmarks/reference/four_bar_authors.csv`).
+    let authors = numbers(FOUR_BAR);
+    assert_eq!(authors.len(), 22);
+    for &[time, x, y, z] in authors
+        .iter()
+        .map(|r| <&[f64; 4]>::try_from(&r[..]).unwrap())
+    {
         let p = at(time);
         in_plane = in_plane.max((p[0] - x).abs()).max((p[1] - y).abs());
         out_of_plane = out_of_plane.max((p[2] - z).abs());

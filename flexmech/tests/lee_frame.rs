@@ -17,6 +17,7 @@
 //! end conditions `r = (1, 1), M = 0` fix `(H, V, φ)` for each `P`.
 
 use crate::common;
+use flexmech::cli::benchmarks::reference::{fields, LEE_FRAME};
 use flexmech::model::load_model;
 use flexmech::results::run_model;
 use nalgebra::{Matrix3x4, Matrix4, Vector3, Vector4};
@@ -155,6 +156,14 @@ fn lee_s_frame_snaps_at_the_exact_limit_loads() {
     let exact = exact_limit_loads(2, 0.0);
     assert_eq!(exact.len(), 2);
     assert!(exact[0] > 18.0 && exact[1] < -9.0, "{exact:?}");
+    // The reference file the benchmark table reads holds these values.
+    let stored: Vec<f64> = fields(LEE_FRAME)
+        .iter()
+        .map(|f| f[1].parse().unwrap())
+        .collect();
+    for (s, e) in stored.iter().zip(&exact) {
+        assert!((s - e).abs() < 1e-9, "{stored:?} vs {exact:?}");
+    }
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/benchmarks/lee_frame.toml");
     let dir = tempfile::tempdir().unwrap();
     let summary = run_model(&load_model(&file).unwrap(), dir.path()).unwrap();

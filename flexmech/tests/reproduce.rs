@@ -246,3 +246,57 @@ fn unknown_models_and_bad_scales_are_errors() {
         Err(ReproduceError::TimeScale(_))
     ));
 }
+
+/// `flexmech reproduce --benchmarks`: every benchmark of the set is run,
+/// charted beside its reference and reported in the table; the table's
+/// numbers are the ones the benchmark tests bound (the exact limit loads
+/// of Lee's frame to 1e-4, the Princeton beam to 1 %).
+#[test]
+fn the_benchmark_set_is_charted_and_tabled() {
+    use flexmech::cli::benchmarks::reproduce_benchmarks;
+    let dir = tempfile::tempdir().unwrap();
+    let report = reproduce_benchmarks(dir.path(), true, false).unwrap();
+    assert_eq!(report.charts.len(), 6);
+    for png in &report.charts {
+        assert!(exists_with_svg(png), "{}", png.display());
+        assert!(png.with_extension("tex").exists() && png.with_extension("csv").exists());
+    }
+    let md = std::fs::read_to_string(&report.table.0).unwrap();
+    assert_eq!(md.lines().count(), 2 + report.rows.len());
+    assert!(md.lines().skip(2).all(|l| l.matches(" | ").count() == 6));
+    assert!(!md.contains("NaN"), "{md}");
+    let csv = std::fs::read_to_string(&report.table.1).unwrap();
+    assert_eq!(csv.lines().count(), 1 + report.rows.len());
+    for benchmark in [
+        "Princeton",
+        "four-bar",
+        "lateral buckling",
+        "rotating shaft",
+        "elastica",
+        "Lee",
+    ] {
+        assert!(
+            report.rows.iter().any(|r| r.benchmark.contains(benchmark)),
+            "{benchmark}"
+        );
+    }
+    for r in report
+        .rows
+        .iter()
+        .filter(|r| r.benchmark.starts_with("Lee"))
+    {
+        let (ours, exact): (f64, f64) = (r.ours.parse().unwrap(), r.reference.parse().unwrap());
+        assert!((ours - exact).abs() < 1e-4 * 18.55, "{r:?}");
+    }
+    let worst = report
+        .rows
+        .iter()
+        .find(|r| r.quantity.starts_with("largest difference over the 14"));
+    let percent: f64 = worst
+        .unwrap()
+        .difference
+        .trim_end_matches(" %")
+        .parse()
+        .unwrap();
+    assert!(percent < 1.0, "{percent}");
+}

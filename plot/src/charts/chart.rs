@@ -83,6 +83,7 @@ impl Series {
     ) -> (Color, Dash, Marker, usize) {
         let (color, dash) = super::style::auto_style(index);
         let every = match (self.marker, self.mark_every) {
+            (_, 0) if self.dash == Some(Dash::Markers) => 1,
             (Some(Marker::None), _) => 0,
             (_, 0) if points <= AUTO_MARKERS => 1,
             (None, k) => k,

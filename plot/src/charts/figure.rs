@@ -64,6 +64,8 @@ pub(super) struct Curve {
     pub(super) label: String,
     pub(super) color: RGBColor,
     pub(super) dash: &'static [f64],
+    /// Whether its points are joined by a line (else markers only).
+    pub(super) line: bool,
     pub(super) runs: Vec<Vec<(f64, f64)>>,
     /// Marker on every k-th drawn point (0: none).
     pub(super) mark_every: usize,

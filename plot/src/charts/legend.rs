@@ -163,7 +163,7 @@ impl Figure {
             let x0 = l + LEGEND_PAD * s + col as f64 * column_step;
             let sample = [(x0, y), (x0 + LEGEND_SAMPLE * s, y)];
             let dash: Vec<f64> = curve.dash.iter().map(|d| d * s).collect();
-            for piece in dashed(&sample, &dash) {
+            for piece in dashed(&sample, &dash).into_iter().filter(|_| curve.line) {
                 root.draw(&PathElement::new(
                     pixels(&piece),
                     curve.color.stroke_width(px(LINE_WIDTH * s) as u32),

@@ -590,6 +590,7 @@ impl Curve {
             label: s.label.clone(),
             color: color.plotters(),
             dash: style.pixels(),
+            line: style.has_line(),
             runs,
             mark_every,
             marker,
@@ -613,7 +614,7 @@ impl Curve {
         let mut index = 0usize;
         for run in &self.runs {
             let pts: Vec<(f64, f64)> = run.iter().map(|&p| frame.to_px(lay, p)).collect();
-            for piece in clip_polyline(&pts, rect) {
+            for piece in clip_polyline(&pts, rect).into_iter().filter(|_| self.line) {
                 if piece.len() == 1 {
                     let c = pixels(&piece)[0];
                     root.draw(&Circle::new(c, line_width, self.color.filled()))?;

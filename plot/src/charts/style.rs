@@ -76,6 +76,9 @@ pub enum Dash {
     LongDashed,
     /// Dash, dot, dot, dash, …
     DashDotDot,
+    /// No line: a marker on every point (published values, sparse data);
+    /// never in the automatic cycle.
+    Markers,
 }
 
 impl Dash {
@@ -99,7 +102,13 @@ impl Dash {
             Dash::DashDot => &[26.0, 10.0, 4.0, 10.0],
             Dash::LongDashed => &[44.0, 14.0],
             Dash::DashDotDot => &[22.0, 8.0, 4.0, 8.0, 4.0, 8.0],
+            Dash::Markers => &[],
         }
+    }
+
+    /// Whether the curve's points are joined by a line.
+    pub(super) fn has_line(self) -> bool {
+        self != Dash::Markers
     }
 
     /// The pattern as a TikZ line style: TikZ's own name where one matches,
@@ -113,6 +122,7 @@ impl Dash {
             Dash::DashDot => "dashdotted",
             Dash::LongDashed => "dash pattern=on 11pt off 3.5pt",
             Dash::DashDotDot => "dashdotdotted",
+            Dash::Markers => "only marks",
         }
     }
 }
