@@ -32,7 +32,7 @@ pub fn run(dir: &Path, titles: bool) -> Result<Outcome, ReproduceError> {
                     reference: sig(reference),
                     source: "published",
                     ours: sig(ours),
-                    difference: difference(ours, reference, reference),
+                    difference: difference(ours, reference),
                     mesh: MESH,
                     step: STEP,
                 });

@@ -48,7 +48,7 @@ pub fn run(dir: &Path, titles: bool) -> Result<Outcome, ReproduceError> {
             "C's out-of-plane minimum z_C (m)".into(),
             sig(AUTHORS_Z_MIN.0),
             sig(c[k][2]),
-            difference(c[k][2], AUTHORS_Z_MIN.0, AUTHORS_Z_MIN.0),
+            difference(c[k][2], AUTHORS_Z_MIN.0),
         ),
         row(
             "its time (s)".into(),

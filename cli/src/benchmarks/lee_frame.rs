@@ -2,7 +2,7 @@
 //! the exact limit loads of the same planar rod.
 
 use super::reference::{fields, LEE_FRAME};
-use super::table::{difference, sig, Row};
+use super::table::{difference_of, sig, Row};
 use super::{read_error, rows3, solve, Outcome, ReproduceError};
 use flexmech_plot::charts::{Dash, LineChart, Marker, Panels, Series};
 use std::path::Path;
@@ -37,7 +37,7 @@ pub fn run(dir: &Path, titles: bool) -> Result<Outcome, ReproduceError> {
                 reference: sig(*load),
                 source: "exact",
                 ours: sig(ours),
-                difference: difference(ours, *load, exact[0].1),
+                difference: difference_of(ours, *load, exact[0].1, "of the first"),
                 mesh: MESH,
                 step: STEP,
             }

@@ -62,7 +62,7 @@ pub fn run(dir: &Path, titles: bool) -> Result<Outcome, ReproduceError> {
                 format!("tip {name} (m), F = {} N, β = 45°", r[0]),
                 sig(p),
                 sig(o),
-                super::table::difference(o, p, r[2].hypot(r[3])),
+                super::table::difference_of(o, p, r[2].hypot(r[3]), "of |u|"),
             ));
         }
     }

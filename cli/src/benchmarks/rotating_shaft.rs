@@ -19,7 +19,7 @@ fn row(quantity: &str, reference: f64, ours: f64) -> Row {
         reference: sig(reference),
         source: "independent run",
         ours: sig(ours),
-        difference: difference(ours, reference, reference),
+        difference: difference(ours, reference),
         mesh: MESH,
         step: STEP,
     }

@@ -36,10 +36,15 @@ pub fn sig(x: f64) -> String {
     }
 }
 
-/// `ours − reference`, and its size relative to `scale`.
-pub fn difference(ours: f64, reference: f64, scale: f64) -> String {
+/// `ours − reference`, and its size relative to the reference.
+pub fn difference(ours: f64, reference: f64) -> String {
+    difference_of(ours, reference, reference, "relative")
+}
+
+/// `ours − reference`, and its size as a fraction of `scale` (`what` it is).
+pub fn difference_of(ours: f64, reference: f64, scale: f64, what: &str) -> String {
     format!(
-        "{:.1e} ({:.1e} relative)",
+        "{:.1e} ({:.1e} {what})",
         ours - reference,
         (ours - reference).abs() / scale.abs()
     )
@@ -52,10 +57,18 @@ pub fn write(rows: &[Row], dir: &Path) -> Result<(PathBuf, PathBuf), ReproduceEr
     );
     let mut csv = String::from("benchmark,quantity,reference,source,ours,difference,mesh,step\n");
     for r in rows {
+        let cell = |s: &str| s.replace('|', "\\|");
         let _ = writeln!(
             md,
             "| {} | {} | {} ({}) | {} | {} | {} | {} |",
-            r.benchmark, r.quantity, r.reference, r.source, r.ours, r.difference, r.mesh, r.step
+            cell(&r.benchmark),
+            cell(&r.quantity),
+            cell(&r.reference),
+            r.source,
+            cell(&r.ours),
+            cell(&r.difference),
+            r.mesh,
+            r.step
         );
         let quote = |s: &str| format!("\"{}\"", s.replace('"', "\"\""));
         let fields = [
