@@ -10,6 +10,8 @@
 #   results/<model>/<integrator>.pvd  ParaView series of each run
 #   results/animations/<model>.gif    each example moving
 #   results/models/<name>.h5          the other models
+#   results/benchmarks/               the benchmark set beside its references:
+#                                     a chart each and table.md (reproduce --benchmarks)
 # (or the directory given as the first argument instead of results/).
 set -e
 source "$(dirname "$0")/env.sh"
@@ -17,6 +19,7 @@ OUT="${1:-results}"
 cargo build --release --bin flexmech
 FLEXMECH="${CARGO_TARGET_DIR:-target}/release/flexmech"
 "$FLEXMECH" reproduce --out "$OUT"
+"$FLEXMECH" reproduce --benchmarks --out "$OUT"
 "$FLEXMECH" run data/benchmarks/*.toml data/statics/*.toml data/dynamics/*.toml --out "$OUT/models"
 cargo test --release -p flexmech --test main published_dynamics -- --ignored
 echo "results written to $OUT/ (figures in $OUT/charts/, summary in $OUT/summary.md, ParaView series $OUT/<model>/<integrator>.pvd, animations in $OUT/animations/)"

@@ -143,6 +143,8 @@ pub use flexmech_studies as studies;
 /// that `cargo test --doc` compiles and runs every code block it holds.
 #[doc = include_str!("../../docs/book/README.md")]
 pub mod book {
+    #[doc = include_str!("../../docs/book/benchmarks.md")]
+    pub mod benchmarks {}
     #[doc = include_str!("../../docs/book/getting-started.md")]
     pub mod getting_started {}
     #[doc = include_str!("../../docs/book/joints.md")]
