@@ -81,3 +81,25 @@ def test_an_arc_length_path_locates_the_truss_limit_points(in_root):
     assert stopped.completed
     assert "solver.stop.displacement" in stopped.end_reason
     assert stopped.critical_points[0] == points[0]
+
+
+def test_a_ball_on_an_arm_passes_its_force_at_the_arm_s_end():
+    # A cantilever whose tip carries a spherical joint on an arm a = 0.1
+    # (the `arm` key); a post pinned at its foot hangs from the ball and is
+    # pulled down by F. The cantilever twists by -a F L / GJ (linear
+    # theory, to 1e-3) — the same model as flexmech/tests/joint_models.rs.
+    a, f, gj = 0.1, 1.0, 100.0
+    model = flexmech.Model("ball-on-arm").section("s", EA=1e8, GA=[1e8, 1e8], GJ=gj, EI=[1e4, 1e4])
+    model.beam("cantilever", "s", start=[0, 0, 0], end=[1, 0, 0], elements=4, e2=[0, 1, 0], nodes_per_element=3)
+    model.beam("post", "s", start=[1, a, 0], end=[1, a, -0.5], elements=2, e2=[1, 0, 0])
+    model.support("cantilever.start").support("post.end", ["ux", "uy", "rz"])
+    model.joint("ball", "spherical", "cantilever.end", "post.start", arm=[0.0, a, 0.0])
+    model.nodal_load("post.end", [0, 0, -f]).statics(1).track("cantilever.end")
+    result = flexmech.run(model)
+    assert result.completed, result.status
+    twist = result["/nodes/cantilever.end/rotation"][-1, 0]
+    assert abs(twist / (-a * f / gj) - 1) < 1e-3, twist
+    # The slave must start at the master plus the arm.
+    model.set("joint[0].arm", [0.0, 2 * a, 0.0])
+    with pytest.raises(Exception, match="joint\\[0\\].slave"):
+        flexmech.run(model)
