@@ -3,8 +3,7 @@
 
 use super::reference::{column, numbers, LATERAL_BUCKLING};
 use super::table::{difference, sig, Row};
-use super::{nearest, rows3, solve, times, Outcome, ReproduceError};
-use flexmech_plot::charts::{LineChart, Panels, Series};
+use super::{against_twin, nearest, rows3, solve, times, Outcome, ReproduceError};
 use std::path::Path;
 
 const MODEL: &str = include_str!("../../../data/benchmarks/lateral_buckling.toml");
@@ -71,21 +70,9 @@ pub fn run(dir: &Path, titles: bool) -> Result<Outcome, ReproduceError> {
             difference(swing, twin_swing),
         ),
     ];
-    let mut lateral = LineChart::new("", "time (s)", "mid-span lateral displacement u_y (m)");
-    let mut vertical = LineChart::new("", "time (s)", "mid-span vertical displacement u_z (m)");
-    if titles {
-        lateral.title = "Lateral buckling of a strip".into();
-    }
-    lateral.series = vec![
-        Series::new("flexmech", t.clone(), u.iter().map(|d| d[1]).collect()),
-        Series::new("independent run", tt.clone(), ty),
-    ];
-    vertical.series = vec![
-        Series::new("flexmech", t, u.iter().map(|d| d[2]).collect()),
-        Series::new("independent run", tt, column(&twin, 3)),
-    ];
+    let title = titles.then(|| "Lateral buckling of a strip".to_string());
     Ok(Outcome {
         rows,
-        chart: Panels::row(vec![lateral, vertical]),
+        chart: against_twin(title, &t, &u, &twin, ["lateral u_y", "vertical u_z"]),
     })
 }

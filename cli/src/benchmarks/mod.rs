@@ -20,7 +20,7 @@ pub mod table;
 
 use crate::reproduce::ReproduceError;
 use flexmech_model::parse_model;
-use flexmech_plot::charts::Panels;
+use flexmech_plot::charts::{LineChart, Panels, Series};
 use flexmech_results::run::run_model_to;
 use flexmech_results::ResultReader;
 use std::path::{Path, PathBuf};
@@ -138,4 +138,37 @@ fn nearest(times: &[f64], t: f64) -> usize {
     (0..times.len())
         .min_by(|&a, &b| (times[a] - t).abs().total_cmp(&(times[b] - t).abs()))
         .unwrap_or(0)
+}
+
+/// Two panels of a mid-span history over time, `u_y` and `u_z` (`names`
+/// for the axes), flexmech's (`t`, `u`) against an independent run's rows
+/// `[t, ux, uy, uz]`; `title` above the first.
+fn against_twin(
+    title: Option<String>,
+    t: &[f64],
+    u: &[[f64; 3]],
+    twin: &[Vec<f64>],
+    names: [&str; 2],
+) -> Panels {
+    let twin_t = reference::column(twin, 0);
+    let panels = (1..3)
+        .map(|c| {
+            let label = format!("mid-span {} displacement (m)", names[c - 1]);
+            let mut chart = LineChart::new("", "time (s)", label);
+            chart.series = vec![
+                Series::new("flexmech", t.to_vec(), u.iter().map(|d| d[c]).collect()),
+                Series::new(
+                    "independent run",
+                    twin_t.clone(),
+                    reference::column(twin, c + 1),
+                ),
+            ];
+            chart
+        })
+        .collect::<Vec<_>>();
+    let mut panels = Panels::row(panels);
+    if let Some(title) = title {
+        panels.charts[0].title = title;
+    }
+    panels
 }

@@ -4,8 +4,7 @@
 
 use super::reference::{column, numbers, ROTATING_SHAFT};
 use super::table::{difference, sig, Row};
-use super::{nearest, rows3, solve, times, Outcome, ReproduceError};
-use flexmech_plot::charts::{LineChart, Panels, Series};
+use super::{against_twin, nearest, rows3, solve, times, Outcome, ReproduceError};
 use std::path::Path;
 
 const MODEL: &str = include_str!("../../../data/benchmarks/rotating_shaft.toml");
@@ -58,21 +57,9 @@ pub fn run(dir: &Path, titles: bool) -> Result<Outcome, ReproduceError> {
             radius(&tt, &oy, &oz, (1.5, 2.5)),
         ),
     ];
-    let mut horizontal = LineChart::new("", "time (s)", "mid-span displacement u_y (m)");
-    let mut vertical = LineChart::new("", "time (s)", "mid-span displacement u_z (m)");
-    if titles {
-        horizontal.title = "Rotating shaft through its critical speed".into();
-    }
-    horizontal.series = vec![
-        Series::new("flexmech", t.clone(), u.iter().map(|d| d[1]).collect()),
-        Series::new("independent run", tt.clone(), ty),
-    ];
-    vertical.series = vec![
-        Series::new("flexmech", t, u.iter().map(|d| d[2]).collect()),
-        Series::new("independent run", tt, tz),
-    ];
+    let title = titles.then(|| "Rotating shaft through its critical speed".to_string());
     Ok(Outcome {
         rows,
-        chart: Panels::row(vec![horizontal, vertical]),
+        chart: against_twin(title, &t, &u, &twin, ["horizontal u_y", "vertical u_z"]),
     })
 }
