@@ -8,10 +8,15 @@ the link, 5 on the crank), driver, integrator (generalized-alpha, rho_inf =
 strip's mid-span node) as the model file. Writes the mid-span node's
 displacement every 2e-3 s as CSV (t, ux, uy, uz).
 
-    python3 -m venv sef && sef/bin/pip install "numpy<1.24" "scipy<1.12" h5py
+    python3.11 -m venv sef && sef/bin/pip install "numpy<1.24" "scipy<1.12" h5py   # Python <= 3.11
     git clone https://github.com/vspsonn/mb_sef_py && git -C mb_sef_py checkout ed99143
     PYTHONPATH=mb_sef_py sef/bin/python benches/sef/lateral_buckling.py \
         [--strip-elements 20] [--csv out.csv]
+
+--strip-elements must be even (half on each side of the mid-span node). About
+a minute per run (20 elements) on one core. The CSV has the columns of
+data/benchmarks/reference/lateral_buckling_twin.csv, without its comment
+lines (which say where it came from); compare the two with any CSV tool.
 
 The library's default Newton tolerance (1e-6 of the force norm, about 0.3 N
 here) would seed the buckling with residual forces larger than the

@@ -8,12 +8,14 @@ cylindrical joint along x at x = 6), speed profile, gravity, integrator
 (generalized-alpha, rho_inf = 0, h = 1e-4, 2.5 s) as the model file. Writes
 the mid-span node's displacement every 1e-3 s as CSV (t, ux, uy, uz).
 
-    python3 -m venv sef && sef/bin/pip install "numpy<1.24" "scipy<1.12" h5py
+    python3.11 -m venv sef && sef/bin/pip install "numpy<1.24" "scipy<1.12" h5py   # Python <= 3.11
     git clone https://github.com/vspsonn/mb_sef_py && git -C mb_sef_py checkout ed99143
     PYTHONPATH=mb_sef_py sef/bin/python benches/sef/rotating_shaft.py [--t-end 2.5] [--csv out.csv]
 
 The library stores its logs in single precision (about 7 digits). Takes
-about an hour (25 000 steps).
+about 35 minutes on one core (25 000 steps). The CSV has the columns of
+data/benchmarks/reference/rotating_shaft_twin.csv (which keeps every second
+row), without its comment lines.
 """
 import argparse
 import os

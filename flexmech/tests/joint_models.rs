@@ -322,4 +322,10 @@ fn a_ball_on_an_arm_passes_its_force_at_the_arm_s_end() {
         err.contains("joint[0].slave") && err.contains("ball"),
         "{err}"
     );
+    // Its fix is the arm that puts the ball where the slave is, not an angle
+    // (a spherical joint has none).
+    assert!(
+        err.contains("`arm = [0.0, 0.1") && !err.contains("`angle`"),
+        "{err}"
+    );
 }

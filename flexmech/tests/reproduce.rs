@@ -265,6 +265,16 @@ fn the_benchmark_set_is_charted_and_tabled() {
     assert_eq!(md.lines().count(), 2 + report.rows.len());
     assert!(md.lines().skip(2).all(|l| l.matches(" | ").count() == 6));
     assert!(!md.contains("NaN"), "{md}");
+    // The book prints this table: it must be what the command writes.
+    let book = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/book/benchmarks.md"),
+    )
+    .unwrap();
+    assert!(
+        book.contains(md.trim_end()),
+        "docs/book/benchmarks.md's table differs from `flexmech reproduce --benchmarks`'s; \
+         paste DIR/benchmarks/table.md into it:\n{md}"
+    );
     let csv = std::fs::read_to_string(&report.table.1).unwrap();
     assert_eq!(csv.lines().count(), 1 + report.rows.len());
     for benchmark in [

@@ -271,19 +271,59 @@ fn refused(model: &Model, key: String, e: BuildError) -> ModelError {
             format!(
                 "joint `{joint}`: the slave `{}` starts at {} but the master `{}` plus the \
                  released translation at the initial angle puts it at {} (off by {gap:.3e}); \
-                 move the beam, or set the joint's `angle`",
+                 {}",
                 label(spec.map(|s| s.slave)),
                 p(at),
                 spec.map_or_else(String::new, |s| match s.master {
                     Some(m) => model.node_label(m),
                     None => "ground".into(),
                 }),
-                p(expected)
+                p(expected),
+                slave_off_fix(spec, at, expected)
             )
         }
         other => other.to_string(),
     };
     ModelError::new(&model.path, key, None, message)
+}
+
+/// The fix a misplaced slave's message offers for its joint's kind: the
+/// `angle` of a kind that has one, the `arm` (with the value that puts the
+/// ball where the slave is) of a spherical joint, else moving the beam.
+fn slave_off_fix(spec: Option<&crate::JointSpec>, at: &[f64; 3], expected: &[f64; 3]) -> String {
+    let Some(kind) = spec.map(|s| &s.kind) else {
+        return "move the beam".into();
+    };
+    if kind.has_angle() {
+        return "move the beam, or set the joint's `angle`".into();
+    }
+    if kind.type_name() != "spherical" {
+        return "move the beam to where the joint places the slave".into();
+    }
+    let arm: Vec<f64> = match kind.params().get("arm").and_then(|v| v.as_array()) {
+        Some(a) => a
+            .iter()
+            .map(|v| {
+                v.as_float()
+                    .or(v.as_integer().map(|i| i as f64))
+                    .unwrap_or(0.0)
+            })
+            .collect(),
+        None => vec![0.0; 3],
+    };
+    let needed: Vec<String> = (0..3)
+        .map(|i| {
+            format!(
+                "{:?}",
+                at[i] - expected[i] + arm.get(i).copied().unwrap_or(0.0)
+            )
+        })
+        .collect();
+    format!(
+        "move the beam, or put the ball on an arm of the master: `arm = [{}]` (the slave's \
+         offset from the master node)",
+        needed.join(", ")
+    )
 }
 
 /// Builds the mechanism of `model` through the [`MechanismBuilder`], whose

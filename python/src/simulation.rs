@@ -171,7 +171,7 @@ impl PySimulation {
         let mech = &self.stepper.borrow_owner().mechanism;
         self.checks.push(mech, &record);
         self.count += 1;
-        if self.count.is_multiple_of(self.model.output.every.max(1)) {
+        if flexmech::results::run::is_kept(self.count, self.model.output.every) {
             self.pending = None;
             self.kept.push(record);
         } else {

@@ -208,6 +208,14 @@ impl RunError {
     }
 }
 
+/// Whether a run keeps its `count`-th record (from 1) under `[output]
+/// every`: the first (the initial state, or a restart's checkpoint) and
+/// every `every`-th after it — times 0, every·Δt, 2·every·Δt, … (the last
+/// is kept besides, at the end).
+pub fn is_kept(count: usize, every: usize) -> bool {
+    count.saturating_sub(1).is_multiple_of(every.max(1))
+}
+
 /// Between the solver and the sink: keeps the first record, every
 /// `every`-th after it and always the last one, and watches every converged step (energy balance,
 /// stability, figures of merit).
@@ -241,9 +249,7 @@ impl Keeper<'_> {
         if self.error.is_some() {
             return false;
         }
-        // The first record (the initial state) and every `every`-th after it:
-        // times 0, every·Δt, 2·every·Δt, … (and the last, flushed at the end).
-        if (self.count - 1).is_multiple_of(self.every) {
+        if is_kept(self.count, self.every) {
             self.pending = None;
             self.give(step)
         } else {
