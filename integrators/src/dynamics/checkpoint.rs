@@ -187,6 +187,11 @@ impl Tape {
     }
 
     /// Refuses values left over.
+    /// Whether every saved value has been read.
+    pub(crate) fn is_done(&self) -> bool {
+        self.at == self.data.len()
+    }
+
     pub(crate) fn done(&self) -> Result<(), CheckpointMismatch> {
         if self.at == self.data.len() {
             Ok(())

@@ -154,18 +154,7 @@ impl MidpointTerms {
     ) -> Self {
         let slots = MassSlots::new(asm, &topo.dofs, &inertia);
         let (v_n, w_n) = slave_velocities(mech, topo, state, initial);
-        let rates = mech
-            .joints
-            .iter()
-            .enumerate()
-            .map(|(j, joint)| {
-                let mut rate = vec![0.0; joint.map.released_count()];
-                if let Some(r0) = rate.first_mut() {
-                    *r0 = initial.joint_rates.get(j).copied().unwrap_or(0.0);
-                }
-                rate
-            })
-            .collect();
+        let rates = initial_released_rates(mech, initial);
         Self {
             inertia,
             slots,
@@ -380,10 +369,26 @@ impl TimeScheme for MidpointTerms {
     }
 }
 
+/// Every joint's released rates at t = 0: the model's initial rate of the
+/// first coordinate (the angle), zero for the others.
+pub(super) fn initial_released_rates(mech: &Mechanism, initial: &Motion) -> Vec<Vec<f64>> {
+    mech.joints
+        .iter()
+        .enumerate()
+        .map(|(j, joint)| {
+            let mut rate = vec![0.0; joint.map.released_count()];
+            if let Some(r0) = rate.first_mut() {
+                *r0 = initial.joint_rates.get(j).copied().unwrap_or(0.0);
+            }
+            rate
+        })
+        .collect()
+}
+
 /// The rate of a joint's released coordinates over a step: additive
 /// coordinates by their difference, a multiplicative released rotation by
 /// the spin between its two values.
-fn released_rate(
+pub(super) fn released_rate(
     a: &flexmech_joints::ReleasedState,
     b: &flexmech_joints::ReleasedState,
     count: usize,

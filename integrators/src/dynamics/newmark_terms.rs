@@ -209,6 +209,10 @@ pub(crate) struct NewmarkTerms {
     pub(super) prev: Kinematics,
     /// The joints' initial rates (of their first released coordinate).
     pub(super) initial_rates: Vec<f64>,
+    /// Every joint's released rates over the last step (its coordinates'
+    /// increments over the step size): the predictor carries them on, as
+    /// it carries the nodes' velocities.
+    rates: Vec<Vec<f64>>,
     pub(super) dt: f64,
     /// The drivers' reactions at the end of the last accepted step.
     reactions: Option<(Vec<Vec<f64>>, Vec<f64>)>,
@@ -260,6 +264,7 @@ impl NewmarkTerms {
             dt: f64::NAN,
             reactions: None,
             initial_rates: initial.joint_rates.clone(),
+            rates: super::midpoint::initial_released_rates(mech, initial),
         }
     }
 }
@@ -371,6 +376,10 @@ impl TimeScheme for NewmarkTerms {
         (&self.prev.v, &self.prev.w)
     }
 
+    fn joint_rates(&self) -> &[Vec<f64>] {
+        &self.rates
+    }
+
     fn mass(&self) -> &Inertia {
         &self.inertia
     }
@@ -406,6 +415,10 @@ impl TimeScheme for NewmarkTerms {
         }
         if !self.damped.is_empty() {
             tape.put(self.dissipated);
+        }
+        tape.put(self.rates.len() as f64);
+        for r in &self.rates {
+            tape.put_list(r);
         }
     }
 
@@ -451,6 +464,18 @@ impl TimeScheme for NewmarkTerms {
         if !self.damped.is_empty() {
             self.dissipated = tape.take()?;
         }
+        // Checkpoints written before the released rates were carried end
+        // here: the predictor then starts the joints from rest.
+        if !tape.is_done() {
+            let joints = tape.take_count("joints", Some(mech.joints.len()))?;
+            self.rates = (0..joints)
+                .map(|j| {
+                    tape.take_list("a joint's rates", Some(mech.joints[j].map.released_count()))
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+        } else {
+            self.rates.iter_mut().flatten().for_each(|r| *r = 0.0);
+        }
         tape.done()
     }
 
@@ -493,6 +518,15 @@ impl TimeScheme for NewmarkTerms {
             })
             .sum();
         sys.terms.dissipated += damping;
+        for (j, rate) in sys.terms.rates.iter_mut().enumerate() {
+            let count = rate.len();
+            *rate = super::midpoint::released_rate(
+                &sys.start.released[j],
+                &sys.end.released[j],
+                count,
+                dt,
+            );
+        }
         let (kin, k) = (&mut sys.terms.prev, &sys.terms.coefficients);
         for i in 0..start.x.len() {
             let a1 = pseudo_acceleration(k, end.x[i] - start.x[i], &kin.v[i], &kin.a[i], dt);
