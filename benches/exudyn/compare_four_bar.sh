@@ -20,7 +20,7 @@ scale="${1:-1}"; tend="${2:-12}"; rounds="${3:-3}"
 scaled_models "$here/../../data/benchmarks/four_bar_tacs.toml" "$scale" "$tend" four_bar
 
 echo "four-bar: element scale $scale ($((8 * scale))/$((16 * scale))/$((8 * scale)) elements), t_end $tend, dt 1e-2, $rounds rounds, one thread each"
-paired_rounds "$rounds" "$out/four_bar_tacs.toml" "$out/modified.toml" "$here/four_bar.py" --elements-scale "$scale" --t-end "$tend"
+paired_rounds "$rounds" "$out/four_bar.toml" "$out/modified.toml" "$here/four_bar.py" --elements-scale "$scale" --t-end "$tend"
 echo "flexmech: $(head -1 "$out/a.log")"
 echo "flexmech modified: $(head -1 "$out/m.log")"
 grep -h '^exudyn' "$out/b.log" "$out/c.log"

@@ -416,12 +416,22 @@ impl Series {
         path: &Path,
     ) -> Result<(), ResultError> {
         self.set_rows(t + blocks.len(), path)?;
-        for (k, block) in blocks.iter().enumerate() {
-            self.ds
-                .write_slice::<_, f64, _, _>(*block, (t + k, .., ..))
-                .ctx(path, || format!("writing row {} of {}", t + k, self.name))?;
-        }
-        Ok(())
+        let Some(n) = blocks.first().map(|b| b.len()) else {
+            return Ok(());
+        };
+        // One contiguous slab for all the rows: one write, not one per row.
+        let flat: Vec<f64> = blocks
+            .iter()
+            .flat_map(|b| b.iter().flatten())
+            .copied()
+            .collect();
+        let rows = || format!("writing rows {t}.. of {}", self.name);
+        let view = ndarray::ArrayView3::from_shape((blocks.len(), n, N), &flat)
+            .map_err(|e| hdf5::Error::from(e.to_string()))
+            .ctx(path, rows)?;
+        self.ds
+            .write_slice(view, (t..t + blocks.len(), .., ..))
+            .ctx(path, rows)
     }
 }
 
