@@ -34,7 +34,9 @@ def flexmech(path):
         return f['/time'][:], np.column_stack([f['/nodes/bar2.end/position'][:],
             F[:, n1 // 2, 0], M[:, n1 + n2 + n3 // 2, 1:3]])
 t, a = flexmech(sys.argv[1])
-_, m = flexmech(sys.argv[2])
+tm, m = flexmech(sys.argv[2])
+# A run that halved a step stores the extra times too: compare on A's grid.
+m = m[[int(np.argmin(np.abs(tm - ti))) for ti in t]]
 names = ['x_C', 'y_C', 'z_C', 'N bar 1', 'M2 bar 3', 'M3 bar 3']
 def row(label, b):
     # in-plane positions against the bar length 0.12, the rest against their amplitude

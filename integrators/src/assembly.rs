@@ -562,9 +562,40 @@ fn reduce_tangent(w: &mut Work, el: &Element, dofs: &DofMap, s: &Slots) {
             }
         }
     }
-    w.tmp.gemm(1.0, &w.k, &w.g, 0.0);
+    times_sparse(&w.k, &w.g, &mut w.tmp);
     let rows = if split { &w.g_row } else { &w.g };
-    w.k_red.gemm_tr(1.0, rows, &w.tmp, 0.0);
+    sparse_tr_times(rows, &w.tmp, &mut w.k_red);
+}
+
+/// `out = k g` for a map `g` whose columns are a node's few entries each:
+/// the zeros of `g` skipped (an element's maps are 12–18 × 12–14 with one
+/// or two nonzero 6-blocks per column, where a general product pays its
+/// packing for nothing).
+fn times_sparse(k: &DMatrix<f64>, g: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    out.fill(0.0);
+    for j in 0..g.ncols() {
+        for (r, &v) in g.column(j).iter().enumerate() {
+            if v != 0.0 {
+                out.column_mut(j).axpy(v, &k.column(r), 1.0);
+            }
+        }
+    }
+}
+
+/// `out = gᵀ t` for a map `g` as in [`times_sparse`], its zeros skipped.
+fn sparse_tr_times(g: &DMatrix<f64>, t: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    for i in 0..g.ncols() {
+        let gi = g.column(i);
+        for j in 0..t.ncols() {
+            let tj = t.column(j);
+            out[(i, j)] = gi
+                .iter()
+                .zip(tj.iter())
+                .filter(|(a, _)| **a != 0.0)
+                .map(|(a, b)| a * b)
+                .sum();
+        }
+    }
 }
 
 /// An element's forces `r` (6 per node, ordered as its nodes) as
@@ -712,4 +743,37 @@ fn scratch_for(scratch: &mut [Work], dofs: usize) -> &mut Work {
         .position(|w| w.r.len() == dofs)
         .unwrap_or_default();
     &mut scratch[i]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A map like an element's: 12 rows, columns with one or two nonzero
+    /// 6-blocks (a node's column, or a slave's and its master's).
+    fn map(m: usize) -> DMatrix<f64> {
+        DMatrix::from_fn(12, m, |r, j| {
+            let block = r / 6;
+            let hit = block == j % 2 || j % 3 == 0;
+            if hit && (r + j) % 4 != 1 {
+                ((r * 7 + j * 3) % 11) as f64 - 5.0
+            } else {
+                0.0
+            }
+        })
+    }
+
+    #[test]
+    fn the_sparse_map_products_equal_the_dense_ones() {
+        let k = DMatrix::from_fn(12, 12, |r, c| ((r * 13 + c * 5) % 17) as f64 - 8.0);
+        for m in [1, 7, 14] {
+            let (g, rows) = (map(m), map(m).map(|v| 0.5 * v));
+            let mut t = DMatrix::zeros(12, m);
+            times_sparse(&k, &g, &mut t);
+            assert_eq!(t, &k * &g);
+            let mut out = DMatrix::zeros(m, m);
+            sparse_tr_times(&rows, &t, &mut out);
+            assert_eq!(out, rows.transpose() * &t);
+        }
+    }
 }

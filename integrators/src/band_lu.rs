@@ -117,6 +117,14 @@ impl BandStructure {
         for (new, &old) in order.iter().enumerate() {
             perm[old] = new;
         }
+        Self::with_perm(pattern, perm)
+    }
+
+    /// The bandwidths of `pattern` renumbered by `perm` (`perm[i]`: the new
+    /// index of unknown `i`).
+    pub fn with_perm(pattern: &SymbolicSparseColMat<usize>, perm: Vec<usize>) -> Self {
+        let n = pattern.nrows();
+        let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
         let (mut kl, mut ku) = (0, 0);
         for j in 0..n {
             for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
@@ -167,6 +175,11 @@ pub struct BandLu {
     /// Equilibrating scale of each row of the band storage, following the
     /// row interchanges during a factorisation.
     row_scale: Vec<f64>,
+    /// The equilibrating scale of each column (of each unknown, renumbered).
+    col_scale: Vec<f64>,
+    /// The smallest and largest equilibrated pivot `|uⱼⱼ| dᵣ dⱼ` of the last
+    /// factorisation (`dᵣ` the scale of the pivot's row).
+    pivot_range: (f64, f64),
     /// Upper bandwidth of the last factors: `ku` plus the farthest row
     /// interchange (beyond `ku`, the last factorisation wrote into the rows
     /// kept for the fill of interchanges, which the next must clear).
@@ -205,6 +218,8 @@ impl BandLu {
             columns,
             diagonal,
             row_scale: vec![1.0; n],
+            col_scale: vec![1.0; n],
+            pivot_range: (0.0, 0.0),
             u_width: band.ku,
             work: vec![0.0; n],
             band,
@@ -221,6 +236,7 @@ impl BandLu {
         for (&p, d) in self.band.perm.iter().zip(equilibrating_scale(&diag)) {
             self.row_scale[p] = d;
         }
+        self.col_scale.copy_from_slice(&self.row_scale);
     }
 
     /// Factorises the matrix with the pattern's `values` (CSC order):
@@ -237,6 +253,7 @@ impl BandLu {
         let from = if self.u_width > ku { 0 } else { kl };
         let (ab, d, piv) = (&mut self.ab, &mut self.row_scale, &mut self.piv);
         let mut farthest = 0usize;
+        let (mut smallest, mut largest_pivot) = (f64::INFINITY, 0.0f64);
         for c in 0..n {
             // Row r of column c at kv + r − c of its storage.
             let (done, rest) = ab.split_at_mut(c * ld);
@@ -292,7 +309,8 @@ impl BandLu {
                 }
             }
             piv[c] = c + jp;
-            if best == 0.0 {
+            if best == 0.0 || !best.is_finite() {
+                smallest = 0.0;
                 continue;
             }
             if jp != 0 {
@@ -303,26 +321,52 @@ impl BandLu {
                 d.swap(c, c + jp);
                 farthest = farthest.max(jp);
             }
+            let pivot = column[kv].abs() * d[c] * self.col_scale[c];
+            smallest = smallest.min(pivot);
+            largest_pivot = largest_pivot.max(pivot);
             let reciprocal = 1.0 / column[kv];
             column[kv + 1..=kv + km]
                 .iter_mut()
                 .for_each(|v| *v *= reciprocal);
         }
         self.u_width = ku + farthest;
+        self.pivot_range = (smallest, largest_pivot);
+    }
+
+    /// The smallest equilibrated pivot of the last factorisation over its
+    /// largest (0 for a zero or non-finite pivot, 1 for no unknowns).
+    pub fn pivot_ratio(&self) -> f64 {
+        let (smallest, largest) = self.pivot_range;
+        if smallest == f64::INFINITY {
+            1.0
+        } else if largest > 0.0 && largest.is_finite() {
+            smallest / largest
+        } else {
+            0.0
+        }
     }
 
     /// Solves `A x = rhs` in place with the last factorisation.
     pub fn solve(&mut self, rhs: &mut [f64]) {
-        let n = self.piv.len();
-        let (kl, ku, ld) = (self.band.kl, self.band.ku, self.ld);
-        let kv = kl + ku;
-        let b = &mut self.work;
+        let mut b = std::mem::take(&mut self.work);
         for (i, &p) in self.band.perm.iter().enumerate() {
             b[p] = rhs[i];
         }
-        // L: unit lower, multipliers below the diagonal, interchanges
-        // first.
-        for j in 0..n {
+        self.forward(&mut b, 0);
+        self.backward(&mut b);
+        for (i, &p) in self.band.perm.iter().enumerate() {
+            rhs[i] = b[p];
+        }
+        self.work = b;
+    }
+
+    /// `b ← L⁻¹ P b` in the renumbered unknowns (the interchanges and the
+    /// unit lower factor), for a `b` that is zero above row `from + kl`:
+    /// the steps before `from` neither move nor change it.
+    pub(crate) fn forward(&self, b: &mut [f64], from: usize) {
+        let n = self.piv.len();
+        let (kl, kv, ld) = (self.band.kl, self.band.kl + self.band.ku, self.ld);
+        for j in from..n {
             let l = self.piv[j];
             if l != j {
                 b.swap(l, j);
@@ -332,17 +376,53 @@ impl BandLu {
             let bj = b[j];
             subtract_multiple(&mut b[j + 1..=j + km], &self.ab[col + 1..=col + km], bj);
         }
-        // U: upper bandwidth ku plus the farthest interchange (≤ kl + ku).
-        for j in (0..n).rev() {
+    }
+
+    /// `b ← U⁻¹ b` in the renumbered unknowns: upper bandwidth `ku` plus the
+    /// farthest interchange (≤ `kl + ku`).
+    pub(crate) fn backward(&self, b: &mut [f64]) {
+        let (kv, ld) = (self.band.kl + self.band.ku, self.ld);
+        for j in (0..self.piv.len()).rev() {
             let col = j * ld + kv;
             b[j] /= self.ab[col];
             let bj = b[j];
             let top = j.saturating_sub(self.u_width);
             subtract_multiple(&mut b[top..j], &self.ab[col + top - j..col], bj);
         }
-        for (i, &p) in self.band.perm.iter().enumerate() {
-            rhs[i] = b[p];
+    }
+
+    /// `y ← y U⁻¹` (the row vector `y` solving `y U = a`, `a` given in `y`)
+    /// in the renumbered unknowns, for an `a` that is zero before column
+    /// `from` (so is `y`).
+    pub(crate) fn row_backward(&self, y: &mut [f64], from: usize) {
+        let (kv, ld) = (self.band.kl + self.band.ku, self.ld);
+        for j in from..self.piv.len() {
+            let col = j * ld + kv;
+            let top = j.saturating_sub(self.u_width).max(from);
+            let u = &self.ab[col + top - j..col];
+            let t: f64 = y[top..j].iter().zip(u).map(|(a, b)| a * b).sum();
+            y[j] = (y[j] - t) / self.ab[col];
         }
+    }
+
+    /// Whether every pivot of the last factorisation is finite and
+    /// nonzero (else a solve gives non-finite values).
+    pub(crate) fn pivots_regular(&self) -> bool {
+        let kv = self.band.kl + self.band.ku;
+        (0..self.piv.len()).all(|j| {
+            let p = self.ab[j * self.ld + kv];
+            p != 0.0 && p.is_finite()
+        })
+    }
+
+    /// The unknowns' count.
+    pub(crate) fn len(&self) -> usize {
+        self.piv.len()
+    }
+
+    /// The renumbering and bandwidths the factorisation works in.
+    pub(crate) fn structure(&self) -> &BandStructure {
+        &self.band
     }
 }
 

@@ -184,30 +184,26 @@ impl Topology {
         }
     }
 
-    /// The local-to-global map of joint `j`: rows 0..6 the master's node map
-    /// (its rows when `rows`, else its columns), rows 6.. the released
-    /// coordinates; columns follow `local_eqs[j]`.
-    fn local_map(&self, mech: &Mechanism, j: usize, rows: bool) -> DMatrix<f64> {
-        let joint = &mech.joints[j];
-        let eqs = &self.local_eqs[j];
-        let mut l = DMatrix::zeros(LOCAL, eqs.len());
-        let master = &self.dofs.nodes[joint.master];
+    /// The local-to-global map of joint `j`, one entry per column (following
+    /// `local_eqs[j]`): the master's node map (its rows when `rows`, else
+    /// its columns) in local rows 0..6, then the released coordinates, each
+    /// the unit vector of its local row `6 + c`.
+    fn local_map<'a>(&'a self, mech: &Mechanism, j: usize, rows: bool) -> Vec<LocalColumn<'a>> {
+        let master = &self.dofs.nodes[mech.joints[j].master];
         let map = if rows {
             master.rows()
         } else {
             &master.cols[..]
         };
-        for (k, col) in map.iter().enumerate() {
-            l.fixed_view_mut::<6, 1>(0, k).copy_from(col);
-        }
-        let mut k = master.eqs.len();
-        for (c, eq) in self.released_eqs[j].iter().enumerate() {
-            if eq.is_some() {
-                l[(6 + c, k)] = 1.0;
-                k += 1;
-            }
-        }
-        l
+        let released = self.released_eqs[j].iter().enumerate();
+        map.iter()
+            .map(LocalColumn::Node)
+            .chain(
+                released
+                    .filter(|(_, eq)| eq.is_some())
+                    .map(|(c, _)| LocalColumn::Released(6 + c)),
+            )
+            .collect()
     }
 
     /// The joints' contribution to the reduced tangent, `Σ_j L_jᵀ ∂(N_jᵀ g_s)/∂q L_j`,
@@ -284,8 +280,7 @@ impl Topology {
                 self.local_map(mech, j, rows),
                 self.local_map(mech, j, false),
             );
-            let hd = DMatrix::from_column_slice(LOCAL, LOCAL, h.as_slice());
-            blocks[j] = lr.transpose() * hd * &lc;
+            blocks[j] = triple_product(&lr, &h, &lc);
         }
         blocks
     }
@@ -637,4 +632,80 @@ pub fn joint_records(mech: &Mechanism, state: &MechanismState) -> Vec<JointRecor
             }
         })
         .collect()
+}
+
+/// One column of a joint's local-to-global map ([`Topology::local_map`]).
+#[derive(Debug, Clone, Copy)]
+enum LocalColumn<'a> {
+    /// A column of the master's node map, in local rows 0..6.
+    Node(&'a Vector6<f64>),
+    /// The unit vector of one local row (a released coordinate's).
+    Released(usize),
+}
+
+impl LocalColumn<'_> {
+    /// `h · self` for a local `h` (`LOCAL` rows and columns).
+    fn times(&self, h: &SMatrix<f64, LOCAL, LOCAL>) -> SVector<f64, LOCAL> {
+        match *self {
+            LocalColumn::Node(col) => h.fixed_columns::<6>(0) * col,
+            LocalColumn::Released(r) => h.column(r).into_owned(),
+        }
+    }
+
+    /// `selfᵀ · v` for a local `v`.
+    fn dot(&self, v: &SVector<f64, LOCAL>) -> f64 {
+        match *self {
+            LocalColumn::Node(col) => col.dot(&v.fixed_rows::<6>(0)),
+            LocalColumn::Released(r) => v[r],
+        }
+    }
+}
+
+/// `Lᵣᵀ h L_c` of a joint's local block `h` through its maps (dense, as
+/// many rows as `lr` and columns as `lc`): each column of `h L_c` once, then
+/// its dot products — a few hundred flops, where general matrix products
+/// cost their packing and dispatch.
+fn triple_product(
+    lr: &[LocalColumn<'_>],
+    h: &SMatrix<f64, LOCAL, LOCAL>,
+    lc: &[LocalColumn<'_>],
+) -> DMatrix<f64> {
+    let mut out = DMatrix::zeros(lr.len(), lc.len());
+    for (b, col) in lc.iter().enumerate() {
+        let hc = col.times(h);
+        for (a, row) in lr.iter().enumerate() {
+            out[(a, b)] = row.dot(&hc);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_joint_block_product_equals_the_dense_one() {
+        let h = SMatrix::<f64, LOCAL, LOCAL>::from_fn(|r, c| ((r * 7 + c * 3) % 13) as f64 - 6.0);
+        let (c1, c2) = (
+            Vector6::new(1.0, 0.0, -2.0, 0.5, 0.0, 3.0),
+            Vector6::new(0.0, 1.5, 0.0, 0.0, -1.0, 0.0),
+        );
+        let dense = |cols: &[LocalColumn<'_>]| {
+            DMatrix::from_fn(LOCAL, cols.len(), |r, k| match cols[k] {
+                LocalColumn::Node(v) if r < 6 => v[r],
+                LocalColumn::Released(row) if r == row => 1.0,
+                _ => 0.0,
+            })
+        };
+        let lr = [LocalColumn::Node(&c1), LocalColumn::Released(6)];
+        let lc = [
+            LocalColumn::Node(&c2),
+            LocalColumn::Node(&c1),
+            LocalColumn::Released(LOCAL - 1),
+        ];
+        let hd = DMatrix::from_column_slice(LOCAL, LOCAL, h.as_slice());
+        let expected = dense(&lr).transpose() * hd * dense(&lc);
+        assert!((triple_product(&lr, &h, &lc) - expected).amax() < 1e-12);
+    }
 }

@@ -7,6 +7,7 @@
 pub mod arc_length;
 pub mod assembly;
 pub mod band_lu;
+pub mod band_split;
 pub mod builder;
 pub mod constraints;
 pub mod critical;

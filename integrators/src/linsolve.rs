@@ -4,8 +4,9 @@
 //! per pattern: a band LU after a reverse Cuthill–McKee renumbering
 //! ([`crate::band_lu`]) when the band is narrow — beam mechanisms, where it
 //! measured several times faster — and faer's general sparse LU otherwise.
-//! Sequential inside, so results do not depend on the thread count; the
-//! parallelism lives in assembly.
+//! A long band is factorised in two halves at once
+//! ([`crate::band_split`]); the operations are the same for any number of
+//! threads, so results do not depend on the thread count.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
@@ -13,6 +14,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par};
 
 use crate::band_lu::{equilibrating_scale, BandLu, BandStructure};
+use crate::band_split::{SplitBandLu, SPLIT_MIN_UNKNOWNS};
 
 /// A matrix in a solver's pattern: its values with the pattern.
 #[derive(Clone, Copy)]
@@ -66,6 +68,11 @@ impl TangentRef<'_> {
     }
 }
 
+/// Smallest equilibrated pivot, as a fraction of the largest, that leaves
+/// a converged solve's condition estimate out
+/// ([`crate::tolerances::Tolerances::pivot_alarm`]).
+pub const PIVOT_ALARM: f64 = crate::tolerances::TOLERANCES.pivot_alarm;
+
 /// Largest band storage, relative to the pattern's stored entries, for which
 /// the band backend is chosen: beyond it the band's zeros cost more than a
 /// general sparse LU's bookkeeping.
@@ -82,6 +89,8 @@ struct GeneralLu {
 /// The factorisation a solver uses for its pattern.
 enum Backend {
     Band(Box<BandLu>),
+    /// A long band in two halves ([`crate::band_split`]).
+    Split(Box<SplitBandLu>),
     General(Box<GeneralLu>),
 }
 
@@ -100,10 +109,16 @@ pub struct SparseLu {
 impl SparseLu {
     /// Analysis of a square pattern: the band backend when the renumbered
     /// band's storage is at most [`BAND_STORAGE_RATIO`] times the pattern's
-    /// entries, faer's general sparse LU otherwise.
+    /// entries — in two halves from [`SPLIT_MIN_UNKNOWNS`] unknowns on —,
+    /// faer's general sparse LU otherwise.
     pub fn new(pattern: SymbolicSparseColMat<usize>) -> Result<Self, String> {
         let band = BandStructure::of(&pattern);
         if band.fits() && band.storage() <= BAND_STORAGE_RATIO * pattern.row_idx().len().max(1) {
+            if pattern.nrows() >= SPLIT_MIN_UNKNOWNS {
+                if let Some(lu) = SplitBandLu::new(&pattern, band.clone()) {
+                    return Ok(Self::with(pattern, Backend::Split(Box::new(lu))));
+                }
+            }
             let lu = BandLu::new(&pattern, band);
             return Ok(Self::with(pattern, Backend::Band(Box::new(lu))));
         }
@@ -138,7 +153,7 @@ impl SparseLu {
 
     /// Whether this solver uses the band backend.
     pub fn is_band(&self) -> bool {
-        matches!(self.backend, Backend::Band(_))
+        matches!(self.backend, Backend::Band(_) | Backend::Split(_))
     }
 
     /// The pattern the solver was built for.
@@ -153,6 +168,7 @@ impl SparseLu {
         self.key = f64::NAN;
         match &mut self.backend {
             Backend::Band(lu) => lu.factor(values),
+            Backend::Split(lu) => lu.factor(values),
             Backend::General(lu) => {
                 let mat = SparseColMatRef::new(self.pattern.as_ref(), values);
                 lu.symbolic
@@ -168,6 +184,19 @@ impl SparseLu {
         }
         self.factored = true;
         Ok(())
+    }
+
+    /// Whether the current factorisation's pivots say nothing against its
+    /// regularity: the band backends' smallest equilibrated pivot is above
+    /// [`PIVOT_ALARM`] of the largest. `false` for the general backend (it
+    /// does not say), where the condition estimate decides.
+    pub fn pivots_healthy(&self) -> bool {
+        self.factored
+            && match &self.backend {
+                Backend::Band(lu) => lu.pivot_ratio() > PIVOT_ALARM,
+                Backend::Split(lu) => lu.pivot_ratio() > PIVOT_ALARM,
+                Backend::General(_) => false,
+            }
     }
 
     /// The key its owner attached to the current factorisation
@@ -207,6 +236,7 @@ impl SparseLu {
         let n = rhs.len();
         match &mut self.backend {
             Backend::Band(lu) => lu.solve(rhs),
+            Backend::Split(lu) => lu.solve(rhs),
             Backend::General(lu) => {
                 faer::sparse::linalg::lu::LuRef::new_unchecked(&lu.symbolic, &lu.numeric)
                     .solve_in_place_with_conj(

@@ -176,7 +176,10 @@ pub struct NewtonReport {
 /// Runs Newton's method from the system's current iterate. `r` and `dq` are
 /// caller-owned scratch vectors of length `n_eq`. A singular tangent at the
 /// converged iterate ends it in [`NewtonFailure::Singular`] (two triangular
-/// solves estimate its condition number), and so does one at the start of
+/// solves estimate its condition number — left out where the last
+/// factorisation's pivots are all of a healthy size,
+/// [`SparseLu::pivots_healthy`]: a null direction leaves a round-off
+/// pivot), and so does one at the start of
 /// the solve — checked unless `lu` holds a factorisation checked regular
 /// by the previous solve ([`SparseLu::checked_regular`]: the solution it
 /// starts from was regular, and a tangent that turned singular since then
@@ -195,7 +198,13 @@ pub fn solve<S: NewtonSystem>(
     let start_checked = lu.checked_regular();
     let report = iterate(sys, lu, settings, start_checked, r, dq, &mut factored)?;
     if !settings.modified {
-        check_regular(sys, lu, factored, true)?;
+        // Pivots of a healthy size rule out the null direction the
+        // estimate looks for (see `PIVOT_ALARM`): its two solves are saved.
+        if factored && lu.pivots_healthy() {
+            lu.set_regular();
+        } else {
+            check_regular(sys, lu, factored, true)?;
+        }
     }
     Ok(report)
 }

@@ -8,17 +8,20 @@
 //! of many parallel tasks (a study's runs, [`one_thread_each`]), splitting
 //! its loops again only adds hand-offs between the same threads.
 //!
-//! Nor does a large mesh gain when its element kernels are cheap next to the
-//! rest of the step: a Newmark step of 2-node elements spends about a sixth
-//! of its time in the kernels (≈ 1 µs per element) and the rest in the band
-//! factorisation and the solves, which stay on one thread; splitting the
-//! kernels saved less than the hand-offs and the second busy core cost it
-//! (2 048 and 4 096 elements ran 1.00–1.07 × *slower* with two threads than
-//! with one). So an element loop is split only when its kernels, timed on
-//! one thread for the first few calls ([`LoopCost`]), cost at least
-//! [`PARALLEL_MIN_NS_PER_ELEMENT`] each: the energy–momentum scheme's exact
+//! Nor does a mid-sized mesh gain when its element kernels are cheap next to
+//! the rest of the step: a Newmark step of 2-node elements spends about a
+//! sixth of its time in the kernels (≈ 1 µs per element) and most of the
+//! rest in the band factorisation and the solves; with those on one thread,
+//! splitting the kernels saved less than the hand-offs and the second busy
+//! core cost it (2 048 and 4 096 elements ran 1.00–1.07 × *slower* with two
+//! threads than with one). So an element loop is split when its kernels,
+//! timed on one thread for the first few calls ([`LoopCost`]), cost at least
+//! [`PARALLEL_MIN_NS_PER_ELEMENT`] each — the energy–momentum scheme's exact
 //! tangent (≈ 24 µs, 1.5–1.6 × faster on two threads at 2 048 elements),
-//! 3-node elements (≈ 5 µs). Either way the sums are the same numbers.
+//! 3-node elements (≈ 5 µs) — or when the mesh is large enough
+//! ([`PARALLEL_ALWAYS_ELEMENTS`]) that its band LU is factorised in two
+//! halves at once as well ([`crate::band_split`]). Either way the sums are
+//! the same numbers.
 
 use std::cell::Cell;
 use std::thread::LocalKey;
@@ -30,6 +33,14 @@ pub const PARALLEL_MIN_ELEMENTS: usize = 64;
 /// Least time per element (ns) of an element loop's kernels, timed on one
 /// thread, for the loop to be split over threads.
 pub const PARALLEL_MIN_NS_PER_ELEMENT: f64 = 2000.0;
+
+/// Fewest elements for which a loop is split whatever its kernels cost:
+/// from here on the mesh's band LU is factorised in two halves too
+/// ([`crate::band_split::SPLIT_MIN_UNKNOWNS`] unknowns, 6 per node), so
+/// the whole step, not a sixth of it, runs on two threads (2-node
+/// cantilevers under Newmark on two threads: 512 elements 1.1 × slower
+/// split, 1 024 to 4 096 elements 1.1–1.2 × faster).
+pub const PARALLEL_ALWAYS_ELEMENTS: usize = 1024;
 
 /// One-thread calls timed before a loop's cost is known.
 const PROBE_CALLS: u32 = 3;
@@ -70,6 +81,22 @@ fn with_flag<R>(flag: &'static LocalKey<Cell<bool>>, task: impl FnOnce() -> R) -
     task()
 }
 
+/// Runs `a` and `b`, on two threads where there are two to use (not
+/// inside [`one_thread_each`], not on a one-thread pool), else one after
+/// the other — the same computations either way: for the two halves of a
+/// factorisation ([`crate::band_split`]), each far costlier than a hand-off.
+pub fn join<A: Send, B: Send>(
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    if sequential(usize::MAX) {
+        let ra = a();
+        (ra, b())
+    } else {
+        rayon::join(a, b)
+    }
+}
+
 /// Runs `task` with every element loop that may be split ([`sequential`]
 /// false) split over the threads whatever its kernels cost: for tests of
 /// the parallel paths with cheap kernels.
@@ -95,13 +122,14 @@ impl LoopCost {
     pub fn split(&self, elements: usize) -> bool {
         !sequential(elements)
             && (ALWAYS_SPLIT.with(Cell::get)
+                || elements >= PARALLEL_ALWAYS_ELEMENTS
                 || (self.probes >= PROBE_CALLS && self.best >= PARALLEL_MIN_NS_PER_ELEMENT))
     }
 
     /// Whether this one-thread call should be timed (the loop could be
     /// split and its cost is not known yet).
     pub fn probing(&self, elements: usize) -> bool {
-        !sequential(elements) && self.probes < PROBE_CALLS
+        !sequential(elements) && elements < PARALLEL_ALWAYS_ELEMENTS && self.probes < PROBE_CALLS
     }
 
     /// Records a timed one-thread call over `elements` elements.

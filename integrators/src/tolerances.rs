@@ -31,6 +31,13 @@ pub struct Tolerances {
     /// `κ ≳ 1/ε`; a slender cantilever of a thousand elements with
     /// `EA/EI = 10⁵` has `κ ≈ 10¹⁰`.
     pub singular_condition: f64,
+    /// A factorisation whose smallest equilibrated pivot is above this
+    /// fraction of its largest has its converged solve's singularity check
+    /// (a condition estimate, two more solves) left out: `10⁻⁹`. A null
+    /// direction leaves a pivot of round-off size (`≈ ε` of the largest) in
+    /// an elimination with pivoting, and `κ ≳ 1/ε`; the check refuses from
+    /// `κ > 1/(100 ε)` — five orders below this alarm.
+    pub pivot_alarm: f64,
     /// A run has reached its end (`t_end`, or the load factor 1) when it is
     /// within this fraction of it: `10⁻¹²` (round-off of summed steps).
     pub end_of_run: f64,
@@ -54,6 +61,7 @@ pub const TOLERANCES: Tolerances = Tolerances {
     inexact_contraction: 0.05,
     pivot_threshold: 0.1,
     singular_condition: 1.0 / (100.0 * f64::EPSILON),
+    pivot_alarm: 1e-9,
     end_of_run: 1e-12,
     level_snap: 1e-9,
     border_pivot: 1e-10,

@@ -267,6 +267,41 @@ fn energy_momentum_is_bitwise_deterministic_across_thread_counts() {
 }
 
 #[test]
+fn newmark_on_a_band_in_two_halves_is_bitwise_the_same_on_one_and_two_threads() {
+    use flexmech_integrators::band_split::SPLIT_MIN_UNKNOWNS;
+    use flexmech_integrators::threads::PARALLEL_ALWAYS_ELEMENTS;
+    // Six unknowns a node: the band LU goes in two halves at once, and the
+    // element loops are split whatever their kernels cost.
+    let elements = PARALLEL_ALWAYS_ELEMENTS.max(SPLIT_MIN_UNKNOWNS / 6 + 1);
+    let (mech, motion, mut settings) = spinning_beam_of(MassKind::Lumped, elements, 2);
+    settings.dt = 0.01;
+    settings.t_end = 0.03;
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut steps: Vec<StepRecord> = Vec::new();
+        pool.install(|| {
+            flexmech_integrators::dynamics::newmark::solve(&mech, &settings, &motion, |s| {
+                steps.push(s.clone())
+            })
+            .unwrap()
+        });
+        steps
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.len(), 4);
+    assert_eq!(one.len(), two.len());
+    for (a, b) in one.iter().zip(&two) {
+        assert_eq!(a.energy.total.to_bits(), b.energy.total.to_bits());
+        for (p, q) in a.positions.iter().zip(&b.positions) {
+            assert_eq!(p.map(f64::to_bits), q.map(f64::to_bits));
+        }
+    }
+}
+
+#[test]
 fn stored_times_are_multiples_of_the_step() {
     // Summing 0.1 ten times gives 0.9999999999999999; the stored times are
     // n·Δt exactly, in every integrator.

@@ -207,11 +207,38 @@ struct ReleasedDerivatives {
 }
 
 impl ReleasedDerivatives {
+    /// The derivatives of the joint's `r_R` and `Λ_R` at `state`, by dual
+    /// numbers with as many lanes as the joint releases coordinates (twice:
+    /// the first and the second increments), not [`MAX_RELEASED`]'s.
     fn of<J: JointKinematics>(joint: &J, state: &ReleasedState) -> Self {
-        type D = DualSVec64<{ 2 * MAX_RELEASED }>;
-        let a: [D; MAX_RELEASED] = std::array::from_fn(|i| D::from_re(0.0).derivative(i));
-        let b: [D; MAX_RELEASED] =
-            std::array::from_fn(|i| D::from_re(0.0).derivative(MAX_RELEASED + i));
+        match released_count::<J>() {
+            0 => Self::of_in::<J, 0, 0>(joint, state),
+            1 => Self::of_in::<J, 1, 2>(joint, state),
+            2 => Self::of_in::<J, 2, 4>(joint, state),
+            3 => Self::of_in::<J, 3, 6>(joint, state),
+            _ => Self::of_in::<J, MAX_RELEASED, { 2 * MAX_RELEASED }>(joint, state),
+        }
+    }
+
+    /// [`Self::of`] over `N` released coordinates, `L = 2N` dual lanes: lane
+    /// `i` the first increment of coordinate `i`, lane `N + i` its second.
+    fn of_in<J: JointKinematics, const N: usize, const L: usize>(
+        joint: &J,
+        state: &ReleasedState,
+    ) -> Self {
+        type D<const L: usize> = DualSVec64<L>;
+        let lane = |i: usize| {
+            let x = D::<L>::from_re(0.0);
+            if i < L {
+                x.derivative(i)
+            } else {
+                x
+            }
+        };
+        let a: [D<L>; MAX_RELEASED] =
+            std::array::from_fn(|i| if i < N { lane(i) } else { lane(L) });
+        let b: [D<L>; MAX_RELEASED] =
+            std::array::from_fn(|i| if i < N { lane(N + i) } else { lane(L) });
         let (rr, lr) = joint.released_at_state(
             state,
             Increments {
@@ -219,7 +246,7 @@ impl ReleasedDerivatives {
                 second: &b,
             },
         );
-        let lanes = |x: &D| x.eps.unwrap_generic(Const::<{ 2 * MAX_RELEASED }>, U1);
+        let lanes = |x: &D<L>| x.eps.unwrap_generic(Const::<L>, U1);
         let lr0 = lr.map(|x| x.re);
         let mut d = Self {
             r: rr.map(|x| x.re),
@@ -227,7 +254,7 @@ impl ReleasedDerivatives {
             v: SMatrix::zeros(),
             s: SMatrix::zeros(),
         };
-        for k in 0..released_count::<J>() {
+        for k in 0..N {
             let dl = lr.map(|x| lanes(&x)[k]) * lr0.transpose();
             d.s.set_column(
                 k,
@@ -238,7 +265,7 @@ impl ReleasedDerivatives {
                 ),
             );
             d.u.set_column(k, &rr.map(|x| lanes(&x)[k]));
-            d.v.set_column(k, &rr.map(|x| lanes(&x)[MAX_RELEASED + k]));
+            d.v.set_column(k, &rr.map(|x| lanes(&x)[N + k]));
         }
         d
     }
@@ -304,12 +331,17 @@ fn released_transfer_in<J: JointKinematics, const N: usize>(
             second: &b,
         },
     );
-    let m = l1 * l0.transpose();
+    // The axial part of `m = l1 l0ᵀ`, `m_ij = l1_i· · l0_j·`: its six
+    // off-diagonal entries only (a general product of hyper-duals would
+    // form all nine through nalgebra's generic kernel).
+    let m = |i: usize, j: usize| {
+        l1[(i, 0)] * l0[(j, 0)] + l1[(i, 1)] * l0[(j, 1)] + l1[(i, 2)] * l0[(j, 2)]
+    };
     let half = HyperDualSVec64::<N, N>::from_re(0.5);
     let spin = Vector3::new(
-        (m[(2, 1)] - m[(1, 2)]) * half,
-        (m[(0, 2)] - m[(2, 0)]) * half,
-        (m[(1, 0)] - m[(0, 1)]) * half,
+        (m(2, 1) - m(1, 2)) * half,
+        (m(0, 2) - m(2, 0)) * half,
+        (m(1, 0) - m(0, 1)) * half,
     );
     let w = (r1 - r0).dot(&gx.map(HyperDualSVec64::<N, N>::from_re))
         + spin.dot(&gp.map(HyperDualSVec64::<N, N>::from_re));
