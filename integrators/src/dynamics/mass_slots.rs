@@ -4,8 +4,10 @@
 
 use crate::assembly::Assembler;
 use crate::dofs::DofMap;
+use crate::threads::{sequential, PARALLEL_ALWAYS_ELEMENTS};
 use flexmech_core::Inertia;
 use nalgebra::{Matrix3, Vector3};
+use rayon::prelude::*;
 /// Where the mass and inertia blocks land in the tangent values. The
 /// translational mass `Σ m_ij I` is constant: the diagonal positions of the
 /// blocks whose nodes are independent, with their masses, are listed once,
@@ -90,7 +92,7 @@ impl MassSlots {
         mut tangent: Option<(&mut Assembler, &DofMap)>,
         force: impl Fn(usize, f64) -> Vector3<f64>,
         coefficient: f64,
-        moment: impl Fn(usize, &Matrix3<f64>, bool) -> (Vector3<f64>, Matrix3<f64>),
+        moment: impl Fn(usize, &Matrix3<f64>, bool) -> (Vector3<f64>, Matrix3<f64>) + Sync,
     ) {
         for &(i, j, m) in &inertia.mass {
             let f = force(j, m);
@@ -102,11 +104,11 @@ impl MassSlots {
         if let Some((asm, dofs)) = tangent.as_mut() {
             self.add_translational(asm, dofs, inertia, coefficient);
         }
-        for (i, j0) in inertia.rotational.iter().enumerate() {
-            if *j0 == Matrix3::zeros() {
+        let moments = rotational_moments(inertia, tangent.is_some(), &moment);
+        for (i, (m, k)) in moments.into_iter().enumerate() {
+            if inertia.rotational[i] == Matrix3::zeros() {
                 continue;
             }
-            let (m, k) = moment(i, j0, tangent.is_some());
             for c in 0..3 {
                 g[6 * i + 3 + c] += m[c];
                 abs[6 * i + 3 + c] += m[c].abs();
@@ -115,6 +117,31 @@ impl MassSlots {
                 self.add_rotational(asm, dofs, i, &k);
             }
         }
+    }
+}
+
+/// Every node's inertial moment and its tangent (zero for nodes without
+/// rotary inertia), computed on two threads where a mesh's element loops
+/// are split whatever they cost ([`PARALLEL_ALWAYS_ELEMENTS`] nodes and
+/// more): each node's on its own, summed afterwards in node order, so the
+/// results are the same for any thread count.
+fn rotational_moments(
+    inertia: &Inertia,
+    tangent: bool,
+    moment: &(impl Fn(usize, &Matrix3<f64>, bool) -> (Vector3<f64>, Matrix3<f64>) + Sync),
+) -> Vec<(Vector3<f64>, Matrix3<f64>)> {
+    let one = |(i, j0): (usize, &Matrix3<f64>)| {
+        if *j0 == Matrix3::zeros() {
+            (Vector3::zeros(), Matrix3::zeros())
+        } else {
+            moment(i, j0, tangent)
+        }
+    };
+    let nodes = inertia.rotational.len();
+    if nodes >= PARALLEL_ALWAYS_ELEMENTS && !sequential(nodes) {
+        inertia.rotational.par_iter().enumerate().map(one).collect()
+    } else {
+        inertia.rotational.iter().enumerate().map(one).collect()
     }
 }
 
