@@ -25,13 +25,24 @@ impl Configuration {
     /// multiplicative — rotation vectors are never added), re-normalised
     /// through the quaternion so that orthogonality does not drift.
     pub fn increment(&mut self, node: usize, u: &Vector3<f64>, phi: &Vector3<f64>) {
-        self.x[node] += u;
-        let r = exp(phi) * self.rot[node];
-        self.rot[node] = matrix_from_quaternion(&quaternion_from_matrix(&r).normalize());
+        increment_pose(&mut self.x[node], &mut self.rot[node], u, phi);
     }
 
     /// Unit quaternion `(w, x, y, z)` of node `i`'s rotation, `w ≥ 0`.
     pub fn quaternion(&self, i: usize) -> Vector4<f64> {
         quaternion_from_matrix(&self.rot[i]).normalize()
     }
+}
+
+/// [`Configuration::increment`] of one node's pose `(x, rot)`: `x ← x + u`,
+/// `R ← exp(φ̂) R`, re-orthonormalised through its unit quaternion.
+pub fn increment_pose(
+    x: &mut Vector3<f64>,
+    rot: &mut Matrix3<f64>,
+    u: &Vector3<f64>,
+    phi: &Vector3<f64>,
+) {
+    *x += u;
+    let r = exp(phi) * *rot;
+    *rot = matrix_from_quaternion(&quaternion_from_matrix(&r).normalize());
 }

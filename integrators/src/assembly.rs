@@ -14,7 +14,7 @@
 use crate::dofs::DofMap;
 use faer::sparse::SymbolicSparseColMat;
 use flexmech_core::{Configuration, Element, Inertia, Mesh};
-use nalgebra::{DMatrix, DVector, Matrix3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector6};
 use rayon::prelude::*;
 
 use crate::element_split::{Shared, Split};
@@ -171,9 +171,6 @@ fn kind_scratch(mesh: &Mesh) -> Vec<Work> {
 struct Work {
     r: DVector<f64>,
     k: DMatrix<f64>,
-    g: DMatrix<f64>,
-    /// The rows' map, where some node's rows differ from its columns.
-    g_row: DMatrix<f64>,
     tmp: DMatrix<f64>,
     k_red: DMatrix<f64>,
 }
@@ -184,8 +181,6 @@ impl Work {
         Self {
             r: DVector::zeros(d),
             k: DMatrix::zeros(d, d),
-            g: DMatrix::zeros(d, m),
-            g_row: DMatrix::zeros(d, m),
             tmp: DMatrix::zeros(d, m),
             k_red: DMatrix::zeros(m, m),
         }
@@ -539,61 +534,59 @@ impl Assembler {
 }
 
 /// `Gᵀ K G` of an element some joint touches, from the kernel's `K` in
-/// `w.k`, into `w.k_red` (`G` its node maps over the element's equations).
+/// `w.k`, into `w.k_red` (`G` its node maps over the element's equations:
+/// column `j` of `G` is, in each node block `a` whose map has equation `j`,
+/// that map's column; the rows' map likewise with the maps' rows).
 fn reduce_tangent(w: &mut Work, el: &Element, dofs: &DofMap, s: &Slots) {
-    w.g.fill(0.0);
-    let split = el.nodes().iter().any(|&nd| dofs.nodes[nd].rows.is_some());
-    if split {
-        w.g_row.fill(0.0);
+    let entries = |rows: bool| {
+        el.nodes().iter().enumerate().flat_map(move |(a, &nd)| {
+            let map = &dofs.nodes[nd];
+            let vectors = if rows { map.rows() } else { &map.cols[..] };
+            map.eqs.iter().zip(vectors).map(move |(eq, v)| {
+                let j = s
+                    .eqs
+                    .binary_search(eq)
+                    .expect("element equation list is complete");
+                (a, j, v)
+            })
+        })
+    };
+    map_columns(&w.k, entries(false), &mut w.tmp);
+    map_rows(&w.tmp, entries(true), &mut w.k_red);
+}
+
+/// `t = K G` for `G` given by its entries `(node block a, column j, v)`
+/// (column `j` holds `v` in rows `6a..6a + 6`): each entry's six columns of
+/// `K` times `v`, its zeros skipped — no product over the zeros of `G`.
+fn map_columns<'a>(
+    k: &DMatrix<f64>,
+    entries: impl Iterator<Item = (usize, usize, &'a Vector6<f64>)>,
+    t: &mut DMatrix<f64>,
+) {
+    t.fill(0.0);
+    for (a, j, v) in entries {
+        for (c, &vc) in v.iter().enumerate() {
+            if vc != 0.0 {
+                t.column_mut(j).axpy(vc, &k.column(6 * a + c), 1.0);
+            }
+        }
     }
-    for (a, &nd) in el.nodes().iter().enumerate() {
-        let map = &dofs.nodes[nd];
-        for (k, (eq, col)) in map.eqs.iter().zip(&map.cols).enumerate() {
-            let j = s
-                .eqs
-                .binary_search(eq)
-                .expect("element equation list is complete");
-            let row = &map.rows()[k];
-            for d in 0..6 {
-                w.g[(6 * a + d, j)] += col[d];
-                if split {
-                    w.g_row[(6 * a + d, j)] += row[d];
+}
+
+/// `out = Hᵀ t` for `H` given by its entries as in [`map_columns`].
+fn map_rows<'a>(
+    t: &DMatrix<f64>,
+    entries: impl Iterator<Item = (usize, usize, &'a Vector6<f64>)>,
+    out: &mut DMatrix<f64>,
+) {
+    out.fill(0.0);
+    for (a, i, v) in entries {
+        for (c, &vc) in v.iter().enumerate() {
+            if vc != 0.0 {
+                for j in 0..t.ncols() {
+                    out[(i, j)] += vc * t[(6 * a + c, j)];
                 }
             }
-        }
-    }
-    times_sparse(&w.k, &w.g, &mut w.tmp);
-    let rows = if split { &w.g_row } else { &w.g };
-    sparse_tr_times(rows, &w.tmp, &mut w.k_red);
-}
-
-/// `out = k g` for a map `g` whose columns are a node's few entries each:
-/// the zeros of `g` skipped (an element's maps are 12–18 × 12–14 with one
-/// or two nonzero 6-blocks per column, where a general product pays its
-/// packing for nothing).
-fn times_sparse(k: &DMatrix<f64>, g: &DMatrix<f64>, out: &mut DMatrix<f64>) {
-    out.fill(0.0);
-    for j in 0..g.ncols() {
-        for (r, &v) in g.column(j).iter().enumerate() {
-            if v != 0.0 {
-                out.column_mut(j).axpy(v, &k.column(r), 1.0);
-            }
-        }
-    }
-}
-
-/// `out = gᵀ t` for a map `g` as in [`times_sparse`], its zeros skipped.
-fn sparse_tr_times(g: &DMatrix<f64>, t: &DMatrix<f64>, out: &mut DMatrix<f64>) {
-    for i in 0..g.ncols() {
-        let gi = g.column(i);
-        for j in 0..t.ncols() {
-            let tj = t.column(j);
-            out[(i, j)] = gi
-                .iter()
-                .zip(tj.iter())
-                .filter(|(a, _)| **a != 0.0)
-                .map(|(a, b)| a * b)
-                .sum();
         }
     }
 }
@@ -749,31 +742,47 @@ fn scratch_for(scratch: &mut [Work], dofs: usize) -> &mut Work {
 mod tests {
     use super::*;
 
-    /// A map like an element's: 12 rows, columns with one or two nonzero
-    /// 6-blocks (a node's column, or a slave's and its master's).
-    fn map(m: usize) -> DMatrix<f64> {
-        DMatrix::from_fn(12, m, |r, j| {
-            let block = r / 6;
-            let hit = block == j % 2 || j % 3 == 0;
-            if hit && (r + j) % 4 != 1 {
-                ((r * 7 + j * 3) % 11) as f64 - 5.0
-            } else {
-                0.0
-            }
-        })
-    }
-
     #[test]
-    fn the_sparse_map_products_equal_the_dense_ones() {
+    fn the_map_products_equal_the_dense_ones() {
         let k = DMatrix::from_fn(12, 12, |r, c| ((r * 13 + c * 5) % 17) as f64 - 8.0);
-        for m in [1, 7, 14] {
-            let (g, rows) = (map(m), map(m).map(|v| 0.5 * v));
-            let mut t = DMatrix::zeros(12, m);
-            times_sparse(&k, &g, &mut t);
-            assert_eq!(t, &k * &g);
-            let mut out = DMatrix::zeros(m, m);
-            sparse_tr_times(&rows, &t, &mut out);
-            assert_eq!(out, rows.transpose() * &t);
-        }
+        let v = |s: usize| {
+            Vector6::from_fn(|r, _| {
+                if (r + s) % 4 == 1 {
+                    0.0
+                } else {
+                    (r * 7 + s * 3) as f64 % 11.0 - 5.0
+                }
+            })
+        };
+        let vs: Vec<Vector6<f64>> = (0..8).map(v).collect();
+        // Columns with one node's block, or two (a slave's and its master's).
+        let cols = [
+            (0, 0, &vs[0]),
+            (1, 1, &vs[1]),
+            (0, 2, &vs[2]),
+            (1, 2, &vs[3]),
+            (1, 3, &vs[4]),
+        ];
+        let rows = [
+            (0, 0, &vs[5]),
+            (1, 1, &vs[6]),
+            (0, 2, &vs[7]),
+            (1, 2, &vs[3]),
+            (1, 3, &vs[4]),
+        ];
+        let dense = |entries: &[(usize, usize, &Vector6<f64>)]| {
+            let mut g = DMatrix::zeros(12, 4);
+            for &(a, j, v) in entries {
+                for c in 0..6 {
+                    g[(6 * a + c, j)] += v[c];
+                }
+            }
+            g
+        };
+        let (mut t, mut out) = (DMatrix::zeros(12, 4), DMatrix::zeros(4, 4));
+        map_columns(&k, cols.iter().copied(), &mut t);
+        map_rows(&t, rows.iter().copied(), &mut out);
+        let expected = dense(&rows).transpose() * &k * dense(&cols);
+        assert!((out - expected).amax() < 1e-9);
     }
 }

@@ -489,13 +489,24 @@ fn subtract_multiple(t: &mut [f64], l: &[f64], u: f64) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A random unsymmetric matrix on a banded pattern, scrambled by a
     /// permutation (so RCM has work to do) and with small diagonal entries
     /// (so pivoting has work to do).
     fn scrambled(n: usize, width: usize, seed: u64) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
+        scrambled_with(n, width, seed, |r| 1e-3 * r)
+    }
+
+    /// [`scrambled`] with the diagonal `diag(r)` of a random `r` in
+    /// `[-½, ½)`.
+    pub(crate) fn scrambled_with(
+        n: usize,
+        width: usize,
+        seed: u64,
+        diag: impl Fn(f64) -> f64,
+    ) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
         let mut s = seed;
         let mut rand = || {
             s = s
@@ -507,7 +518,7 @@ mod tests {
         let mut entries = Vec::new();
         for i in 0..n {
             for j in i.saturating_sub(width)..(i + width + 1).min(n) {
-                let v = if i == j { 1e-3 * rand() } else { rand() };
+                let v = if i == j { diag(rand()) } else { rand() };
                 entries.push((shuffle[i], shuffle[j], v));
             }
         }
@@ -630,7 +641,11 @@ mod tests {
     }
 
     /// `A x` for a CSC matrix.
-    fn product(pattern: &SymbolicSparseColMat<usize>, values: &[f64], x: &[f64]) -> Vec<f64> {
+    pub(crate) fn product(
+        pattern: &SymbolicSparseColMat<usize>,
+        values: &[f64],
+        x: &[f64],
+    ) -> Vec<f64> {
         let mut b = vec![0.0; x.len()];
         let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
         for j in 0..x.len() {

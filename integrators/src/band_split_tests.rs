@@ -1,51 +1,12 @@
 use super::*;
 
-/// A random unsymmetric matrix on a banded pattern of `n` unknowns and
-/// half-width `width`, scrambled by a permutation (so the renumbering has
-/// work to do), diagonal `diag` times its off-diagonal size.
-fn banded(n: usize, width: usize, diag: f64, seed: u64) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
-    let mut s = seed;
-    let mut rand = || {
-        s = s
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    let shuffle: Vec<usize> = (0..n).map(|i| (i * 7 + 3) % n).collect();
-    let mut entries = Vec::new();
-    for i in 0..n {
-        for j in i.saturating_sub(width)..(i + width + 1).min(n) {
-            let v = if i == j {
-                diag * (1.0 + rand())
-            } else {
-                rand()
-            };
-            entries.push((shuffle[i], shuffle[j], v));
-        }
-    }
-    entries.sort_by_key(|&(i, j, _)| (j, i));
-    let mut col_ptr = vec![0usize; n + 1];
-    for &(_, j, _) in &entries {
-        col_ptr[j + 1] += 1;
-    }
-    for j in 0..n {
-        col_ptr[j + 1] += col_ptr[j];
-    }
-    let row_idx = entries.iter().map(|e| e.0).collect();
-    let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-    (pattern, entries.iter().map(|e| e.2).collect())
-}
+use crate::band_lu::tests::{product, scrambled_with};
 
-/// `A x` for a CSC matrix.
-fn product(pattern: &SymbolicSparseColMat<usize>, values: &[f64], x: &[f64]) -> Vec<f64> {
-    let mut b = vec![0.0; x.len()];
-    let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
-    for j in 0..x.len() {
-        for k in cp[j]..cp[j + 1] {
-            b[ri[k]] += values[k] * x[j];
-        }
-    }
-    b
+/// A random unsymmetric matrix on a banded pattern of `n` unknowns and
+/// half-width `width`, scrambled (so the renumbering has work to do), its
+/// diagonal `diag` times its off-diagonal size.
+fn banded(n: usize, width: usize, diag: f64, seed: u64) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
+    scrambled_with(n, width, seed, |r| diag * (1.0 + r))
 }
 
 /// `x` and the split solve of `A x̃ = A x`.

@@ -8,10 +8,13 @@ use crate::dofs::{DofMap, NodeMap};
 use crate::error::SolveError;
 use crate::mechanism::Mechanism;
 use crate::record::JointRecord;
+use crate::threads::{sequential, PARALLEL_ALWAYS_ELEMENTS};
 use flexmech_core::rotation::{exp, log};
+use flexmech_core::state::increment_pose;
 use flexmech_core::Configuration;
 use flexmech_joints::{JointStep, ReleasedState, LOCAL};
 use nalgebra::{DMatrix, Matrix3, SMatrix, SVector, Vector3, Vector6};
+use rayon::prelude::*;
 
 /// Positions and rotations of every node and the released coordinates of
 /// every joint: the complete state of a mechanism.
@@ -478,17 +481,32 @@ impl Topology {
     /// Applies a Newton increment: independent nodes, then released
     /// coordinates and the exact placement of every slave.
     pub fn apply(&self, mech: &Mechanism, state: &mut MechanismState, dq: &[f64]) {
-        for n in 0..state.config.x.len() {
+        // Each node on its own: on two threads for a large mesh, the same
+        // numbers either way.
+        let node = |(n, (x, rot)): (usize, (&mut Vector3<f64>, &mut Matrix3<f64>))| {
             if self.slave_of[n].is_none() {
                 let p = self.dofs.node_increment(n, dq);
                 if p != Vector6::zeros() {
-                    state.config.increment(
-                        n,
-                        &p.fixed_rows::<3>(0).into_owned(),
-                        &p.fixed_rows::<3>(3).into_owned(),
+                    let (u, phi) = (
+                        p.fixed_rows::<3>(0).into_owned(),
+                        p.fixed_rows::<3>(3).into_owned(),
                     );
+                    increment_pose(x, rot, &u, &phi);
                 }
             }
+        };
+        let config = &mut state.config;
+        let nodes = config.x.len();
+        if nodes >= PARALLEL_ALWAYS_ELEMENTS && !sequential(nodes) {
+            let poses = config.x.par_iter_mut().zip(config.rot.par_iter_mut());
+            poses.enumerate().for_each(node);
+        } else {
+            config
+                .x
+                .iter_mut()
+                .zip(config.rot.iter_mut())
+                .enumerate()
+                .for_each(node);
         }
         for &j in &self.order {
             let delta: Vec<f64> = self.released_eqs[j]

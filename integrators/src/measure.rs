@@ -102,12 +102,7 @@ pub fn static_record(
         momentum_linear: [0.0; 3],
         momentum_angular: [0.0; 3],
         positions: config.x.iter().map(|x| [x.x, x.y, x.z]).collect(),
-        quaternions: (0..config.x.len())
-            .map(|i| {
-                let q = config.quaternion(i);
-                [q.x, q.y, q.z, q.w]
-            })
-            .collect(),
+        quaternions: quaternions(config),
         joints: joint_records(mech, state),
         support_reactions: vec![[f64::NAN; 6]; mech.supported_nodes().len()],
         velocities: Vec::new(),
@@ -149,4 +144,19 @@ pub fn dynamic_record(
         })
         .collect();
     rec
+}
+
+/// Every node's unit quaternion `[x, y, z, w]`, on two threads for a large
+/// mesh (the same numbers either way).
+fn quaternions(config: &Configuration) -> Vec<[f64; 4]> {
+    let one = |i: usize| {
+        let q = config.quaternion(i);
+        [q.x, q.y, q.z, q.w]
+    };
+    let nodes = config.x.len();
+    if nodes >= crate::threads::PARALLEL_ALWAYS_ELEMENTS && !sequential(nodes) {
+        (0..nodes).into_par_iter().map(one).collect()
+    } else {
+        (0..nodes).map(one).collect()
+    }
 }

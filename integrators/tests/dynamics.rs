@@ -233,6 +233,32 @@ fn tumbling_rigid_body_keeps_its_exact_energy_and_momentum() {
     assert!(q_end[0].abs() < 0.999, "{q_end:?}");
 }
 
+/// The records of `solve` on a pool of `threads` threads.
+fn records_on(
+    threads: usize,
+    solve: impl FnOnce(&mut dyn FnMut(&StepRecord)) + Send,
+) -> Vec<StepRecord> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let mut steps: Vec<StepRecord> = Vec::new();
+    pool.install(|| solve(&mut |s| steps.push(s.clone())));
+    steps
+}
+
+/// Whether two runs' records are the same to the bit (energy, β, positions).
+fn assert_same_bits(one: &[StepRecord], two: &[StepRecord]) {
+    assert_eq!(one.len(), two.len());
+    for (a, b) in one.iter().zip(two) {
+        assert_eq!(a.beta.to_bits(), b.beta.to_bits());
+        assert_eq!(a.energy.total.to_bits(), b.energy.total.to_bits());
+        for (p, q) in a.positions.iter().zip(&b.positions) {
+            assert_eq!(p.map(f64::to_bits), q.map(f64::to_bits));
+        }
+    }
+}
+
 #[test]
 fn energy_momentum_is_bitwise_deterministic_across_thread_counts() {
     use flexmech_integrators::dynamics::energy_momentum;
@@ -242,28 +268,13 @@ fn energy_momentum_is_bitwise_deterministic_across_thread_counts() {
     settings.dt = 0.2;
     settings.t_end = 2.0;
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        let mut steps: Vec<StepRecord> = Vec::new();
-        pool.install(|| {
+        records_on(threads, |push| {
             flexmech_integrators::threads::always_split(|| {
-                energy_momentum::solve(&mech, &settings, &motion, |s| steps.push(s.clone()))
-                    .unwrap()
-            })
-        });
-        steps
+                energy_momentum::solve(&mech, &settings, &motion, push).unwrap()
+            });
+        })
     };
-    let (one, two) = (run(1), run(2));
-    assert_eq!(one.len(), two.len());
-    for (a, b) in one.iter().zip(&two) {
-        assert_eq!(a.beta.to_bits(), b.beta.to_bits());
-        assert_eq!(a.energy.total.to_bits(), b.energy.total.to_bits());
-        for (p, q) in a.positions.iter().zip(&b.positions) {
-            assert_eq!(p.map(f64::to_bits), q.map(f64::to_bits));
-        }
-    }
+    assert_same_bits(&run(1), &run(2));
 }
 
 #[test]
@@ -277,28 +288,14 @@ fn newmark_on_a_band_in_two_halves_is_bitwise_the_same_on_one_and_two_threads() 
     settings.dt = 0.01;
     settings.t_end = 0.03;
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        let mut steps: Vec<StepRecord> = Vec::new();
-        pool.install(|| {
-            flexmech_integrators::dynamics::newmark::solve(&mech, &settings, &motion, |s| {
-                steps.push(s.clone())
-            })
-            .unwrap()
-        });
-        steps
+        records_on(threads, |push| {
+            flexmech_integrators::dynamics::newmark::solve(&mech, &settings, &motion, push)
+                .unwrap();
+        })
     };
-    let (one, two) = (run(1), run(2));
+    let one = run(1);
     assert_eq!(one.len(), 4);
-    assert_eq!(one.len(), two.len());
-    for (a, b) in one.iter().zip(&two) {
-        assert_eq!(a.energy.total.to_bits(), b.energy.total.to_bits());
-        for (p, q) in a.positions.iter().zip(&b.positions) {
-            assert_eq!(p.map(f64::to_bits), q.map(f64::to_bits));
-        }
-    }
+    assert_same_bits(&one, &run(2));
 }
 
 #[test]
