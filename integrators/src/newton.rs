@@ -198,13 +198,7 @@ pub fn solve<S: NewtonSystem>(
     let start_checked = lu.checked_regular();
     let report = iterate(sys, lu, settings, start_checked, r, dq, &mut factored)?;
     if !settings.modified {
-        // Pivots of a healthy size rule out the null direction the
-        // estimate looks for (see `PIVOT_ALARM`): its two solves are saved.
-        if factored && lu.pivots_healthy() {
-            lu.set_regular();
-        } else {
-            check_regular(sys, lu, factored, true)?;
-        }
+        check_regular(sys, lu, factored, true)?;
     }
     Ok(report)
 }
@@ -360,7 +354,9 @@ fn reported_residual(res: f64, norm: f64, scale: f64, floor: f64) -> f64 {
 /// one of infinitely many: a mechanism). `factored`: whether `lu` holds a
 /// factorisation from this solve (otherwise the current tangent is
 /// factorised first); `converged`: whether the iterate is the solution (or
-/// the start of the step). Costs two triangular solves.
+/// the start of the step). Costs two triangular solves, none where the
+/// factorisation's pivots are all of a healthy size
+/// ([`SparseLu::pivots_healthy`]).
 pub(crate) fn check_regular<S: NewtonSystem>(
     sys: &mut S,
     lu: &mut SparseLu,
@@ -374,6 +370,12 @@ pub(crate) fn check_regular<S: NewtonSystem>(
         sys.update_tangent(&mut vec![0.0; lu.pattern().nrows()]);
         lu.factor(sys.tangent_values())
             .map_err(NewtonFailure::LinearSolve)?;
+    }
+    // Pivots of a healthy size rule out the null direction the estimate
+    // looks for (see `PIVOT_ALARM`): its solves are saved.
+    if lu.pivots_healthy() {
+        lu.set_regular();
+        return Ok(());
     }
     let (condition, mode) = lu.condition_estimate(sys.tangent_values());
     if condition <= SINGULAR_CONDITION {
