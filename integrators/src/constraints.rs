@@ -8,13 +8,12 @@ use crate::dofs::{DofMap, NodeMap};
 use crate::error::SolveError;
 use crate::mechanism::Mechanism;
 use crate::record::JointRecord;
-use crate::threads::{sequential, PARALLEL_ALWAYS_ELEMENTS};
+use crate::threads::for_each_pose;
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::state::increment_pose;
 use flexmech_core::Configuration;
 use flexmech_joints::{JointStep, ReleasedState, LOCAL};
 use nalgebra::{DMatrix, Matrix3, SMatrix, SVector, Vector3, Vector6};
-use rayon::prelude::*;
 
 /// Positions and rotations of every node and the released coordinates of
 /// every joint: the complete state of a mechanism.
@@ -483,7 +482,8 @@ impl Topology {
     pub fn apply(&self, mech: &Mechanism, state: &mut MechanismState, dq: &[f64]) {
         // Each node on its own: on two threads for a large mesh, the same
         // numbers either way.
-        let node = |(n, (x, rot)): (usize, (&mut Vector3<f64>, &mut Matrix3<f64>))| {
+        let config = &mut state.config;
+        for_each_pose(&mut config.x, &mut config.rot, |n, x, rot| {
             if self.slave_of[n].is_none() {
                 let p = self.dofs.node_increment(n, dq);
                 if p != Vector6::zeros() {
@@ -494,20 +494,7 @@ impl Topology {
                     increment_pose(x, rot, &u, &phi);
                 }
             }
-        };
-        let config = &mut state.config;
-        let nodes = config.x.len();
-        if nodes >= PARALLEL_ALWAYS_ELEMENTS && !sequential(nodes) {
-            let poses = config.x.par_iter_mut().zip(config.rot.par_iter_mut());
-            poses.enumerate().for_each(node);
-        } else {
-            config
-                .x
-                .iter_mut()
-                .zip(config.rot.iter_mut())
-                .enumerate()
-                .for_each(node);
-        }
+        });
         for &j in &self.order {
             let delta: Vec<f64> = self.released_eqs[j]
                 .iter()

@@ -146,17 +146,11 @@ pub fn dynamic_record(
     rec
 }
 
-/// Every node's unit quaternion `[x, y, z, w]`, on two threads for a large
-/// mesh (the same numbers either way).
+/// Every node's unit quaternion `[x, y, z, w]` (on two threads for a large
+/// mesh, [`crate::threads::map_nodes`]).
 fn quaternions(config: &Configuration) -> Vec<[f64; 4]> {
-    let one = |i: usize| {
+    crate::threads::map_nodes(config.x.len(), |i| {
         let q = config.quaternion(i);
         [q.x, q.y, q.z, q.w]
-    };
-    let nodes = config.x.len();
-    if nodes >= crate::threads::PARALLEL_ALWAYS_ELEMENTS && !sequential(nodes) {
-        (0..nodes).into_par_iter().map(one).collect()
-    } else {
-        (0..nodes).map(one).collect()
-    }
+    })
 }

@@ -97,6 +97,43 @@ pub fn join<A: Send, B: Send>(
     }
 }
 
+/// Whether a per-node loop over `nodes` nodes goes to two threads: a mesh
+/// large enough that its element loops are split whatever they cost
+/// ([`PARALLEL_ALWAYS_ELEMENTS`]), threads to use.
+pub fn split_nodes(nodes: usize) -> bool {
+    nodes >= PARALLEL_ALWAYS_ELEMENTS && !sequential(nodes)
+}
+
+/// `f(i)` for every node `i < nodes`, in order — on two threads where
+/// [`split_nodes`]; each value computed on its own, so the same either way.
+pub fn map_nodes<T: Send>(nodes: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+    use rayon::prelude::*;
+    if split_nodes(nodes) {
+        (0..nodes).into_par_iter().map(f).collect()
+    } else {
+        (0..nodes).map(f).collect()
+    }
+}
+
+/// `f(i, xᵢ, Rᵢ)` on every node's pose — on two threads where
+/// [`split_nodes`]; each node on its own, so the same either way.
+pub fn for_each_pose(
+    x: &mut [nalgebra::Vector3<f64>],
+    rot: &mut [nalgebra::Matrix3<f64>],
+    f: impl Fn(usize, &mut nalgebra::Vector3<f64>, &mut nalgebra::Matrix3<f64>) + Sync + Send,
+) {
+    use rayon::prelude::*;
+    if split_nodes(x.len()) {
+        let poses = x.par_iter_mut().zip(rot.par_iter_mut()).enumerate();
+        poses.for_each(|(i, (x, r))| f(i, x, r));
+    } else {
+        x.iter_mut()
+            .zip(rot.iter_mut())
+            .enumerate()
+            .for_each(|(i, (x, r))| f(i, x, r));
+    }
+}
+
 /// Runs `task` with every element loop that may be split ([`sequential`]
 /// false) split over the threads whatever its kernels cost: for tests of
 /// the parallel paths with cheap kernels.

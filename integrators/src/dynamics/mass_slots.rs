@@ -4,10 +4,8 @@
 
 use crate::assembly::Assembler;
 use crate::dofs::DofMap;
-use crate::threads::{sequential, PARALLEL_ALWAYS_ELEMENTS};
 use flexmech_core::Inertia;
 use nalgebra::{Matrix3, Vector3};
-use rayon::prelude::*;
 /// Where the mass and inertia blocks land in the tangent values. The
 /// translational mass `Σ m_ij I` is constant: the diagonal positions of the
 /// blocks whose nodes are independent, with their masses, are listed once,
@@ -121,28 +119,22 @@ impl MassSlots {
 }
 
 /// Every node's inertial moment and its tangent (zero for nodes without
-/// rotary inertia), computed on two threads where a mesh's element loops
-/// are split whatever they cost ([`PARALLEL_ALWAYS_ELEMENTS`] nodes and
-/// more): each node's on its own, summed afterwards in node order, so the
-/// results are the same for any thread count.
+/// rotary inertia), on two threads for a large mesh
+/// ([`crate::threads::map_nodes`]: each node's on its own, summed afterwards
+/// in node order, the same for any thread count).
 fn rotational_moments(
     inertia: &Inertia,
     tangent: bool,
     moment: &(impl Fn(usize, &Matrix3<f64>, bool) -> (Vector3<f64>, Matrix3<f64>) + Sync),
 ) -> Vec<(Vector3<f64>, Matrix3<f64>)> {
-    let one = |(i, j0): (usize, &Matrix3<f64>)| {
+    crate::threads::map_nodes(inertia.rotational.len(), |i| {
+        let j0 = &inertia.rotational[i];
         if *j0 == Matrix3::zeros() {
             (Vector3::zeros(), Matrix3::zeros())
         } else {
             moment(i, j0, tangent)
         }
-    };
-    let nodes = inertia.rotational.len();
-    if nodes >= PARALLEL_ALWAYS_ELEMENTS && !sequential(nodes) {
-        inertia.rotational.par_iter().enumerate().map(one).collect()
-    } else {
-        inertia.rotational.iter().enumerate().map(one).collect()
-    }
+    })
 }
 
 /// Test support: forward AD of an inertial moment under a spatial spin of

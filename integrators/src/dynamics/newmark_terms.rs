@@ -528,13 +528,20 @@ impl TimeScheme for NewmarkTerms {
             );
         }
         let (kin, k) = (&mut sys.terms.prev, &sys.terms.coefficients);
-        for i in 0..start.x.len() {
+        // The angular accelerations (a logarithm each) node by node, on two
+        // threads for a large mesh.
+        let angular = {
+            let kin = &*kin;
+            crate::threads::map_nodes(start.x.len(), |i| {
+                angular_acceleration(k, &start.rot[i], &end.rot[i], &kin.w[i], &kin.alpha[i], dt)
+            })
+        };
+        for (i, al) in angular.into_iter().enumerate() {
             let a1 = pseudo_acceleration(k, end.x[i] - start.x[i], &kin.v[i], &kin.a[i], dt);
             kin.v[i] += (kin.a[i] * (1.0 - k.gamma) + a1 * k.gamma) * dt;
             kin.acc[i] = k.acceleration(a1, &kin.a[i], &kin.acc[i]);
             kin.a[i] = a1;
-            let al: Vector3<f64> =
-                angular_acceleration(k, &start.rot[i], &end.rot[i], &kin.w[i], &kin.alpha[i], dt);
+            let al: Vector3<f64> = al;
             kin.w[i] += (kin.alpha[i] * (1.0 - k.gamma) + al * k.gamma) * dt;
             kin.ang_acc[i] = k.acceleration(al, &kin.alpha[i], &kin.ang_acc[i]);
             kin.alpha[i] = al;

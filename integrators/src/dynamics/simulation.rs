@@ -41,6 +41,7 @@ use crate::sensitivity::Parameter;
 use crate::step_control::StepControl;
 use crate::system::ReducedSystem;
 use crate::tolerances::TOLERANCES;
+use flexmech_core::state::increment_pose;
 use flexmech_core::{Configuration, Element};
 use nalgebra::Vector3;
 
@@ -368,12 +369,14 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
         let mech = sys.mech;
         sys.start.clone_from(&sys.end);
         let (v, w) = sys.terms.velocities();
-        for i in 0..mech.mesh.node_count() {
-            if !mech.fixed[i].iter().any(|&h| h) && sys.topo.slave_of[i].is_none() {
-                let spin = sys.start.config.rot[i] * w[i] * dt;
-                sys.end.config.increment(i, &(v[i] * dt), &spin);
+        let (topo, start_rot) = (&sys.topo, &sys.start.config.rot);
+        let end = &mut sys.end.config;
+        crate::threads::for_each_pose(&mut end.x, &mut end.rot, |i, x, rot| {
+            if !mech.fixed[i].iter().any(|&h| h) && topo.slave_of[i].is_none() {
+                let spin = start_rot[i] * w[i] * dt;
+                increment_pose(x, rot, &(v[i] * dt), &spin);
             }
-        }
+        });
         for (j, rates) in sys.terms.joint_rates().iter().enumerate() {
             let delta: Vec<f64> = rates.iter().map(|r| r * dt).collect();
             if delta.iter().any(|&d| d != 0.0) {
