@@ -428,7 +428,9 @@ impl BandLu {
 
 /// The left-looking update of one column with no interchanges among the
 /// `ku` steps before it, for the bandwidths of the common beam chains
-/// (`kl = ku` = 11 for 2-node elements, 17 for 3-node ones); `false` (and
+/// (`kl = ku` = 11 for 2-node elements, 17 for 3-node ones, 12 for the
+/// mechanisms of 2-node links closed by joints: the slider-crank's and the
+/// four-bar's of `data/benchmarks`); `false` (and
 /// nothing done) for others. `window`: the column's storage from row
 /// `c − ku` on; `earlier`: the storage from column `c − ku` on. The same
 /// operations in the same order as the general loop.
@@ -439,6 +441,7 @@ fn eliminate_unrolled(
 ) -> bool {
     match (kl, ku) {
         (11, 11) => eliminate_fixed::<11, 11, 23>(ld, window, earlier),
+        (12, 12) => eliminate_fixed::<12, 12, 25>(ld, window, earlier),
         (17, 17) => eliminate_fixed::<17, 17, 35>(ld, window, earlier),
         _ => false,
     }
@@ -553,11 +556,17 @@ pub(crate) mod tests {
     }
 
     /// Without interchanges, at the bandwidths of the unrolled column
-    /// update (11, 17) and one beside them (12): the row-by-row solves and
+    /// update (11, 12, 17) and one beside them (13): the row-by-row solves and
     /// the unrolled update give the product's `x` back.
     #[test]
     fn solves_without_interchanges_agree_with_the_product() {
-        for (n, width, seed) in [(300, 11, 5), (200, 17, 6), (150, 12, 7), (30, 11, 8)] {
+        for (n, width, seed) in [
+            (300, 11, 5),
+            (200, 17, 6),
+            (150, 12, 7),
+            (140, 13, 9),
+            (30, 11, 8),
+        ] {
             let (pattern, mut values) = scrambled(n, width, seed);
             // Diagonally dominant: the diagonal pivots all stay.
             let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
