@@ -564,7 +564,7 @@ pub(crate) mod tests {
             (300, 11, 5),
             (200, 17, 6),
             (150, 12, 7),
-            (140, 13, 9),
+            (143, 13, 9),
             (30, 11, 8),
         ] {
             let (pattern, mut values) = scrambled(n, width, seed);
