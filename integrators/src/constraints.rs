@@ -12,8 +12,9 @@ use crate::threads::for_each_pose;
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::state::increment_pose;
 use flexmech_core::Configuration;
-use flexmech_joints::{JointStep, ReleasedState, LOCAL};
+use flexmech_joints::{JointStep, ReleasedState, LOCAL, MAX_RELEASED};
 use nalgebra::{DMatrix, Matrix3, SMatrix, SVector, Vector3, Vector6};
+use smallvec::SmallVec;
 
 /// Positions and rotations of every node and the released coordinates of
 /// every joint: the complete state of a mechanism.
@@ -146,8 +147,10 @@ impl Topology {
                     .map
                     .variation(&state.config.x[m], &state.config.rot[m], &state.released[j]);
             let nm = n.fixed_columns::<6>(0).into_owned();
-            let master_cols = self.dofs.nodes[m].cols.clone();
-            let mut cols: Vec<Vector6<f64>> = master_cols.iter().map(|c| nm * c).collect();
+            // The slave's own vector, refilled (no allocation per iteration).
+            let mut cols = std::mem::take(&mut self.dofs.nodes[joint.slave].cols);
+            cols.clear();
+            cols.extend(self.dofs.nodes[m].cols.iter().map(|c| nm * c));
             for (c, eq) in self.released_eqs[j].iter().enumerate() {
                 if eq.is_some() {
                     cols.push(n.column(6 + c).into_owned());
@@ -190,7 +193,7 @@ impl Topology {
     /// `local_eqs[j]`): the master's node map (its rows when `rows`, else
     /// its columns) in local rows 0..6, then the released coordinates, each
     /// the unit vector of its local row `6 + c`.
-    fn local_map<'a>(&'a self, mech: &Mechanism, j: usize, rows: bool) -> Vec<LocalColumn<'a>> {
+    fn local_map<'a>(&'a self, mech: &Mechanism, j: usize, rows: bool) -> LocalMap<'a> {
         let master = &self.dofs.nodes[mech.joints[j].master];
         let map = if rows {
             master.rows()
@@ -496,12 +499,14 @@ impl Topology {
             }
         });
         for &j in &self.order {
-            let delta: Vec<f64> = self.released_eqs[j]
-                .iter()
-                .map(|eq| eq.map_or(0.0, |e| dq[e]))
-                .collect();
+            let eqs = &self.released_eqs[j];
+            let mut delta = [0.0; MAX_RELEASED];
+            for (d, eq) in delta.iter_mut().zip(eqs) {
+                *d = eq.map_or(0.0, |e| dq[e]);
+            }
+            let delta = &delta[..eqs.len()];
             if delta.iter().any(|&d| d != 0.0) {
-                mech.joints[j].map.advance(&mut state.released[j], &delta);
+                mech.joints[j].map.advance(&mut state.released[j], delta);
             }
         }
         self.place_slaves(mech, state);
@@ -559,13 +564,19 @@ impl Topology {
         for (j, joint) in mech.joints.iter().enumerate() {
             let k = joint.map.released_count();
             let (now, before) = (state.released[j], previous.released[j]);
-            let mut delta: Vec<f64> = (0..k).map(|c| (now.q[c] - before.q[c]) * ratio).collect();
+            let mut delta = [0.0; MAX_RELEASED];
+            for (c, d) in delta.iter_mut().enumerate().take(k) {
+                *d = (now.q[c] - before.q[c]) * ratio;
+            }
+            let mut delta = &delta[..k];
+            let spin;
             if now.rot != before.rot {
                 // A multiplicative released rotation (spherical): the spin between the two.
                 let w = log(&(now.rot * before.rot.transpose())) * ratio;
-                delta = vec![w.x, w.y, w.z];
+                spin = [w.x, w.y, w.z];
+                delta = &spin;
             }
-            joint.map.advance(&mut state.released[j], &delta);
+            joint.map.advance(&mut state.released[j], delta);
         }
         self.place_slaves(mech, state);
     }
@@ -588,7 +599,7 @@ impl Topology {
             state.prescribed[k] = v;
         }
         for (j, joint) in mech.joints.iter().enumerate() {
-            let mut delta = vec![0.0; joint.map.released_count()];
+            let mut delta = [0.0; MAX_RELEASED];
             let mut any = false;
             for (c, d) in joint.driven.iter().enumerate() {
                 if let Some(s) = d {
@@ -597,7 +608,8 @@ impl Topology {
                 }
             }
             if any {
-                joint.map.advance(&mut state.released[j], &delta);
+                let k = joint.map.released_count();
+                joint.map.advance(&mut state.released[j], &delta[..k]);
             }
         }
         self.place_slaves(mech, state);
@@ -638,6 +650,10 @@ pub fn joint_records(mech: &Mechanism, state: &MechanismState) -> Vec<JointRecor
         })
         .collect()
 }
+
+/// A joint's local-to-global map ([`Topology::local_map`]): on the stack
+/// for a master with up to six columns.
+type LocalMap<'a> = SmallVec<[LocalColumn<'a>; LOCAL]>;
 
 /// One column of a joint's local-to-global map ([`Topology::local_map`]).
 #[derive(Debug, Clone, Copy)]

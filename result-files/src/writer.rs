@@ -335,6 +335,9 @@ impl Series {
             .new_dataset::<T>()
             .shape(extents)
             .chunk(chunk.to_vec())
+            // Every row is written before it is read (a failed write's rows
+            // are trimmed by `finish`): no zero-filling of new chunks.
+            .fill_time(hdf5::plist::dataset_create::FillTime::Never)
             .create(name)
             .ctx(path, || format!("creating dataset {name}"))?;
         create_str_attr(&ds, names::ATTR_DESCRIPTION, description)
@@ -1217,6 +1220,9 @@ impl ResultWriter {
         // Lock before truncating: a second writer of the same file fails here
         // and leaves the first one's result intact.
         let lock = lock_result(path)?;
+        // The default (earliest) file format on purpose: from the 1.10 format on,
+        // a file left open by a killed writer cannot be reopened without
+        // `h5clear`, and a killed run's file must stay readable.
         let file = File::create(path).ctx(path, || "creating the file".to_owned())?;
         write_root_attributes(&file, path, meta)?;
         if let Some(mesh) = &meta.mesh {
