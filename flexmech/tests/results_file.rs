@@ -826,3 +826,26 @@ fn a_second_writer_of_the_same_file_is_refused_and_the_first_result_survives() {
     let again = ResultWriter::create(&path, &meta()).expect("free again");
     again.finish(layout::STATUS_COMPLETED, 1.0).expect("finish");
 }
+
+#[test]
+fn held_steps_fall_due_after_a_second_and_are_written_by_the_next_append() {
+    // The writer asks for a restart state only when its held steps are due
+    // (the file last written a second ago): a dynamic run builds it only
+    // then. Without one, the next append writes the held steps first.
+    let _serial = serial();
+    let path = tmp_path("due.h5");
+    let mut writer = ResultWriter::create(&path, &meta()).expect("create the writer");
+    writer.append(&record(0)).expect("append a step");
+    assert!(!writer.wants_checkpoint(), "a step just held is not due");
+    std::thread::sleep(std::time::Duration::from_millis(1100));
+    writer.append(&record(1)).expect("append a step");
+    assert!(writer.wants_checkpoint(), "held for more than a second");
+    writer.append(&record(2)).expect("append a step");
+    // Written: the file's clock restarted, so the new step is not due.
+    assert!(!writer.wants_checkpoint(), "the due steps written first");
+    writer
+        .finish(layout::STATUS_COMPLETED, 1.0)
+        .expect("finish");
+    let file = hdf5::File::open(&path).expect("reopen");
+    check_series(&file, 3);
+}

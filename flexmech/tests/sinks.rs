@@ -87,3 +87,72 @@ fn a_file_read_whole_holds_what_the_reader_reads() {
         .to_string()
         .contains("no/such.h5"));
 }
+
+/// A memory sink that takes the restart state only when asked for at every
+/// third kept step, as the result file takes it only at its writes.
+struct EveryThird {
+    memory: Memory,
+    /// The kept steps' indices after which a restart state came.
+    saved_after: Vec<usize>,
+}
+
+impl Sink for EveryThird {
+    fn begin(
+        &mut self,
+        meta: &flexmech::results::RunMeta,
+    ) -> Result<(), flexmech::results::SinkError> {
+        self.memory.begin(meta)
+    }
+
+    fn step(
+        &mut self,
+        record: &flexmech::integrators::StepRecord,
+    ) -> Result<(), flexmech::results::SinkError> {
+        self.memory.step(record)
+    }
+
+    fn checkpoint(
+        &mut self,
+        state: &flexmech::integrators::dynamics::Checkpoint,
+    ) -> Result<(), flexmech::results::SinkError> {
+        self.saved_after.push(self.memory.records.len() - 1);
+        self.memory.checkpoint(state)
+    }
+
+    fn wants_checkpoint(&self) -> bool {
+        self.memory.records.len().is_multiple_of(3)
+    }
+
+    fn finish(
+        &mut self,
+        end: &flexmech::results::RunEnd,
+    ) -> Result<(), flexmech::results::SinkError> {
+        self.memory.finish(end)
+    }
+}
+
+#[test]
+fn the_restart_state_is_built_when_the_sink_wants_it_and_at_the_end() {
+    let text = std::fs::read_to_string(data("paper/cam.toml"))
+        .unwrap()
+        .replace("t_end = 3.0", "t_end = 0.2");
+    let model = parse_model(&text, &data("paper/cam.toml")).unwrap();
+    let mut sink = EveryThird {
+        memory: Memory::default(),
+        saved_after: Vec::new(),
+    };
+    run(&model, &mut sink).unwrap();
+    let kept = sink.memory.records.len();
+    assert!(kept > 6, "{kept} kept steps");
+    let mut expected: Vec<usize> = (2..kept).step_by(3).collect();
+    if expected.last() != Some(&(kept - 1)) {
+        expected.push(kept - 1);
+    }
+    assert_eq!(sink.saved_after, expected);
+    let last = sink.memory.checkpoint.as_ref().unwrap();
+    assert_eq!(
+        last.time,
+        sink.memory.records[kept - 1].time,
+        "the state at the last step"
+    );
+}

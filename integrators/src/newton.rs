@@ -59,8 +59,9 @@ pub struct NewtonSettings {
     pub modified: bool,
     /// The exact tangent from the first iteration even where the system
     /// offers a cheaper one ([`NewtonSystem::tangent_is_exact`]; the
-    /// energy–momentum scheme's 2-node elements): quadratic convergence at
-    /// every iterate. `false`: the cheap tangent first, the exact one once
+    /// energy–momentum scheme's 2-node elements), and a new one at every
+    /// iterate (no chord steps, [`CHORD_CONTRACTION`]): quadratic convergence
+    /// at every iterate. `false`: the cheap tangent first, the exact one once
     /// it contracts slowly. Either way the solution meets the same
     /// tolerance.
     pub exact_tangent: bool,
@@ -215,6 +216,8 @@ fn iterate<S: NewtonSystem>(
     let mut history = Vec::with_capacity(settings.max_iterations + 1);
     let mut previous_norm = f64::INFINITY;
     let mut factorizations = 0;
+    // The licence of the chord step that made the current iterate, if one did.
+    let mut chord: Option<f64> = None;
     for it in 0..=settings.max_iterations {
         // At the start of a full-Newton solve a factorisation all but
         // certainly follows: residual and tangent in one pass.
@@ -235,7 +238,7 @@ fn iterate<S: NewtonSystem>(
             return Err(NewtonFailure::NotFinite { iteration: it });
         }
         let floored = at_floor(norm, &mut previous_norm, sys.floor())
-            || quadratic_at_floor(it, norm, &history, sys, settings);
+            || quadratic_at_floor(it, norm, &history, sys, settings, chord);
         if res <= settings.tolerance || floored {
             let residual = reported_residual(res, norm, scale, sys.floor());
             return Ok(NewtonReport {
@@ -257,11 +260,11 @@ fn iterate<S: NewtonSystem>(
             } else {
                 res < MODIFIED_CONTRACTION * history[it - 1]
             }
+        } else if *factored && it > 0 {
+            chord = chord_licence(sys, norm, &history).filter(|_| !settings.exact_tangent);
+            chord.is_some() || floor_reuse(sys, norm, history[it - 1])
         } else {
-            // At the floor, still falling: a round-off correction with
-            // this solve's factorisation, made close to the solution (see the module's notes and
-            // `FLOOR_REUSE_RESIDUAL`).
-            *factored && it > 0 && norm <= sys.floor() && history[it - 1] <= FLOOR_REUSE_RESIDUAL
+            false
         };
         let slow = if settings.modified {
             !reuse
@@ -303,6 +306,44 @@ fn iterate<S: NewtonSystem>(
     })
 }
 
+/// Whether full Newton corrects the iterate with the factorisation this
+/// solve has made rather than a new tangent at the floor: still falling, a
+/// round-off correction with a factorisation made close to the solution
+/// (see the module's notes and [`FLOOR_REUSE_RESIDUAL`]). Elsewhere a chord
+/// step ([`chord_licence`]) may.
+fn floor_reuse<S: NewtonSystem>(sys: &S, norm: f64, previous: f64) -> bool {
+    norm <= sys.floor() && previous <= FLOOR_REUSE_RESIDUAL
+}
+
+/// The contraction of the last correction, `history[k] / history[k − 1]`,
+/// where it licenses a chord step (see [`CHORD_CONTRACTION`]): the expected
+/// contraction of that step. Only in a solve that has contracted at every
+/// iteration (Newton's quadratic regime: a correction from far off may
+/// contract a thousandfold by chance where the tangent still changes fast),
+/// and where [`floor_reuse`] does not already correct the iterate.
+fn chord_licence<S: NewtonSystem>(sys: &S, norm: f64, history: &[f64]) -> Option<f64> {
+    let [.., previous, res] = *history else {
+        return None;
+    };
+    (sys.tangent_is_exact()
+        && res <= CHORD_CONTRACTION * previous
+        && history.windows(2).all(|w| w[1] < w[0])
+        && !floor_reuse(sys, norm, previous))
+    .then(|| res / previous)
+}
+
+/// Largest ratio of successive scaled residuals at which full Newton makes
+/// its next correction with the factorisation it has — a chord step —
+/// instead of a new tangent: `10⁻³`. A Newton correction from the step's
+/// predictor that cuts the residual a thousandfold comes from a tangent
+/// that is off at the new iterate by terms of the size of that correction
+/// (its contraction is the same order), so the chord step cuts the residual
+/// about as much again — the slider-crank of `data/benchmarks` goes `1,
+/// 1.6e-6`, then to its floor at `2e-9` by the chord as by a new tangent —
+/// for a solve instead of a tangent and a factorisation. A chord that
+/// contracts less is followed by a new tangent.
+pub const CHORD_CONTRACTION: f64 = 1e-3;
+
 /// Largest scaled residual of the previous iterate from which an exact
 /// Newton correction lands at the solution: its error is of the order of
 /// that residual squared (1e-6 here), so an iterate it brings to the
@@ -316,19 +357,24 @@ pub const FLOOR_ACCEPT_FROM: f64 = 1e-3;
 
 /// Whether the iterate `it` is at the round-off floor straight from an
 /// iterate within [`FLOOR_ACCEPT_FROM`] by a full-Newton correction with the
-/// exact tangent (quadratic convergence).
+/// exact tangent (quadratic convergence) — or by a chord step (`chord`: its
+/// licence, [`chord_licence`]) whose expected residual, the licence times
+/// the scaled residual it started from, is within the tolerance (the chord
+/// converges linearly: from farther, the stall test stays).
 fn quadratic_at_floor<S: NewtonSystem>(
     it: usize,
     norm: f64,
     history: &[f64],
     sys: &S,
     settings: &NewtonSettings,
+    chord: Option<f64>,
 ) -> bool {
     it > 0
         && !settings.modified
         && sys.tangent_is_exact()
         && norm <= sys.floor()
         && history[it - 1] <= FLOOR_ACCEPT_FROM
+        && chord.is_none_or(|c| c * history[it - 1] <= settings.tolerance)
 }
 
 /// A force scale at most this many round-off floors is itself round-off:

@@ -51,7 +51,7 @@ impl NewtonSystem for Cubic {
         self.q[1] += dq[1];
     }
     fn tangent_is_exact(&self) -> bool {
-        self.exact
+        self.exact || self.factor == 1.0
     }
     /// Round-off of `q³ + q − 2` near the root: a few ε.
     fn floor(&self) -> f64 {
@@ -116,6 +116,30 @@ fn a_poor_cheap_tangent_is_replaced_by_the_exact_one() {
     let mut exact = Cubic::new(2.0);
     run(&mut exact, true);
     assert_eq!(exact.cheap_count, 0);
+}
+
+#[test]
+fn full_newton_takes_chord_steps_once_a_correction_contracts_a_thousandfold() {
+    // The exact tangent: corrections contract quadratically, 0.03, 4e-4,
+    // then a thousandfold and more — from there the factorisation is kept
+    // and the same root is reached to the tolerance.
+    let mut sys = Cubic::new(1.0);
+    let report = run(&mut sys, false);
+    assert!(
+        report.factorizations < report.iterations,
+        "no chord step: {report:?}"
+    );
+    // Every correction after the last factorisation was licensed by the
+    // one before it.
+    let h = &report.history;
+    let first_chord = report.factorizations;
+    for k in first_chord..report.iterations {
+        assert!(h[k] <= CHORD_CONTRACTION * h[k - 1], "{h:?}");
+    }
+    // `newton = "exact"`: a new tangent at every iterate.
+    let mut exact = Cubic::new(1.0);
+    let report = run(&mut exact, true);
+    assert_eq!(report.factorizations, report.iterations, "{report:?}");
 }
 
 /// `rᵢ(q) = qᵢ² − 1`, two uncoupled unknowns: the tangent `2qᵢ` is singular

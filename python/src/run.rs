@@ -86,6 +86,10 @@ impl<S: Sink> Sink for Watched<S> {
         self.inner.checkpoint(state)
     }
 
+    fn wants_checkpoint(&self) -> bool {
+        self.inner.wants_checkpoint()
+    }
+
     fn modes(&mut self, set: &ModeSet, joints: &[String]) -> Result<(), SinkError> {
         self.inner.modes(set, joints)
     }

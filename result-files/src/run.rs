@@ -236,6 +236,8 @@ struct Keeper<'a> {
     critical: Vec<CriticalPoint>,
     /// The values of the modes written, with their kind.
     modes: Option<(ModeKind, Vec<f64>)>,
+    /// A step went to the sink without its restart state.
+    unsaved: bool,
 }
 
 impl Keeper<'_> {
@@ -283,10 +285,29 @@ impl Keeper<'_> {
 
     /// Hands the simulation's restart state to the sink.
     fn checkpoint(&mut self, sim: &Simulation<'_>) {
+        self.unsaved = false;
         if self.error.is_none() {
             if let Err(e) = self.sink.checkpoint(&sim.checkpoint()) {
                 self.error = Some(e);
             }
+        }
+    }
+
+    /// After a step went to the sink: hands the restart state over if the
+    /// sink wants it now; [`Self::finish_checkpoints`] hands the last one.
+    fn offer_checkpoint(&mut self, sim: &Simulation<'_>) {
+        self.unsaved = true;
+        if self.sink.wants_checkpoint() {
+            self.checkpoint(sim);
+        }
+    }
+
+    /// At a dynamic run's end (also after a failure): hands over the last
+    /// converged step if it is still pending, and the restart state at the
+    /// last step handed over.
+    fn finish_checkpoints(&mut self, sim: &Simulation<'_>) {
+        if self.flush_last() || self.unsaved {
+            self.checkpoint(sim);
         }
     }
 
@@ -532,6 +553,7 @@ fn run_with(
         error: None,
         critical: Vec::new(),
         modes: None,
+        unsaved: false,
     };
     let start = Instant::now();
     let (outcome, setup) = solve(model, &built, restart, &mut keeper, start);
@@ -703,14 +725,14 @@ fn solve_dynamic(
         Err(e) => return (Err(e), 0.0),
     };
     if keeper.push(&sim.record()) {
-        keeper.checkpoint(&sim);
+        keeper.offer_checkpoint(&sim);
     }
     let setup = start.elapsed().as_secs_f64();
     let outcome = loop {
         match sim.step() {
             Ok(Some(record)) => {
                 if keeper.push(&record) {
-                    keeper.checkpoint(&sim);
+                    keeper.offer_checkpoint(&sim);
                 }
             }
             Ok(None) => break Ok(()),
@@ -718,9 +740,7 @@ fn solve_dynamic(
         }
     };
     // The last converged state, also after a failure.
-    if keeper.flush_last() {
-        keeper.checkpoint(&sim);
-    }
+    keeper.finish_checkpoints(&sim);
     (outcome, setup)
 }
 

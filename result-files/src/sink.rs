@@ -69,9 +69,16 @@ pub trait Sink {
     fn begin(&mut self, meta: &RunMeta) -> Result<(), SinkError>;
     /// A kept step.
     fn step(&mut self, record: &StepRecord) -> Result<(), SinkError>;
-    /// The restart state of a dynamic run after a kept step.
+    /// The restart state of a dynamic run after a kept step: after every
+    /// kept step for which [`Self::wants_checkpoint`] says so, and after the
+    /// last one.
     fn checkpoint(&mut self, _state: &Checkpoint) -> Result<(), SinkError> {
         Ok(())
+    }
+    /// Whether the sink takes the restart state of the step it was given
+    /// last (building it copies the whole state). Default: always.
+    fn wants_checkpoint(&self) -> bool {
+        true
     }
     /// The modes of a modal or buckling analysis, after its steps;
     /// `joints` names the model's joints. Default: ignored.
@@ -236,6 +243,13 @@ impl Sink for FileSink {
 
     fn checkpoint(&mut self, state: &Checkpoint) -> Result<(), SinkError> {
         Ok(self.writer()?.checkpoint(state)?)
+    }
+
+    fn wants_checkpoint(&self) -> bool {
+        // Only the state at the last step of a write is kept.
+        self.writer
+            .as_ref()
+            .is_none_or(ResultWriter::wants_checkpoint)
     }
 
     fn modes(&mut self, set: &ModeSet, joints: &[String]) -> Result<(), SinkError> {

@@ -1097,6 +1097,10 @@ pub struct ResultWriter {
     held_checkpoint: Option<flexmech_integrators::dynamics::Checkpoint>,
     /// When the file was last written.
     last_write: std::time::Instant,
+    /// The held steps were due to be written when the last was appended
+    /// (decided once per append, so that [`Self::wants_checkpoint`] and the
+    /// write it announces agree).
+    due: bool,
 }
 
 impl std::fmt::Debug for ResultWriter {
@@ -1247,14 +1251,16 @@ impl ResultWriter {
             held_values: 0,
             held_checkpoint: None,
             last_write: std::time::Instant::now(),
+            due: false,
         })
     }
 
     /// Appends one step. Steps are written in batches: held in memory and
     /// written together (each dataset extended once, then the file flushed)
-    /// once the oldest held step is `WRITE_INTERVAL` (1 s) old or the held steps
-    /// reach `HELD_VALUES` values, and by [`Self::flush`] and
-    /// [`Self::finish`]. A process that dies therefore leaves a valid file
+    /// when an append finds the file last written `WRITE_INTERVAL` (1 s) ago
+    /// or the held steps at `HELD_VALUES` values — by the
+    /// [`Self::checkpoint`] that follows it, or else by the next append —
+    /// and by [`Self::flush`] and [`Self::finish`]. A process that dies therefore leaves a valid file
     /// holding every step up to the last write — at most about a second of
     /// the run is lost — and its restart state at the last of them.
     ///
@@ -1304,14 +1310,22 @@ impl ResultWriter {
                 });
             }
         }
-        if !self.held.is_empty()
-            && (self.held_values >= HELD_VALUES || self.last_write.elapsed() >= WRITE_INTERVAL)
-        {
+        if self.due {
             self.flush()?;
         }
         self.held_values += record_values(step);
         self.held.push(step.clone());
+        self.due = self.held_values >= HELD_VALUES || self.last_write.elapsed() >= WRITE_INTERVAL;
         Ok(())
+    }
+
+    /// Whether the held steps are due to be written: a
+    /// [`Self::checkpoint`] now writes them with it; otherwise the next
+    /// [`Self::append`] writes them first. A dynamic run builds its restart
+    /// state only when this says so (and at its end), since only the state
+    /// at the last step of a write is kept.
+    pub fn wants_checkpoint(&self) -> bool {
+        self.due || self.held.is_empty()
     }
 
     /// Writes the held steps and the restart state, and flushes the file:
@@ -1343,6 +1357,7 @@ impl ResultWriter {
                 })?;
         }
         self.last_write = std::time::Instant::now();
+        self.due = false;
         self.file.flush().ctx(&self.path, || {
             format!("flushing after step {}", self.steps.saturating_sub(1))
         })
@@ -1470,8 +1485,8 @@ impl ResultWriter {
         checkpoint: &flexmech_integrators::dynamics::Checkpoint,
     ) -> Result<(), ResultError> {
         self.held_checkpoint = Some(checkpoint.clone());
-        if self.held.is_empty() {
-            // Its step is in the file already.
+        if self.held.is_empty() || self.due {
+            // Its step is in the file already, or the held steps are due.
             return self.flush();
         }
         Ok(())
