@@ -325,8 +325,7 @@ fn chord_licence<S: NewtonSystem>(sys: &S, norm: f64, history: &[f64]) -> Option
     let [.., previous, res] = *history else {
         return None;
     };
-    (sys.tangent_is_exact()
-        && res <= CHORD_CONTRACTION * previous
+    (res <= CHORD_CONTRACTION * previous
         && history.windows(2).all(|w| w[1] < w[0])
         && !floor_reuse(sys, norm, previous))
     .then(|| res / previous)
@@ -341,7 +340,13 @@ fn chord_licence<S: NewtonSystem>(sys: &S, norm: f64, history: &[f64]) -> Option
 /// about as much again — the slider-crank of `data/benchmarks` goes `1,
 /// 1.6e-6`, then to its floor at `2e-9` by the chord as by a new tangent —
 /// for a solve instead of a tangent and a factorisation. A chord that
-/// contracts less is followed by a new tangent.
+/// contracts less is followed by a new tangent. The energy–momentum
+/// scheme's cheaper tangent takes chord steps on the same terms (its own
+/// contraction licenses them); an iterate a chord step brings to the floor
+/// is accepted without the stall test only where the chord's expected
+/// residual is within the tolerance ([`quadratic_at_floor`]). The
+/// slider-crank's generalized-α run makes 1 112 factorisations in 1 000
+/// steps with them, 2 098 without.
 pub const CHORD_CONTRACTION: f64 = 1e-3;
 
 /// Largest scaled residual of the previous iterate from which an exact
