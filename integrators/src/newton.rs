@@ -261,7 +261,8 @@ fn iterate<S: NewtonSystem>(
                 res < MODIFIED_CONTRACTION * history[it - 1]
             }
         } else if *factored && it > 0 {
-            chord = chord_licence(sys, norm, &history).filter(|_| !settings.exact_tangent);
+            chord = chord_licence(sys, norm, &history, settings.tolerance)
+                .filter(|_| !settings.exact_tangent);
             chord.is_some() || floor_reuse(sys, norm, history[it - 1])
         } else {
             false
@@ -317,15 +318,22 @@ fn floor_reuse<S: NewtonSystem>(sys: &S, norm: f64, previous: f64) -> bool {
 
 /// The contraction of the last correction, `history[k] / history[k − 1]`,
 /// where it licenses a chord step (see [`CHORD_CONTRACTION`]): the expected
-/// contraction of that step. Only in a solve that has contracted at every
+/// contraction of that step. Licensed where it is at most
+/// `CHORD_CONTRACTION`, or where one chord step contracting as much is
+/// expected to reach the `tolerance`. Only in a solve that has contracted at every
 /// iteration (Newton's quadratic regime: a correction from far off may
 /// contract a thousandfold by chance where the tangent still changes fast),
 /// and where [`floor_reuse`] does not already correct the iterate.
-fn chord_licence<S: NewtonSystem>(sys: &S, norm: f64, history: &[f64]) -> Option<f64> {
+fn chord_licence<S: NewtonSystem>(
+    sys: &S,
+    norm: f64,
+    history: &[f64],
+    tolerance: f64,
+) -> Option<f64> {
     let [.., previous, res] = *history else {
         return None;
     };
-    (res <= CHORD_CONTRACTION * previous
+    ((res <= CHORD_CONTRACTION * previous || res * (res / previous) <= tolerance)
         && history.windows(2).all(|w| w[1] < w[0])
         && !floor_reuse(sys, norm, previous))
     .then(|| res / previous)
