@@ -28,7 +28,7 @@
 //! internal forces are: linear *and* angular momentum are conserved exactly.
 
 use crate::kinematics::{released_at, JointKinematics, ReleasedState, LOCAL, MAX_RELEASED};
-use flexmech_core::rotation::{cayley_inverse, exp, skew};
+use flexmech_core::rotation::{cayley_inverse, exp, mm, mmt, mv, skew};
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector6};
 
@@ -101,20 +101,32 @@ impl<T: Scalar> JointStep<T> {
     ) -> Self {
         let [(x0, r0), (x1, r1)] = master;
         let x0 = x0.map(cst::<T>) + Vector3::new(from.0[0], from.0[1], from.0[2]);
-        let r0 = exp(&Vector3::new(from.0[3], from.0[4], from.0[5])) * r0.map(cst::<T>);
+        // Products written out (`mm`, `mmt`, `mv`): nalgebra's general
+        // product multiplies every term by a unit dual number besides.
+        let r0 = mm(
+            &exp(&Vector3::new(from.0[3], from.0[4], from.0[5])),
+            &r0.map(cst::<T>),
+        );
         let x1 = x1.map(cst::<T>) + Vector3::new(seed[0], seed[1], seed[2]);
-        let r1 = exp(&Vector3::new(seed[3], seed[4], seed[5])) * r1.map(cst::<T>);
-        let theta_m = cayley_inverse(&(r1 * r0.transpose()));
+        let r1 = mm(
+            &exp(&Vector3::new(seed[3], seed[4], seed[5])),
+            &r1.map(cst::<T>),
+        );
+        let theta_m = cayley_inverse(&mmt(&r1, &r0));
         let (rr0, l0) = released_at(joint, released[0], from.1);
         let (rr1, l1) = released_at(joint, released[1], inc);
-        let (xs0, xs1) = (x0 + r0 * rr0, x1 + r1 * rr1);
+        let (xs0, xs1) = (x0 + mv(&r0, &rr0), x1 + mv(&r1, &rr1));
         let half = cst::<T>(0.5);
         let quarter = cst::<T>(0.25);
         let offset = (xs0 + xs1 - x0 - x1) * half;
         let tm = skew(&theta_m);
-        let lever = (Matrix3::identity() - tm * tm * quarter) * ((r0 + r1) * half);
-        let theta_r = r0 * cayley_inverse(&(l1 * l0.transpose()));
-        let a = (Matrix3::identity() + tm * half + theta_m * theta_m.transpose() * quarter) * r0
+        let lever = mm(
+            &(Matrix3::identity() - mm(&tm, &tm) * quarter),
+            &((r0 + r1) * half),
+        );
+        let theta_r = mv(&r0, &cayley_inverse(&mmt(&l1, &l0)));
+        let outer = Matrix3::from_fn(|i, j| theta_m[i] * theta_m[j]);
+        let a = mm(&(Matrix3::identity() + tm * half + outer * quarter), &r0)
             / (T::one() - theta_m.dot(&theta_r) * quarter);
         Self {
             offset,
@@ -153,13 +165,17 @@ impl<T: Scalar> JointStep<T> {
         out.fixed_rows_mut::<3>(0).copy_from(&f);
         out.fixed_rows_mut::<3>(3)
             .copy_from(&(self.offset.cross(&f) + m));
-        let mut h = Vector6::zeros();
-        h.fixed_rows_mut::<3>(0)
-            .copy_from(&(self.lever.transpose() * f));
-        h.fixed_rows_mut::<3>(3)
-            .copy_from(&(self.a.transpose() * m));
-        out.fixed_rows_mut::<MAX_RELEASED>(6)
-            .copy_from(&(self.b.transpose() * h));
+        // Written out (see `with_map`).
+        let (lf, am) = (mtv(&self.lever, &f), mtv(&self.a, &m));
+        let h = [lf.x, lf.y, lf.z, am.x, am.y, am.z];
+        for j in 0..MAX_RELEASED {
+            out[6 + j] = (0..6).fold(T::zero(), |acc, i| acc + self.b[(i, j)] * h[i]);
+        }
         out
     }
+}
+
+/// `aᵀ v`, written out.
+fn mtv<T: Scalar>(a: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
+    Vector3::from_fn(|i, _| a[(0, i)] * v[0] + a[(1, i)] * v[1] + a[(2, i)] * v[2])
 }

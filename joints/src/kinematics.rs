@@ -18,7 +18,7 @@
 //! variational map `N` of paper eqs 5–6 (`p_s = N p_Rm`) and the derivative of
 //! `Nᵀ g` that Newton's tangent needs. No kind writes a derivative by hand.
 
-use flexmech_core::rotation::{cayley_inverse, exp, log, skew};
+use flexmech_core::rotation::{cayley_inverse, exp, log, mmt, skew};
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Const, Matrix3, SMatrix, Vector3, Vector6, U1};
 use num_dual::HyperDualSVec64;
@@ -437,7 +437,7 @@ pub fn additive_step_map_from<J: JointKinematics + ?Sized, T: Scalar>(
         let d: [T; MAX_RELEASED] =
             std::array::from_fn(|i| if i < upto { from[i] + tau[i] } else { from[i] });
         let (r, l) = released_at(joint, start, &d);
-        stack(&(r - r_n), &cayley_inverse(&(l * l_n.transpose())))
+        stack(&(r - r_n), &cayley_inverse(&mmt(&l, &l_n)))
     };
     let mut b = SMatrix::<T, 6, MAX_RELEASED>::zeros();
     for k in 0..released_count::<J>() {
