@@ -5,12 +5,17 @@ use flexmech::prelude::*;
 
 use crate::common::data;
 
-#[test]
-fn memory_closure_and_file_sinks_see_the_same_steps() {
+/// The paper's cam example, 0.2 s of it.
+fn short_cam() -> Model {
     let text = std::fs::read_to_string(data("paper/cam.toml"))
         .unwrap()
         .replace("t_end = 3.0", "t_end = 0.2");
-    let model = parse_model(&text, &data("paper/cam.toml")).unwrap();
+    parse_model(&text, &data("paper/cam.toml")).unwrap()
+}
+
+#[test]
+fn memory_closure_and_file_sinks_see_the_same_steps() {
+    let model = short_cam();
     let mut memory = Memory::default();
     let summary = run(&model, &mut memory).unwrap();
     assert_eq!(memory.status(), "completed");
@@ -133,10 +138,7 @@ impl Sink for EveryThird {
 
 #[test]
 fn the_restart_state_is_built_when_the_sink_wants_it_and_at_the_end() {
-    let text = std::fs::read_to_string(data("paper/cam.toml"))
-        .unwrap()
-        .replace("t_end = 3.0", "t_end = 0.2");
-    let model = parse_model(&text, &data("paper/cam.toml")).unwrap();
+    let model = short_cam();
     let mut sink = EveryThird {
         memory: Memory::default(),
         saved_after: Vec::new(),
