@@ -57,6 +57,12 @@ pub fn mv<T: Scalar>(a: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
     Vector3::from_fn(|i, _| a[(i, 0)] * v[0] + a[(i, 1)] * v[1] + a[(i, 2)] * v[2])
 }
 
+/// `aᵀ v` of a 3 × 3 matrix and a vector, written out (see [`mm`]).
+#[inline]
+pub fn mtv<T: Scalar>(a: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
+    Vector3::from_fn(|i, _| a[(0, i)] * v[0] + a[(1, i)] * v[1] + a[(2, i)] * v[2])
+}
+
 /// The axial vector of the skew-symmetric part of `m`: `vee(â) = a`.
 #[inline]
 pub fn vee<T: Scalar>(m: &Matrix3<T>) -> Vector3<T> {

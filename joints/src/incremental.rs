@@ -28,7 +28,7 @@
 //! internal forces are: linear *and* angular momentum are conserved exactly.
 
 use crate::kinematics::{released_at, JointKinematics, ReleasedState, LOCAL, MAX_RELEASED};
-use flexmech_core::rotation::{cayley_inverse, exp, mm, mmt, mv, skew};
+use flexmech_core::rotation::{cayley_inverse, exp, mm, mmt, mtv, mv, skew};
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector6};
 
@@ -173,9 +173,4 @@ impl<T: Scalar> JointStep<T> {
         }
         out
     }
-}
-
-/// `aᵀ v`, written out.
-fn mtv<T: Scalar>(a: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
-    Vector3::from_fn(|i, _| a[(0, i)] * v[0] + a[(1, i)] * v[1] + a[(2, i)] * v[2])
 }
