@@ -15,7 +15,6 @@ use crate::dofs::DofMap;
 use faer::sparse::SymbolicSparseColMat;
 use flexmech_core::{Configuration, Element, Inertia, Mesh};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector6};
-use rayon::prelude::*;
 
 use crate::element_split::{Shared, Split};
 use crate::threads::LoopCost;
@@ -332,28 +331,27 @@ impl Assembler {
             return;
         };
         let sinks = Sinks::new(values, nodal, nodal_abs);
-        chunk_parts(work, split)
-            .into_par_iter()
-            .zip(chunk_scratch.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, (part, scratch))| {
-                for (w_own, index) in part.iter_mut().zip(split.chunks[c].clone()) {
-                    let (el, s) = (&mesh.elements[index], &slots[index]);
-                    let late = split.is_late(index);
-                    // Late elements keep their output for the second phase;
-                    // reduced tangents need the element's own buffers.
-                    let w = if late || (tangent && s.direct.is_none()) {
-                        w_own
-                    } else {
-                        scratch_for(scratch, el.dofs())
-                    };
-                    evaluate(w, index, el, s);
-                    let s = tangent.then_some(s);
-                    // SAFETY: chunk `c` adds only what it owns (all of it
-                    // for an element that is not late).
-                    unsafe { sinks.add(el, w, s, late.then_some((split, c, true))) };
-                }
-            });
+        let items = chunk_parts(work, split)
+            .into_iter()
+            .zip(chunk_scratch.iter_mut());
+        crate::threads::for_each_item(items.collect(), |c, (part, scratch)| {
+            for (w_own, index) in part.iter_mut().zip(split.chunks[c].clone()) {
+                let (el, s) = (&mesh.elements[index], &slots[index]);
+                let late = split.is_late(index);
+                // Late elements keep their output for the second phase;
+                // reduced tangents need the element's own buffers.
+                let w = if late || (tangent && s.direct.is_none()) {
+                    w_own
+                } else {
+                    scratch_for(scratch, el.dofs())
+                };
+                evaluate(w, index, el, s);
+                let s = tangent.then_some(s);
+                // SAFETY: chunk `c` adds only what it owns (all of it
+                // for an element that is not late).
+                unsafe { sinks.add(el, w, s, late.then_some((split, c, true))) };
+            }
+        });
         for &index in &split.late {
             let c = split.chunk_of(index);
             let (el, s) = (&mesh.elements[index], tangent.then_some(&slots[index]));

@@ -131,7 +131,7 @@ impl Topology {
             slave_of,
             released_eqs,
             local_eqs,
-            dofs: DofMap { n_eq, nodes: maps },
+            dofs: DofMap::new(n_eq, maps),
         };
         topo.refresh(mech, state);
         Ok(topo)

@@ -56,9 +56,40 @@ pub struct DofMap {
     pub n_eq: usize,
     /// One map per node.
     pub nodes: Vec<NodeMap>,
+    /// Per node, the nodal DOF of each of its equations when the node is
+    /// independent ([`NodeMap::own_dofs`]; such a map never changes): its
+    /// reduced residual is a gather, not a product with unit columns.
+    own: Vec<Option<OwnDofs>>,
+}
+
+/// The nodal DOFs (0..6) of an independent node's equations, in order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct OwnDofs {
+    dofs: [u8; 6],
+    len: u8,
+}
+
+impl OwnDofs {
+    fn of(map: &NodeMap) -> Option<Self> {
+        let own = map.own_dofs()?;
+        let mut dofs = [0; 6];
+        for (d, &o) in dofs.iter_mut().zip(&own) {
+            *d = o as u8;
+        }
+        Some(Self {
+            dofs,
+            len: own.len() as u8,
+        })
+    }
 }
 
 impl DofMap {
+    /// The map of `n_eq` unknowns with these node maps.
+    pub fn new(n_eq: usize, nodes: Vec<NodeMap>) -> Self {
+        let own = nodes.iter().map(OwnDofs::of).collect();
+        Self { n_eq, nodes, own }
+    }
+
     /// Independent nodes only: each free DOF is an unknown, numbered node by node.
     pub fn independent(fixed: &[[bool; 6]]) -> Self {
         let mut n_eq = 0;
@@ -76,7 +107,7 @@ impl DofMap {
                 m
             })
             .collect();
-        Self { n_eq, nodes }
+        Self::new(n_eq, nodes)
     }
 
     /// Nodal increment of node `n` for the global increment `dq`.
@@ -95,10 +126,20 @@ impl DofMap {
     /// Reduced residual `Σₙ Tₙᵀ gₙ` from nodal residuals `g` (6 per node).
     pub fn reduce(&self, g: &[f64], out: &mut [f64]) {
         out.iter_mut().for_each(|v| *v = 0.0);
-        for (n, m) in self.nodes.iter().enumerate() {
-            let gn = Vector6::from_column_slice(&g[6 * n..6 * n + 6]);
-            for (&e, c) in m.eqs.iter().zip(&m.cols) {
-                out[e] += c.dot(&gn);
+        for (n, (m, own)) in self.nodes.iter().zip(&self.own).enumerate() {
+            let gn = &g[6 * n..6 * n + 6];
+            match own {
+                Some(own) => {
+                    for (&e, &d) in m.eqs.iter().zip(&own.dofs[..own.len as usize]) {
+                        out[e] += gn[d as usize];
+                    }
+                }
+                None => {
+                    let gn = Vector6::from_column_slice(gn);
+                    for (&e, c) in m.eqs.iter().zip(&m.cols) {
+                        out[e] += c.dot(&gn);
+                    }
+                }
             }
         }
     }

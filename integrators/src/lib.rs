@@ -32,6 +32,7 @@ mod start_shift;
 pub mod statics;
 pub mod step_control;
 pub mod system;
+pub mod team;
 pub mod threads;
 pub mod tolerances;
 

@@ -6,21 +6,17 @@ use crate::constraints::{joint_records, MechanismState};
 use crate::mechanism::Mechanism;
 use crate::newton::NewtonReport;
 use crate::record::{Energies, StepRecord};
-use crate::threads::sequential;
+use crate::threads::map_each;
 use flexmech_core::{Configuration, Inertia};
 use nalgebra::Vector3;
-use rayon::prelude::*;
 
 /// Strain energy of the whole mesh (element energies summed in element order).
 pub fn strain_energy(mech: &Mechanism, config: &Configuration) -> f64 {
     let elements = &mech.mesh.elements;
-    let energy = |e: &flexmech_core::mesh::Element| e.energy(&config.x, &config.rot);
-    let per: Vec<f64> = if sequential(elements.len()) {
-        elements.iter().map(energy).collect()
-    } else {
-        elements.par_iter().map(energy).collect()
-    };
-    per.iter().sum()
+    let per = map_each(elements.len(), |e| {
+        elements[e].energy(&config.x, &config.rot)
+    });
+    per.iter().sum::<f64>()
 }
 
 /// Potential of the external nodal forces `fext` (6 per node), taken as

@@ -100,9 +100,9 @@ impl RotationGuard {
 }
 
 fn rotations(mech: &Mechanism, config: &Configuration) -> Vec<Vec<Vector3<f64>>> {
-    mech.mesh
-        .elements
-        .iter()
-        .map(|e| e.relative_rotations(&config.rot))
-        .collect()
+    let elements = &mech.mesh.elements;
+    // Each element's on its own: on two threads for a large mesh.
+    crate::threads::map_nodes(elements.len(), |e| {
+        elements[e].relative_rotations(&config.rot)
+    })
 }

@@ -22,8 +22,13 @@
 //! ([`PARALLEL_ALWAYS_ELEMENTS`]) that its band LU is factorised in two
 //! halves at once as well ([`crate::band_split`]). Either way the sums are
 //! the same numbers.
+//!
+//! The thread count is rayon's (`RAYON_NUM_THREADS`, or the pool a solve
+//! runs in); a solve's split loops run on [`crate::team`], whose helpers
+//! stay awake between one loop and the next.
 
 use std::cell::Cell;
+use std::sync::Mutex;
 use std::thread::LocalKey;
 use std::time::Duration;
 
@@ -91,28 +96,109 @@ pub fn join<A: Send, B: Send>(
 ) -> (A, B) {
     if sequential(usize::MAX) {
         let ra = a();
-        (ra, b())
-    } else {
-        rayon::join(a, b)
+        return (ra, b());
     }
+    let (ra, rb) = (Mutex::new(None), Mutex::new(None));
+    let (a, b) = (Mutex::new(Some(a)), Mutex::new(Some(b)));
+    crate::team::run(rayon::current_num_threads(), 2, &|i| {
+        if i == 0 {
+            if let Some(a) = take(&a) {
+                *lock(&ra) = Some(a());
+            }
+        } else if let Some(b) = take(&b) {
+            *lock(&rb) = Some(b());
+        }
+    });
+    match (take(&ra), take(&rb)) {
+        (Some(ra), Some(rb)) => (ra, rb),
+        // `team::run` runs every task or resumes a task's panic.
+        _ => unreachable!("both halves of a join ran"),
+    }
+}
+
+/// `task(i, item)` for every item, each on whichever of the threads is free
+/// ([`crate::team`]): for chunks of a loop whose results do not depend on
+/// who computes them.
+pub fn for_each_item<T: Send>(items: Vec<T>, task: impl Fn(usize, T) + Sync) {
+    let slots: Vec<Mutex<Option<T>>> = items.into_iter().map(|t| Mutex::new(Some(t))).collect();
+    crate::team::run(rayon::current_num_threads(), slots.len(), &|i| {
+        if let Some(item) = take(&slots[i]) {
+            task(i, item);
+        }
+    });
+}
+
+/// Chunks a per-node loop is cut into, per thread (a little more than one,
+/// so that a thread held up elsewhere does not hold the loop up).
+const NODE_CHUNKS_PER_THREAD: usize = 4;
+
+/// The ranges of `n` nodes' chunks.
+fn node_chunks(n: usize) -> impl Iterator<Item = std::ops::Range<usize>> {
+    let count = (rayon::current_num_threads() * NODE_CHUNKS_PER_THREAD).clamp(1, n.max(1));
+    (0..count).map(move |c| c * n / count..(c + 1) * n / count)
+}
+
+/// The item of a slot, taken (a poisoned lock's too: its task panicked,
+/// which the team resumes).
+fn take<T>(slot: &Mutex<Option<T>>) -> Option<T> {
+    lock(slot).take()
+}
+
+/// A lock's guard, a poisoned one's too.
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// Whether a per-node loop over `nodes` nodes goes to two threads: a mesh
 /// large enough that its element loops are split whatever they cost
-/// ([`PARALLEL_ALWAYS_ELEMENTS`]), threads to use.
+/// ([`PARALLEL_ALWAYS_ELEMENTS`]) or any loop under [`always_split`],
+/// threads to use.
 pub fn split_nodes(nodes: usize) -> bool {
-    nodes >= PARALLEL_ALWAYS_ELEMENTS && !sequential(nodes)
+    (nodes >= PARALLEL_ALWAYS_ELEMENTS || ALWAYS_SPLIT.with(Cell::get)) && !sequential(nodes)
 }
 
 /// `f(i)` for every node `i < nodes`, in order — on two threads where
 /// [`split_nodes`]; each value computed on its own, so the same either way.
 pub fn map_nodes<T: Send>(nodes: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
-    use rayon::prelude::*;
-    if split_nodes(nodes) {
-        (0..nodes).into_par_iter().map(f).collect()
-    } else {
-        (0..nodes).map(f).collect()
+    map_split(nodes, split_nodes(nodes), f)
+}
+
+/// `f(i)` for every `i < n`, in order — on two threads unless
+/// [`sequential`]: for loops whose every item is costly (an element's
+/// energy terms), split from [`PARALLEL_MIN_ELEMENTS`] items on.
+pub fn map_each<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+    map_split(n, !sequential(n), f)
+}
+
+/// `f(i)` for every `i < n`, in order, in chunks on the team's threads if
+/// `split`; each value computed on its own, so the same either way.
+fn map_split<T: Send>(n: usize, split: bool, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+    if !split {
+        return (0..n).map(f).collect();
     }
+    let chunks: Vec<_> = node_chunks(n).collect();
+    let outs: Vec<Mutex<Vec<T>>> = chunks.iter().map(|_| Mutex::new(Vec::new())).collect();
+    crate::team::run(rayon::current_num_threads(), chunks.len(), &|c| {
+        *lock(&outs[c]) = chunks[c].clone().map(&f).collect();
+    });
+    let mut all = Vec::with_capacity(n);
+    for out in outs {
+        all.append(&mut out.into_inner().unwrap_or_else(|e| e.into_inner()));
+    }
+    all
+}
+
+/// `f(i)` for every node `i < nodes` — on the team's threads where
+/// [`split_nodes`], each node once: for node loops that write only what
+/// belongs to their node.
+pub fn for_each_node(nodes: usize, f: impl Fn(usize) + Sync) {
+    if !split_nodes(nodes) {
+        return (0..nodes).for_each(f);
+    }
+    let chunks: Vec<_> = node_chunks(nodes).collect();
+    crate::team::run(rayon::current_num_threads(), chunks.len(), &|c| {
+        chunks[c].clone().for_each(&f)
+    });
 }
 
 /// `f(i, xᵢ, Rᵢ)` on every node's pose — on two threads where
@@ -122,21 +208,31 @@ pub fn for_each_pose(
     rot: &mut [nalgebra::Matrix3<f64>],
     f: impl Fn(usize, &mut nalgebra::Vector3<f64>, &mut nalgebra::Matrix3<f64>) + Sync + Send,
 ) {
-    use rayon::prelude::*;
-    if split_nodes(x.len()) {
-        let poses = x.par_iter_mut().zip(rot.par_iter_mut()).enumerate();
-        poses.for_each(|(i, (x, r))| f(i, x, r));
-    } else {
+    if !split_nodes(x.len()) {
         x.iter_mut()
             .zip(rot.iter_mut())
             .enumerate()
             .for_each(|(i, (x, r))| f(i, x, r));
+        return;
     }
+    let mut items = Vec::new();
+    let (mut x, mut rot) = (x, rot);
+    for range in node_chunks(x.len().min(rot.len())) {
+        let (xs, x_rest) = std::mem::take(&mut x).split_at_mut(range.len());
+        let (rs, rot_rest) = std::mem::take(&mut rot).split_at_mut(range.len());
+        items.push((range.start, xs, rs));
+        (x, rot) = (x_rest, rot_rest);
+    }
+    for_each_item(items, |_, (first, xs, rs)| {
+        for (k, (x, r)) in xs.iter_mut().zip(rs.iter_mut()).enumerate() {
+            f(first + k, x, r);
+        }
+    });
 }
 
-/// Runs `task` with every element loop that may be split ([`sequential`]
-/// false) split over the threads whatever its kernels cost: for tests of
-/// the parallel paths with cheap kernels.
+/// Runs `task` with every element and node loop that may be split
+/// ([`sequential`] false) split over the threads whatever its kernels cost:
+/// for tests of the parallel paths with cheap kernels and small meshes.
 pub fn always_split<R>(task: impl FnOnce() -> R) -> R {
     with_flag(&ALWAYS_SPLIT, task)
 }

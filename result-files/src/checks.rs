@@ -66,6 +66,11 @@ impl Balance {
         }
         if let Some((x0, q0, f0)) = &self.previous {
             for n in 0..s.positions.len() {
+                let loaded = |f: &[f64]| f[6 * n..6 * n + 6].iter().any(|&v| v != 0.0);
+                if !loaded(f0) && !loaded(&loads) {
+                    // No work: skip the node's rotation increment.
+                    continue;
+                }
                 let dx = Vector3::from(s.positions[n]) - Vector3::from(x0[n]);
                 let turn = quaternion(s.quaternions[n]) * quaternion(q0[n]).inverse();
                 let dtheta = turn.scaled_axis();

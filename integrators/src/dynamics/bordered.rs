@@ -10,13 +10,12 @@ use crate::newton::{
     at_floor, check_regular, diverged, NewtonReport, NewtonSettings, NewtonSystem,
 };
 use crate::system::{ReducedSystem, StepTerms};
-use crate::threads::sequential;
+use crate::threads::map_each;
 use crate::tolerances::TOLERANCES;
 use flexmech_core::conserving::MidRotation;
 use flexmech_core::rotation::cayley_inverse;
 use flexmech_core::{Configuration, Element};
 use nalgebra::{Const, SVector, U1};
-use rayon::prelude::*;
 
 /// Terms whose element force carries the correction `β q_k(N_d, 0)`.
 pub(crate) trait Bordered: StepTerms {
@@ -206,17 +205,7 @@ fn energy_equation_nodal<T: Bordered>(
     // Element terms in parallel, summed in element order (deterministic).
     let (start, end) = (&sys.start.config, &sys.end.config);
     let elements = &sys.mech.mesh.elements;
-    let terms: Vec<EnergyTerms> = if sequential(elements.len()) {
-        elements
-            .iter()
-            .map(|el| energy_terms(el, start, end))
-            .collect()
-    } else {
-        elements
-            .par_iter()
-            .map(|el| energy_terms(el, start, end))
-            .collect()
-    };
+    let terms = map_each(elements.len(), |e| energy_terms(&elements[e], start, end));
     for (el, t) in sys.mech.mesh.elements.iter().zip(&terms) {
         e_tot += t.e;
         c_tot += t.c;

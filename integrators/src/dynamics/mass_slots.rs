@@ -4,6 +4,7 @@
 
 use crate::assembly::Assembler;
 use crate::dofs::DofMap;
+use crate::element_split::Shared;
 use flexmech_core::Inertia;
 use nalgebra::{Matrix3, Vector3};
 /// Where the mass and inertia blocks land in the tangent values. The
@@ -76,11 +77,12 @@ impl MassSlots {
 
     /// Adds a scheme's inertial forces to the nodal residual `g` (their
     /// magnitudes to `abs`) and, with `tangent`, their tangent blocks:
-    /// `force(j, m)` is the force of mass entry `(i, j, m)` on node `i`,
-    /// whose derivative with respect to node `j`'s translation is
-    /// `coefficient·m·I`; `moment(i, J₀, tangent)` is node `i`'s inertial
-    /// moment and its derivative under a spin of its end rotation (nodes
-    /// without rotary inertia are skipped).
+    /// `force(m, &node_term(j))` is the force of mass entry `(i, j, m)` on
+    /// node `i` (`node_term` computed once per node), whose derivative with
+    /// respect to node `j`'s translation is `coefficient·m·I`;
+    /// `moment(i, J₀, tangent)` is node `i`'s inertial moment and its
+    /// derivative under a spin of its end rotation (nodes without rotary
+    /// inertia are skipped).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn add_inertia(
         &self,
@@ -88,12 +90,14 @@ impl MassSlots {
         g: &mut [f64],
         abs: &mut [f64],
         mut tangent: Option<(&mut Assembler, &DofMap)>,
-        force: impl Fn(usize, f64) -> Vector3<f64>,
+        node_term: impl Fn(usize) -> Vector3<f64> + Sync + Send,
+        force: impl Fn(f64, &Vector3<f64>) -> Vector3<f64>,
         coefficient: f64,
         moment: impl Fn(usize, &Matrix3<f64>, bool) -> (Vector3<f64>, Matrix3<f64>) + Sync,
     ) {
+        let terms = crate::threads::map_nodes(g.len() / 6, node_term);
         for &(i, j, m) in &inertia.mass {
-            let f = force(j, m);
+            let f = force(m, &terms[j]);
             for c in 0..3 {
                 g[6 * i + c] += f[c];
                 abs[6 * i + c] += f[c].abs();
@@ -101,6 +105,11 @@ impl MassSlots {
         }
         if let Some((asm, dofs)) = tangent.as_mut() {
             self.add_translational(asm, dofs, inertia, coefficient);
+        }
+        let nodes = inertia.rotational.len();
+        if crate::threads::split_nodes(nodes) && self.rotational.iter().all(Option::is_some) {
+            let values = tangent.map(|(asm, _)| &mut asm.values[..]);
+            return self.add_rotational_split(inertia, g, abs, values, &moment);
         }
         let moments = rotational_moments(inertia, tangent.is_some(), &moment);
         for (i, (m, k)) in moments.into_iter().enumerate() {
@@ -115,6 +124,49 @@ impl MassSlots {
                 self.add_rotational(asm, dofs, i, &k);
             }
         }
+    }
+
+    /// The inertial moments' part of [`Self::add_inertia`] for a large mesh
+    /// of independent nodes, on the team's threads: each node's moment,
+    /// and its tangent block into `values` (given a tangent), is added by
+    /// the thread that computes it — the entries of `g`, `abs` and the
+    /// values each node adds to are its own, and each receives one term, so
+    /// the sums are those of the sequential loop.
+    fn add_rotational_split(
+        &self,
+        inertia: &Inertia,
+        g: &mut [f64],
+        abs: &mut [f64],
+        values: Option<&mut [f64]>,
+        moment: &(impl Fn(usize, &Matrix3<f64>, bool) -> (Vector3<f64>, Matrix3<f64>) + Sync),
+    ) {
+        let tangent = values.is_some();
+        let (g, abs) = (Shared::new(g), Shared::new(abs));
+        let values = values.map(Shared::new);
+        crate::threads::for_each_node(inertia.rotational.len(), |i| {
+            let j0 = &inertia.rotational[i];
+            if *j0 == Matrix3::zeros() {
+                return;
+            }
+            let (m, k) = moment(i, j0, tangent);
+            // SAFETY: node `i`'s rotational entries of `g` and `abs`, and the
+            // positions of its own inertia block, are touched by this node
+            // only (see above); `for_each_node` visits each node once.
+            unsafe {
+                g.add(6 * i + 3, m.as_slice(), |v| v);
+                abs.add(6 * i + 3, m.as_slice(), f64::abs);
+            }
+            let (Some(values), Some(at)) = (&values, &self.rotational[i]) else {
+                return;
+            };
+            for &(p, a, b) in at {
+                let v = k[(a, b)];
+                if v != 0.0 {
+                    // SAFETY: as above.
+                    unsafe { values.add(p, &[v], |v| v) };
+                }
+            }
+        });
     }
 }
 

@@ -215,10 +215,8 @@ impl StepTerms for MidpointTerms {
             g,
             abs,
             tangent,
-            |j, m| {
-                let dv = (end.x[j] - start.x[j]) * (2.0 / dt) - self.v_n[j] * 2.0;
-                dv.map(|d| m * d / dt)
-            },
+            |j| (end.x[j] - start.x[j]) * (2.0 / dt) - self.v_n[j] * 2.0,
+            |m, dv| dv.map(|d| m * d / dt),
             2.0 / (dt * dt),
             |i, j0, tangent| {
                 inertial_moment(j0, &start.rot[i], &end.rot[i], &self.w_n[i], dt, tangent)

@@ -342,10 +342,11 @@ impl StepTerms for NewmarkTerms {
             g,
             abs,
             tangent,
-            |j, m| {
+            |j| {
                 let a1 = pseudo_acceleration(k, end.x[j] - start.x[j], &prev.v[j], &prev.a[j], dt);
-                k.acceleration(a1, &prev.a[j], &prev.acc[j]).map(|a| m * a)
+                k.acceleration(a1, &prev.a[j], &prev.acc[j])
             },
+            |m, a| a.map(|a| m * a),
             k.stiffness(dt),
             |i, j0, tangent| {
                 if tangent {
