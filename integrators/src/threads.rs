@@ -1,31 +1,25 @@
-//! When an element loop is worth handing to the thread pool.
+//! When an element loop is worth handing to other threads.
 //!
-//! Handing a loop to rayon's pool wakes a worker (a system call and a
-//! context switch each way, several µs) — more than a small mesh's element
-//! kernels cost (about 1.5 µs per 2-node element): with two threads, a
-//! 32-element cantilever ran in 0.23–0.27 s handing every loop over and in
-//! 0.14 s without. And where there is one thread, or the solve is itself one
-//! of many parallel tasks (a study's runs, [`one_thread_each`]), splitting
-//! its loops again only adds hand-offs between the same threads.
-//!
-//! Nor does a mid-sized mesh gain when its element kernels are cheap next to
-//! the rest of the step: a Newmark step of 2-node elements spends about a
-//! sixth of its time in the kernels (≈ 1 µs per element) and most of the
-//! rest in the band factorisation and the solves; with those on one thread,
-//! splitting the kernels saved less than the hand-offs and the second busy
-//! core cost it (2 048 and 4 096 elements ran 1.00–1.07 × *slower* with two
-//! threads than with one). So an element loop is split when its kernels,
-//! timed on one thread for the first few calls ([`LoopCost`]), cost at least
-//! [`PARALLEL_MIN_NS_PER_ELEMENT`] each — the energy–momentum scheme's exact
-//! tangent (≈ 24 µs, 1.5–1.6 × faster on two threads at 2 048 elements),
-//! 3-node elements (≈ 5 µs) — or when the mesh is large enough
-//! ([`PARALLEL_ALWAYS_ELEMENTS`]) that its band LU is factorised in two
-//! halves at once as well ([`crate::band_split`]). Either way the sums are
-//! the same numbers.
-//!
+//! A solve's split loops run on [`crate::team`], whose helpers stay awake
+//! between one loop and the next, so a hand-off costs about a µs rather
+//! than the system call and context switches of waking a sleeping worker.
 //! The thread count is rayon's (`RAYON_NUM_THREADS`, or the pool a solve
-//! runs in); a solve's split loops run on [`crate::team`], whose helpers
-//! stay awake between one loop and the next.
+//! runs in). Where there is one thread, or the solve is itself one of many
+//! parallel tasks (a study's runs, [`one_thread_each`]), splitting its
+//! loops again would only add hand-offs between the same threads.
+//!
+//! A small mesh's loops stay on the calling thread: a 2-node element's
+//! kernels cost about 1 µs, and a 64-element cantilever under Newmark ran
+//! 1.3× *slower* with its loops split over two threads. From
+//! [`PARALLEL_ALWAYS_ELEMENTS`] elements on, every element and node loop
+//! is split (2-node cantilevers under Newmark, wall time on two threads
+//! over one: 128 elements 0.82, 256 and 512 elements 0.78, 2 048 elements
+//! 0.58 with its band LU in two halves as well, [`crate::band_split`]).
+//! Between the two, a loop is split when its kernels, timed on one thread
+//! for the first few calls ([`LoopCost`]), cost at least
+//! [`PARALLEL_MIN_NS_PER_ELEMENT`] each — the energy–momentum scheme's
+//! exact tangent (≈ 24 µs), 3-node elements (≈ 5 µs). Either way the sums
+//! are the same numbers.
 
 use std::cell::Cell;
 use std::sync::Mutex;
@@ -39,13 +33,9 @@ pub const PARALLEL_MIN_ELEMENTS: usize = 64;
 /// thread, for the loop to be split over threads.
 pub const PARALLEL_MIN_NS_PER_ELEMENT: f64 = 2000.0;
 
-/// Fewest elements for which a loop is split whatever its kernels cost:
-/// from here on the mesh's band LU is factorised in two halves too
-/// ([`crate::band_split::SPLIT_MIN_UNKNOWNS`] unknowns, 6 per node), so
-/// the whole step, not a sixth of it, runs on two threads (2-node
-/// cantilevers under Newmark on two threads: 512 elements 1.1 × slower
-/// split, 1 024 to 4 096 elements 1.1–1.2 × faster).
-pub const PARALLEL_ALWAYS_ELEMENTS: usize = 1024;
+/// Fewest elements for which a loop is split whatever its kernels cost
+/// (see the module docs for the measurements).
+pub const PARALLEL_ALWAYS_ELEMENTS: usize = 128;
 
 /// One-thread calls timed before a loop's cost is known.
 const PROBE_CALLS: u32 = 3;
