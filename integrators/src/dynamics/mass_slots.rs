@@ -106,10 +106,9 @@ impl MassSlots {
         if let Some((asm, dofs)) = tangent.as_mut() {
             self.add_translational(asm, dofs, inertia, coefficient);
         }
-        let nodes = inertia.rotational.len();
-        if crate::threads::split_nodes(nodes) && self.rotational.iter().all(Option::is_some) {
+        if self.rotational.iter().all(Option::is_some) {
             let values = tangent.map(|(asm, _)| &mut asm.values[..]);
-            return self.add_rotational_split(inertia, g, abs, values, &moment);
+            return self.add_rotational_own(inertia, g, abs, values, &moment);
         }
         let moments = rotational_moments(inertia, tangent.is_some(), &moment);
         for (i, (m, k)) in moments.into_iter().enumerate() {
@@ -126,13 +125,15 @@ impl MassSlots {
         }
     }
 
-    /// The inertial moments' part of [`Self::add_inertia`] for a large mesh
-    /// of independent nodes, on the team's threads: each node's moment,
-    /// and its tangent block into `values` (given a tangent), is added by
-    /// the thread that computes it — the entries of `g`, `abs` and the
-    /// values each node adds to are its own, and each receives one term, so
-    /// the sums are those of the sequential loop.
-    fn add_rotational_split(
+    /// The inertial moments' part of [`Self::add_inertia`] where no node is
+    /// a slave (every inertia block has its own positions), node by node —
+    /// on the team's threads for a large mesh
+    /// ([`crate::threads::for_each_node`]): each node's moment, and its
+    /// tangent block into `values` (given a tangent), is added by the thread
+    /// that computes it. The entries of `g`, `abs` and the values each node
+    /// adds to are its own, and each receives one term here, so the sums do
+    /// not depend on the thread count.
+    fn add_rotational_own(
         &self,
         inertia: &Inertia,
         g: &mut [f64],
