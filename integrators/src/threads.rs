@@ -13,8 +13,9 @@
 //! 1.3× *slower* with its loops split over two threads. From
 //! [`PARALLEL_ALWAYS_ELEMENTS`] elements on, every element and node loop
 //! is split (2-node cantilevers under Newmark, wall time on two threads
-//! over one: 128 elements 0.82, 256 and 512 elements 0.78, 2 048 elements
-//! 0.58 with its band LU in two halves as well, [`crate::band_split`]).
+//! over one: 128 elements 0.89, 256 elements 0.81, 512 elements 0.77,
+//! 1 024 elements 0.64, 2 048 elements 0.60 with its band LU in two halves
+//! as well, [`crate::band_split`]).
 //! Between the two, a loop is split when its kernels, timed on one thread
 //! for the first few calls ([`LoopCost`]), cost at least
 //! [`PARALLEL_MIN_NS_PER_ELEMENT`] each — the energy–momentum scheme's
@@ -22,6 +23,7 @@
 //! are the same numbers.
 
 use std::cell::Cell;
+use std::ops::Range;
 use std::sync::Mutex;
 use std::thread::LocalKey;
 use std::time::Duration;
@@ -123,7 +125,7 @@ pub fn for_each_item<T: Send>(items: Vec<T>, task: impl Fn(usize, T) + Sync) {
 const NODE_CHUNKS_PER_THREAD: usize = 4;
 
 /// The ranges of `n` nodes' chunks.
-fn node_chunks(n: usize) -> impl Iterator<Item = std::ops::Range<usize>> {
+fn node_chunks(n: usize) -> impl Iterator<Item = Range<usize>> {
     let count = (rayon::current_num_threads() * NODE_CHUNKS_PER_THREAD).clamp(1, n.max(1));
     (0..count).map(move |c| c * n / count..(c + 1) * n / count)
 }
@@ -168,8 +170,8 @@ fn map_split<T: Send>(n: usize, split: bool, f: impl Fn(usize) -> T + Sync + Sen
     }
     let chunks: Vec<_> = node_chunks(n).collect();
     let outs: Vec<Mutex<Vec<T>>> = chunks.iter().map(|_| Mutex::new(Vec::new())).collect();
-    crate::team::run(rayon::current_num_threads(), chunks.len(), &|c| {
-        *lock(&outs[c]) = chunks[c].clone().map(&f).collect();
+    for_each_chunk(&chunks, |c, range| {
+        *lock(&outs[c]) = range.map(&f).collect()
     });
     let mut all = Vec::with_capacity(n);
     for out in outs {
@@ -186,8 +188,13 @@ pub fn for_each_node(nodes: usize, f: impl Fn(usize) + Sync) {
         return (0..nodes).for_each(f);
     }
     let chunks: Vec<_> = node_chunks(nodes).collect();
+    for_each_chunk(&chunks, |_, range| range.for_each(&f));
+}
+
+/// `f(c, chunks[c])` for every chunk, on the team's threads.
+fn for_each_chunk(chunks: &[Range<usize>], f: impl Fn(usize, Range<usize>) + Sync) {
     crate::team::run(rayon::current_num_threads(), chunks.len(), &|c| {
-        chunks[c].clone().for_each(&f)
+        f(c, chunks[c].clone())
     });
 }
 
