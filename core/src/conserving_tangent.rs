@@ -102,7 +102,11 @@ impl BeamElement<2> {
         (q, self.momentum_tangent_of(&s0, &s1).1)
     }
 
-    /// [`Self::momentum_force_tangent`] from the poses' [`Frames`].
+    /// [`Self::momentum_force_tangent`] from the poses' [`Frames`]: the chain
+    /// rule of the module docs block by block. Only the increments' blocks
+    /// `(η₁, ε₁, η₂, ε₂)` that a term depends on are formed — `δd` on the
+    /// `η`, `w_r` and `δφ` on the `ε` — and the `η₁` blocks are the negated
+    /// `η₂` ones.
     fn momentum_tangent_of(
         &self,
         s0: &Frames<f64>,
@@ -117,24 +121,34 @@ impl BeamElement<2> {
         let (n, m) = (lt * nbar, lt * mbar);
         let dbar = (s0.d + s1.d) * 0.5;
         let arm = -dbar.cross(&n) * 0.5;
-        // Chain rule (module docs).
-        let id = Matrix3::identity();
-        let z = Matrix3::zeros();
+        // S, P, G of the module docs; δd = η₂ − η₁, w_r = (I − P)ε₁ + Pε₂,
+        // δφ = S(ε₂ − ε₁), w̃ = G w_r.
         let s = tangent_inverse(&s1.phi) * s1.lam[0].transpose();
         let p = s1.lam[0] * tangent(&(s1.phi * 0.5)) * s * 0.5;
         let g = tangent(&(omega * 0.5)) * tangent_inverse(&omega) * 0.5;
-        let jd = jac([-id, z, id, z]);
-        let jwr = jac([z, id - p, z, p]);
-        let jphi = jac([z, -s, z, s]);
-        let jnbar = Matrix3::from_diagonal(&(self.section.c_n * (0.5 / l)))
-            * s1.lam_r.transpose()
-            * (jd + s1.d.cross_matrix() * jwr);
-        let jmbar = Matrix3::from_diagonal(&(self.section.c_m * (0.5 / l))) * jphi;
-        let jwt = g * jwr;
-        let jn = -n.cross_matrix() * jwt + lt * jnbar;
-        let jm = -m.cross_matrix() * jwt + lt * jmbar;
-        let jarm = n.cross_matrix() * jd * 0.25 - dbar.cross_matrix() * jn * 0.5;
-        stack((&n, &arm, &m), (&jn, &jarm, &jm))
+        // δN̄ = A (δd + d̂ w_r), δM̄ = D δφ; Λ̃ A on δd, Λ̃ A d̂ on w_r.
+        let lta =
+            lt * Matrix3::from_diagonal(&(self.section.c_n * (0.5 / l))) * s1.lam_r.transpose();
+        let ltad = lta * s1.d.cross_matrix();
+        let ltds = lt * Matrix3::from_diagonal(&(self.section.c_m * (0.5 / l))) * s;
+        let (ng, mg) = (n.cross_matrix() * g, m.cross_matrix() * g);
+        // The ε₂ blocks (through P and S); the ε₁ blocks through I − P and −S.
+        let jn_e2 = (ltad - ng) * p;
+        let jn_e1 = ltad - ng - jn_e2;
+        let jm_e2 = ltds - mg * p;
+        let jm_e1 = -mg - jm_e2;
+        // δ(−½ d̄ × n) = ¼ n̂ δd − ½ d̄̂ δn.
+        let half_dbar = dbar.cross_matrix() * 0.5;
+        let ja_x2 = n.cross_matrix() * 0.25 - half_dbar * lta;
+        let z = Matrix3::zeros();
+        stack(
+            (&n, &arm, &m),
+            (
+                &jac([-lta, jn_e1, lta, jn_e2]),
+                &jac([-ja_x2, -half_dbar * jn_e1, ja_x2, -half_dbar * jn_e2]),
+                &jac([z, jm_e1, z, jm_e2]),
+            ),
+        )
     }
 
     /// The energy–momentum scheme's element force (the discrete gradient

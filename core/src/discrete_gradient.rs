@@ -65,10 +65,12 @@
 use crate::conserving::{Frames, Pose};
 use crate::element::BeamElement;
 use crate::rotation::{
-    cayley, cayley_inverse, exp, log, mm, mmt, mtm, mv, skew, tangent, tangent_inverse,
+    cayley_inverse, cayley_of_quaternion, cayley_quaternion, exp_quaternion, log_quaternion, mm,
+    mmt, mtm, mv, quaternion_conjugate, quaternion_half, quaternion_product, skew, tangent,
+    tangent_inverse,
 };
 use crate::scalar::{cst, Scalar};
-use nalgebra::{Matrix3, SVector, Vector3};
+use nalgebra::{Matrix3, SVector, Vector3, Vector4};
 
 /// Width `ε` of the rank-one corrections' regularisation, relative to
 /// `1 + |θ₁|² + |θ₂|²`: the corrections divide by `|Δθ|² + ε²` instead of
@@ -98,7 +100,8 @@ pub(crate) struct Step<T: Scalar> {
 /// Spatial tangent of the Cayley map: `δcay(c) cay(c)ᵀ = (Q(c) δc)^`,
 /// `Q(c) = (I + ½ĉ)/(1 + ¼|c|²)`.
 fn cayley_tangent<T: Scalar>(c: &Vector3<T>) -> Matrix3<T> {
-    (Matrix3::identity() + skew(c) * cst::<T>(0.5)) / (T::one() + c.norm_squared() * cst::<T>(0.25))
+    (Matrix3::identity() + skew(c) * cst::<T>(0.5))
+        * (T::one() / (T::one() + c.norm_squared() * cst::<T>(0.25)))
 }
 
 /// `Q(c)⁻¹ = I − ½ĉ + ¼ c⊗c`.
@@ -108,7 +111,7 @@ fn cayley_tangent_inverse<T: Scalar>(c: &Vector3<T>) -> Matrix3<T> {
 
 /// The smooth secant operators `(B, T)` of a step seen from one end, from
 /// that end's relative rotations: [`secant_operators_at`] with the
-/// exponentials computed here (for callers that hold rotation vectors only).
+/// quaternions computed here (for callers that hold rotation vectors only).
 pub(crate) fn secant_operators<T: Scalar>(
     lam1: &Matrix3<T>,
     phi0: &Vector3<T>,
@@ -116,47 +119,61 @@ pub(crate) fn secant_operators<T: Scalar>(
     th: &[Vector3<T>; 2],
 ) -> (Matrix3<T>, Matrix3<T>) {
     let half = cst::<T>(0.5);
-    let half0 = exp(&(phi0 * half));
-    let g = cayley_inverse(&mmt(&exp(&(phi1 * half)), &half0));
-    secant_operators_at(lam1, &exp(phi0), &half0, &g, th)
+    let half0 = exp_quaternion(&(phi0 * half));
+    let g = relative_cayley(&exp_quaternion(&(phi1 * half)), &half0);
+    secant_operators_at(lam1, &exp_quaternion(phi0), &half0, &g, th)
+}
+
+/// The Cayley vector of `Λ(a) Λ(b)ᵀ` from the quaternions `a`, `b`:
+/// `cay⁻¹(Λ(a) Λ(b)ᵀ)`.
+fn relative_cayley<T: Scalar>(a: &Vector4<T>, b: &Vector4<T>) -> Vector3<T> {
+    cayley_of_quaternion(&quaternion_product(a, &quaternion_conjugate(b)))
 }
 
 /// The smooth secant operators `(B, T)` of a step seen from one end: node
-/// 1's triad `lam1`, that end's relative rotation `rel0 = exp(φ̂₀)` and its
-/// half `half0 = exp(½φ̂₀)`, the reference rotation's relative increment
+/// 1's triad `lam1`, the unit quaternions (`w ≥ 0`) of that end's relative
+/// rotation `rel0 = exp(φ̂₀)` and of its half `half0 = exp(½φ̂₀)`, the
+/// reference rotation's relative increment
 /// `g = cay⁻¹(exp(½φ̂₁) exp(−½φ̂₀))` towards the other end, and the Cayley
-/// increments `th` of the nodes towards the other end.
+/// increments `th` of the nodes towards the other end. The rotations of the
+/// midpoint rule (`cay(½c) exp(φ̂₀)`, its half, and the increment `g` at ½c)
+/// are composed as quaternions, so no logarithm of a matrix and no
+/// exponential series is taken; with `T = ∂φ/∂c Λ₁ᵀC` and
+/// `∂g/∂c = ½ Q(g)⁻¹ H(½φ) ∂φ/∂c` (module docs),
+/// `B = ½ E Λ₁ Q(g)⁻¹ H(½φ) T − ½I`.
 pub(crate) fn secant_operators_at<T: Scalar>(
     lam1: &Matrix3<T>,
-    rel0: &Matrix3<T>,
-    half0: &Matrix3<T>,
+    rel0: &Vector4<T>,
+    half0: &Vector4<T>,
     g: &Vector3<T>,
     th: &[Vector3<T>; 2],
 ) -> (Matrix3<T>, Matrix3<T>) {
     let half = cst::<T>(0.5);
     let quarter = cst::<T>(0.25);
+    let id = Matrix3::identity();
     let dtheta = th[1] - th[0];
     let tbar = (th[0] + th[1]) * half;
     // Λ₁ᵀΛ₂ advances by cay(c), c = Λ₁ᵀ C Δθ exactly.
-    let to_rel = mtm(lam1, &(Matrix3::identity() - skew(&tbar) * half))
-        / (T::one() + th[0].dot(&th[1]) * quarter);
+    let to_rel = mtm(lam1, &(id - skew(&tbar) * half))
+        * (T::one() / (T::one() + th[0].dot(&th[1]) * quarter));
     let c_half = mv(&to_rel, &dtheta) * half;
-    // Jacobians of φ(c) = log(cay(c) exp(φ̂₀)) and g(c) at ½c (midpoint rule).
-    let phi_h = log(&mm(&cayley(&c_half), rel0));
-    let dphi_dc = mm(&tangent_inverse(&phi_h), &cayley_tangent(&c_half));
-    let g_h = cayley_inverse(&mmt(&exp(&(phi_h * half)), half0));
-    let dg_dc = mm(
-        &mm(&cayley_tangent_inverse(&g_h), &tangent(&(phi_h * half))),
-        &dphi_dc,
-    ) * half;
+    // φ(c) = log(cay(c) exp(φ̂₀)) and g(c) at ½c (midpoint rule).
+    let mut q = quaternion_product(&cayley_quaternion(&c_half), rel0);
+    if q.x.value() < 0.0 {
+        q = -q;
+    }
+    let phi_h = log_quaternion(&q);
+    let g_h = relative_cayley(&quaternion_half(&q), half0);
+    let t = mm(
+        &mm(&tangent_inverse(&phi_h), &cayley_tangent(&c_half)),
+        &to_rel,
+    );
     // θ_r − θ₁ = E b/(1 − ¼θ₁·b), b = Λ₁ g (Cayley composition).
     let b = mv(lam1, g);
-    let e = (Matrix3::identity() + skew(&th[0]) * half + th[0] * th[0].transpose() * quarter)
-        / (T::one() - th[0].dot(&b) * quarter);
-    (
-        mm(&mm(&mm(&e, lam1), &dg_dc), &to_rel) - Matrix3::identity() * half,
-        mm(&dphi_dc, &to_rel),
-    )
+    let e = (id + skew(&th[0]) * half + th[0] * th[0].transpose() * quarter)
+        * (T::one() / (T::one() - th[0].dot(&b) * quarter));
+    let dg = mm(&cayley_tangent_inverse(&g_h), &tangent(&(phi_h * half)));
+    (mm(&mm(&mm(&e, lam1), &dg), &t) * half - id * half, t)
 }
 
 /// The discrete gradient's [`Step`] between two poses' [`Frames`].
@@ -168,7 +185,7 @@ pub(crate) fn dg_step_of<T: Scalar>(s: &Frames<T>, e: &Frames<T>) -> Step<T> {
     // The average of the operators seen from both ends is symmetric in
     // time, hence consistent at second order; seen from the end, the
     // reference rotation's relative increment is the start's reversed.
-    let g = cayley_inverse(&mmt(&e.half, &s.half));
+    let g = relative_cayley(&e.half, &s.half);
     let (bf, tf) = secant_operators_at(&s.lam[0], &s.rel, &s.half, &g, &theta);
     let (bb, tb) = secant_operators_at(&e.lam[0], &e.rel, &e.half, &(-g), &theta.map(|t| -t));
     let (b, t) = ((bf + bb) * half, (tf + tb) * half);

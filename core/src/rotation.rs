@@ -253,6 +253,75 @@ pub fn log_quaternion<T: Scalar>(q: &Vector4<T>) -> Vector3<T> {
     v * factor
 }
 
+/// Hamilton product `a ⊗ b` of quaternions `(w, x, y, z)`: the quaternion
+/// of the rotation `Λ(a) Λ(b)`.
+pub fn quaternion_product<T: Scalar>(a: &Vector4<T>, b: &Vector4<T>) -> Vector4<T> {
+    let (aw, av) = (a.x, Vector3::new(a.y, a.z, a.w));
+    let (bw, bv) = (b.x, Vector3::new(b.y, b.z, b.w));
+    let v = bv * aw + av * bw + av.cross(&bv);
+    Vector4::new(aw * bw - av.dot(&bv), v.x, v.y, v.z)
+}
+
+/// The conjugate `(w, −v)` of a quaternion: the quaternion of `Λᵀ`.
+pub fn quaternion_conjugate<T: Scalar>(q: &Vector4<T>) -> Vector4<T> {
+    Vector4::new(q.x, -q.y, -q.z, -q.w)
+}
+
+/// The quaternion of `exp(½ψ̂)` from the unit quaternion `q` of `exp(ψ̂)`,
+/// `|ψ| ≤ π` (`q` with `w ≥ 0`, as [`quaternion_from_matrix`] gives it): the
+/// square root `(1 + w, v)/√(2(1 + w))` — no trigonometry, and `1 + w ≥ 1`.
+pub fn quaternion_half<T: Scalar>(q: &Vector4<T>) -> Vector4<T> {
+    let w1 = T::one() + q.x;
+    let f = T::one() / (w1 * cst::<T>(2.0)).sqrt();
+    Vector4::new(w1 * f, q.y * f, q.z * f, q.w * f)
+}
+
+/// The quaternion of `cay(θ)`: `(1, ½θ)/√(1 + ¼|θ|²)`.
+pub fn cayley_quaternion<T: Scalar>(theta: &Vector3<T>) -> Vector4<T> {
+    let half = cst::<T>(0.5);
+    let f = T::one() / (T::one() + theta.norm_squared() * cst::<T>(0.25)).sqrt();
+    Vector4::new(
+        f,
+        theta.x * half * f,
+        theta.y * half * f,
+        theta.z * half * f,
+    )
+}
+
+/// The Cayley vector `θ = 2v/w` of the rotation of a quaternion `(w, v)`:
+/// [`cayley_inverse`] without the matrix (undefined for half turns, `w = 0`).
+pub fn cayley_of_quaternion<T: Scalar>(q: &Vector4<T>) -> Vector3<T> {
+    Vector3::new(q.y, q.z, q.w) * (cst::<T>(2.0) / q.x)
+}
+
+/// The unit quaternion of `exp(ψ̂)`, `(cos ½|ψ|, sin(½|ψ|) ψ/|ψ|)`, by
+/// series near the identity.
+pub fn exp_quaternion<T: Scalar>(psi: &Vector3<T>) -> Vector4<T> {
+    let t2 = psi.norm_squared();
+    let (w, f) = if t2.value() < SERIES_LIMIT {
+        // cos(½t) and sin(½t)/t in t².
+        let x = t2 * cst::<T>(0.25);
+        (
+            series(x, &[1.0, -0.5, 1.0 / 24.0, -1.0 / 720.0, 1.0 / 40320.0]),
+            series(
+                x,
+                &[
+                    0.5,
+                    -1.0 / 12.0,
+                    1.0 / 240.0,
+                    -1.0 / 10080.0,
+                    1.0 / 725760.0,
+                ],
+            ),
+        )
+    } else {
+        let t = t2.sqrt();
+        let h = t * cst::<T>(0.5);
+        (h.cos(), h.sin() / t)
+    };
+    Vector4::new(w, psi.x * f, psi.y * f, psi.z * f)
+}
+
 /// Logarithm: the rotation vector `ψ`, `|ψ| ≤ π`, with `exp(ψ̂) = Λ`.
 /// Computed through the quaternion (never `acos` of the trace), so it is
 /// accurate near 0 and near π.

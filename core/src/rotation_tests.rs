@@ -72,6 +72,28 @@ proptest! {
     }
 
     #[test]
+    fn quaternion_maps_agree_with_the_matrices(
+        psi in rotation_vector(),
+        chi in rotation_vector(),
+        theta in small_vector(),
+    ) {
+        // The quaternion route of the discrete gradient's secant operators
+        // against the matrix maps it replaces.
+        let (q, p) = (exp_quaternion(&psi), exp_quaternion(&chi));
+        prop_assert!((q.norm() - 1.0).abs() < 1e-14 && q.x >= 0.0);
+        prop_assert!(close_m(&matrix_from_quaternion(&q), &exp(&psi), 1e-14));
+        let product = matrix_from_quaternion(&quaternion_product(&q, &p));
+        prop_assert!(close_m(&product, &(exp(&psi) * exp(&chi)), 1e-14));
+        let conjugate = matrix_from_quaternion(&quaternion_conjugate(&q));
+        prop_assert!(close_m(&conjugate, &exp(&psi).transpose(), 1e-14));
+        let half = matrix_from_quaternion(&quaternion_half(&q));
+        prop_assert!(close_m(&half, &exp(&(psi * 0.5)), 1e-13));
+        let cay = cayley_quaternion(&theta);
+        prop_assert!(close_m(&matrix_from_quaternion(&cay), &cayley(&theta), 1e-14));
+        prop_assert!(close_v(&cayley_of_quaternion(&cay), &theta, 1e-14));
+    }
+
+    #[test]
     fn tangent_fixes_its_vector(psi in rotation_vector()) {
         // H(ψ)ψ = ψ (check)
         prop_assert!(close_v(&(tangent(&psi) * psi), &psi, 1e-14));

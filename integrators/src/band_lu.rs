@@ -170,6 +170,12 @@ pub struct BandLu {
     /// For each column of the band storage, the range of its entries in the
     /// CSC values (the column it is renumbered from).
     columns: Vec<std::ops::Range<usize>>,
+    /// Where each stored entry's value is: its position in the values a
+    /// factorisation is given, or (`None`) the entry's own index — the CSC
+    /// values of the pattern itself. A half of a split band
+    /// ([`crate::band_split`]) reads the whole's values through it, with no
+    /// copy of its own.
+    sources: Option<Vec<usize>>,
     /// Position in the CSC values of each unknown's diagonal entry.
     diagonal: Vec<Option<usize>>,
     /// Equilibrating scale of each row of the band storage, following the
@@ -216,6 +222,7 @@ impl BandLu {
             piv: vec![0; n],
             slot,
             columns,
+            sources: None,
             diagonal,
             row_scale: vec![1.0; n],
             col_scale: vec![1.0; n],
@@ -224,6 +231,17 @@ impl BandLu {
             work: vec![0.0; n],
             band,
         }
+    }
+
+    /// The same factorisation reading the value of stored entry `k` of the
+    /// pattern at `values[sources[k]]` of the values it is given.
+    pub(crate) fn with_sources(mut self, sources: Vec<usize>) -> Self {
+        debug_assert_eq!(sources.len(), self.slot.len());
+        for k in self.diagonal.iter_mut().flatten() {
+            *k = sources[*k];
+        }
+        self.sources = Some(sources);
+        self
     }
 
     /// The equilibrating scale of the rows of `A` (renumbered).
@@ -260,8 +278,18 @@ impl BandLu {
             let column = &mut rest[..ld];
             column[from..].iter_mut().for_each(|v| *v = 0.0);
             let entries = self.columns[c].clone();
-            for (&row, &v) in self.slot[entries.clone()].iter().zip(&values[entries]) {
-                column[row as usize] = v;
+            let slots = &self.slot[entries.clone()];
+            match &self.sources {
+                None => {
+                    for (&row, &v) in slots.iter().zip(&values[entries]) {
+                        column[row as usize] = v;
+                    }
+                }
+                Some(src) => {
+                    for (&row, &k) in slots.iter().zip(&src[entries]) {
+                        column[row as usize] = values[k];
+                    }
+                }
             }
             // The earlier steps that reach this column, in order: each
             // step's interchange, then its multipliers times the entry of

@@ -41,10 +41,9 @@ pub const SPLIT_MIN_UNKNOWNS: usize = 4096;
 /// its couplings to the separator.
 #[derive(Debug, Clone)]
 struct Half {
+    /// Its band LU, reading the whole pattern's values
+    /// ([`BandLu::with_sources`]).
     lu: BandLu,
-    /// For each stored entry of the half's own pattern, its position in
-    /// the whole pattern's values.
-    src: Vec<usize>,
     /// The entries coupling the half to the separator: `(row in the half,
     /// separator column, position in the values)` of `Aₖₛ`, and
     /// `(separator row, column in the half, position)` of `Aₛₖ`.
@@ -56,8 +55,6 @@ struct Half {
     z: Vec<Vec<f64>>,
     /// `Yₖ`, one row (the half's length) per separator unknown.
     y: Vec<Vec<f64>>,
-    /// Scratch: the half's values.
-    values: Vec<f64>,
     /// Scratch: the half's part of a right-hand side.
     b: Vec<f64>,
 }
@@ -67,10 +64,7 @@ impl Half {
     /// `Yₖ`; returns its part `Yₖ Zₖ` of the Schur complement (row-major
     /// `w × w`), or `None` when the half is singular on its own.
     fn factor(&mut self, values: &[f64], w: usize) -> Option<Vec<f64>> {
-        for (v, &k) in self.values.iter_mut().zip(&self.src) {
-            *v = values[k];
-        }
-        self.lu.factor(&self.values);
+        self.lu.factor(values);
         if !self.lu.pivots_regular() {
             return None;
         }
@@ -347,9 +341,7 @@ fn half(
         .min()
         .unwrap_or(size);
     Some(Half {
-        lu: BandLu::new(&pattern, band),
-        src: entries.iter().map(|e| e.2).collect(),
-        values: vec![0.0; entries.len()],
+        lu: BandLu::new(&pattern, band).with_sources(entries.iter().map(|e| e.2).collect()),
         to_sep,
         from_sep,
         tail,

@@ -385,7 +385,11 @@ pub const FLOOR_ACCEPT_FROM: f64 = 1e-3;
 
 /// Whether the iterate `it` is at the round-off floor straight from an
 /// iterate within [`FLOOR_ACCEPT_FROM`] by a full-Newton correction with the
-/// exact tangent (quadratic convergence) — or by a chord step (`chord`: its
+/// exact tangent (quadratic convergence), or with a cheaper tangent
+/// ([`NewtonSystem::tangent_is_exact`] `false`) whose correction contracted
+/// the scaled residual at least as a quadratic one would (to the square of
+/// the residual it started from or below: the cheaper tangent then did as
+/// well as the exact one) — or by a chord step (`chord`: its
 /// licence, [`chord_licence`]) whose expected residual, the licence times
 /// the scaled residual it started from, is within the tolerance (the chord
 /// converges linearly: from farther, the stall test stays).
@@ -399,7 +403,7 @@ fn quadratic_at_floor<S: NewtonSystem>(
 ) -> bool {
     it > 0
         && !settings.modified
-        && sys.tangent_is_exact()
+        && (sys.tangent_is_exact() || history[it] <= history[it - 1] * history[it - 1])
         && norm <= sys.floor()
         && history[it - 1] <= FLOOR_ACCEPT_FROM
         && chord.is_none_or(|c| c * history[it - 1] <= settings.tolerance)
