@@ -392,7 +392,9 @@ pub const FLOOR_ACCEPT_FROM: f64 = 1e-3;
 /// well as the exact one) — or by a chord step (`chord`: its
 /// licence, [`chord_licence`]) whose expected residual, the licence times
 /// the scaled residual it started from, is within the tolerance (the chord
-/// converges linearly: from farther, the stall test stays).
+/// converges linearly: from farther, the stall test stays). The licence is
+/// the contraction measured with the factorisation the chord reuses, so it
+/// bounds a chord of the cheaper tangent as it does one of the exact.
 fn quadratic_at_floor<S: NewtonSystem>(
     it: usize,
     norm: f64,
@@ -403,10 +405,12 @@ fn quadratic_at_floor<S: NewtonSystem>(
 ) -> bool {
     it > 0
         && !settings.modified
-        && (sys.tangent_is_exact() || history[it] <= history[it - 1] * history[it - 1])
         && norm <= sys.floor()
         && history[it - 1] <= FLOOR_ACCEPT_FROM
-        && chord.is_none_or(|c| c * history[it - 1] <= settings.tolerance)
+        && match chord {
+            Some(c) => c * history[it - 1] <= settings.tolerance,
+            None => sys.tangent_is_exact() || history[it] <= history[it - 1] * history[it - 1],
+        }
 }
 
 /// A force scale at most this many round-off floors is itself round-off:

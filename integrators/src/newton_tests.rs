@@ -14,6 +14,10 @@ struct Cubic {
     /// Tangent evaluations with the exact and the cheap tangent.
     exact_count: usize,
     cheap_count: usize,
+    /// Round-off stand-in: added to `r₀` with alternating signs (so a
+    /// converged iterate's residual is about twice it), and the floor set
+    /// to four times it.
+    noise: f64,
 }
 
 impl Cubic {
@@ -25,6 +29,7 @@ impl Cubic {
             values: vec![0.0; 2],
             exact_count: 0,
             cheap_count: 0,
+            noise: 0.0,
         }
     }
 }
@@ -36,6 +41,12 @@ impl NewtonSystem for Cubic {
             *ri = q * q * q + q - 2.0;
             *vi = factor * (3.0 * q * q + 1.0);
         }
+        let sign = if (self.exact_count + self.cheap_count).is_multiple_of(2) {
+            1.0
+        } else {
+            -1.0
+        };
+        r[0] += sign * self.noise;
         if self.exact {
             self.exact_count += 1;
         } else {
@@ -55,7 +66,7 @@ impl NewtonSystem for Cubic {
     }
     /// Round-off of `q³ + q − 2` near the root: a few ε.
     fn floor(&self) -> f64 {
-        16.0 * f64::EPSILON
+        (16.0 * f64::EPSILON).max(4.0 * self.noise)
     }
     fn set_exact_tangent(&mut self, exact: bool) {
         self.exact = exact;
@@ -66,10 +77,14 @@ impl NewtonSystem for Cubic {
 }
 
 fn run(sys: &mut Cubic, exact_tangent: bool) -> NewtonReport {
+    run_to(sys, exact_tangent, 1e-12)
+}
+
+fn run_to(sys: &mut Cubic, exact_tangent: bool, tolerance: f64) -> NewtonReport {
     let pattern = SymbolicSparseColMat::new_checked(2, 2, vec![0, 1, 2], None, vec![0, 1]);
     let mut lu = SparseLu::new(pattern).expect("pattern");
     let settings = NewtonSettings {
-        tolerance: 1e-12,
+        tolerance,
         max_iterations: 40,
         modified: false,
         exact_tangent,
@@ -231,4 +246,26 @@ fn the_start_check_is_skipped_only_after_a_checked_solution() {
         ),
         "{retry:?}"
     );
+}
+
+#[test]
+fn a_cheap_tangents_chord_to_the_floor_ends_the_solve_as_the_exact_ones_does() {
+    // Residual noise of 1e-12 and a tolerance below it: every solve ends
+    // at the floor. The cheap tangent 1e-4 off contracts linearly, at about
+    // 5e-4 with the quadratic terms, so its corrections license chord
+    // steps; the chord that reaches the floor from an iterate whose licence
+    // says the solution is within the tolerance ends the solve there, with
+    // no stall test's extra correction.
+    let tolerance = 1e-13;
+    let mut sys = Cubic::new(1.0001);
+    sys.noise = 1e-12;
+    let report = run_to(&mut sys, false, tolerance);
+    assert_eq!(sys.exact_count, 0, "{report:?}");
+    assert!(report.factorizations < report.iterations, "{report:?}");
+    let h = &report.history;
+    let scale = 2.0;
+    let floor = sys.floor() / scale;
+    let n = report.iterations;
+    assert!(h[n] <= floor, "{h:?}");
+    assert!(h[n - 1] > floor, "the floor reached twice: {h:?}");
 }
