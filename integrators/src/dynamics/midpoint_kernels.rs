@@ -290,10 +290,16 @@ impl CorrectionTally {
         self.complete.store(complete, Ordering::Relaxed);
     }
 
-    /// Adds one element's correction and force sizes (both `≥ 0`).
+    /// Adds one element's correction and force sizes (both `≥ 0`, so their
+    /// bits order as they do). A plain load first: the locked maximum only
+    /// where the tally grows, which after the first elements is rare.
     fn add(&self, corr: f64, size: f64) {
-        self.corr.fetch_max(corr.to_bits(), Ordering::Relaxed);
-        self.size.fetch_max(size.to_bits(), Ordering::Relaxed);
+        for (tally, v) in [(&self.corr, corr), (&self.size, size)] {
+            let bits = v.to_bits();
+            if bits > tally.load(Ordering::Relaxed) {
+                tally.fetch_max(bits, Ordering::Relaxed);
+            }
+        }
     }
 
     /// [`correction_size`] at the configuration the last evaluation was
