@@ -216,8 +216,9 @@ fn iterate<S: NewtonSystem>(
     let mut history = Vec::with_capacity(settings.max_iterations + 1);
     let mut previous_norm = f64::INFINITY;
     let mut factorizations = 0;
-    // The licence of the chord step that made the current iterate, if one did.
-    let mut chord: Option<f64> = None;
+    // The licence of the reused factorisation that made the current
+    // iterate, if one did.
+    let mut chord: Option<Licence> = None;
     for it in 0..=settings.max_iterations {
         // At the start of a full-Newton solve a factorisation all but
         // certainly follows: residual and tangent in one pass.
@@ -262,8 +263,13 @@ fn iterate<S: NewtonSystem>(
             }
         } else if *factored && it > 0 {
             chord = chord_licence(sys, norm, &history, settings.tolerance)
-                .filter(|_| !settings.exact_tangent);
-            chord.is_some() || floor_reuse(sys, norm, history[it - 1])
+                .filter(|_| !settings.exact_tangent)
+                .map(Licence::Chord)
+                .or_else(|| {
+                    floor_reuse(sys, norm, history[it - 1])
+                        .then(|| Licence::FloorReuse(res / history[it - 1]))
+                });
+            chord.is_some()
         } else {
             false
         };
@@ -394,23 +400,41 @@ pub const FLOOR_ACCEPT_FROM: f64 = 1e-3;
 /// the scaled residual it started from, is within the tolerance (the chord
 /// converges linearly: from farther, the stall test stays). The licence is
 /// the contraction measured with the factorisation the chord reuses, so it
-/// bounds a chord of the cheaper tangent as it does one of the exact.
+/// bounds a chord of the cheaper tangent as it does one of the exact; a
+/// cheaper tangent's correction from an iterate already at the floor
+/// ([`floor_reuse`]) is judged the same way, by the contraction that brought
+/// that iterate there.
 fn quadratic_at_floor<S: NewtonSystem>(
     it: usize,
     norm: f64,
     history: &[f64],
     sys: &S,
     settings: &NewtonSettings,
-    chord: Option<f64>,
+    chord: Option<Licence>,
 ) -> bool {
+    let previous = history[it.saturating_sub(1)];
+    let promised = |c: f64| c * previous <= settings.tolerance;
     it > 0
         && !settings.modified
         && norm <= sys.floor()
-        && history[it - 1] <= FLOOR_ACCEPT_FROM
+        && previous <= FLOOR_ACCEPT_FROM
         && match chord {
-            Some(c) => c * history[it - 1] <= settings.tolerance,
-            None => sys.tangent_is_exact() || history[it] <= history[it - 1] * history[it - 1],
+            Some(Licence::Chord(c)) => promised(c),
+            Some(Licence::FloorReuse(c)) => sys.tangent_is_exact() || promised(c),
+            None => sys.tangent_is_exact() || history[it] <= previous * previous,
         }
+}
+
+/// Why full Newton reused its factorisation for the correction that made
+/// the current iterate, with the contraction last measured with it.
+#[derive(Debug, Clone, Copy)]
+enum Licence {
+    /// A chord step ([`chord_licence`]).
+    Chord(f64),
+    /// A correction from an iterate already at the round-off floor
+    /// ([`floor_reuse`]). With the exact tangent its result is judged as a
+    /// new tangent's would be; with a cheaper one as a chord's.
+    FloorReuse(f64),
 }
 
 /// A force scale at most this many round-off floors is itself round-off:

@@ -16,8 +16,9 @@ struct Cubic {
     cheap_count: usize,
     /// Round-off stand-in: added to `r₀` with alternating signs (so a
     /// converged iterate's residual is about twice it), and the floor set
-    /// to four times it.
+    /// to `floor_noises` times it.
     noise: f64,
+    floor_noises: f64,
 }
 
 impl Cubic {
@@ -30,6 +31,7 @@ impl Cubic {
             exact_count: 0,
             cheap_count: 0,
             noise: 0.0,
+            floor_noises: 4.0,
         }
     }
 }
@@ -66,7 +68,7 @@ impl NewtonSystem for Cubic {
     }
     /// Round-off of `q³ + q − 2` near the root: a few ε.
     fn floor(&self) -> f64 {
-        (16.0 * f64::EPSILON).max(4.0 * self.noise)
+        (16.0 * f64::EPSILON).max(self.floor_noises * self.noise)
     }
     fn set_exact_tangent(&mut self, exact: bool) {
         self.exact = exact;
@@ -91,7 +93,9 @@ fn run_to(sys: &mut Cubic, exact_tangent: bool, tolerance: f64) -> NewtonReport 
     };
     let (mut r, mut dq) = (vec![0.0; 2], vec![0.0; 2]);
     let report = solve(sys, &mut lu, &settings, &mut r, &mut dq).expect("converges");
-    assert!((sys.q[0] - 1.0).abs() < 1e-10 && (sys.q[1] - 1.0).abs() < 1e-10);
+    // The noise shifts the root of r₀ by about itself over r₀′ = 4.
+    let near = 1e-10 + sys.noise;
+    assert!((sys.q[0] - 1.0).abs() < near && (sys.q[1] - 1.0).abs() < near);
     report
 }
 
@@ -268,4 +272,26 @@ fn a_cheap_tangents_chord_to_the_floor_ends_the_solve_as_the_exact_ones_does() {
     let n = report.iterations;
     assert!(h[n] <= floor, "{h:?}");
     assert!(h[n - 1] > floor, "the floor reached twice: {h:?}");
+}
+
+#[test]
+fn a_cheap_tangents_correction_from_the_floor_is_judged_as_a_chord() {
+    // A cheap tangent 3e-3 off: no chord steps (its corrections contract
+    // less than a thousandfold), and a new tangent lands at 6e-9, inside a
+    // floor of 8e-9 but not quadratically. The next correction reuses that
+    // factorisation (the iterate is at the floor) and falls to the noise,
+    // 1e-9, still falling fast: the contraction that brought the iterate to
+    // the floor (2.6e-3) promises a residual within the tolerance, so the
+    // solve ends there instead of confirming the floor once more.
+    let mut sys = Cubic::new(1.003);
+    sys.noise = 1e-9;
+    sys.floor_noises = 16.0;
+    let report = run_to(&mut sys, false, 1e-10);
+    let h = &report.history;
+    let n = report.iterations;
+    let floor = sys.floor() / 2.0;
+    assert_eq!(sys.exact_count, 0, "{report:?}");
+    assert!(h[n - 1] <= floor && h[n] <= floor, "{h:?}");
+    assert!(h[n] < TOLERANCES.stall_ratio * h[n - 1], "stalled: {h:?}");
+    assert_eq!(report.factorizations, n - 1, "{report:?}");
 }
