@@ -105,9 +105,20 @@ mod tests {
             .build()
             .expect("a pool of two threads");
         let started = Mutex::new(Vec::new());
+        // The first two runs wait for each other: neither thread can take a
+        // third before both have started theirs, so the first two recorded
+        // are the first two taken, however the threads are scheduled.
+        let both_started = std::sync::Barrier::new(2);
         let out = pool.install(|| {
             run_queue(&order, |i| {
-                started.lock().expect("not poisoned").push(i);
+                let count = {
+                    let mut started = started.lock().expect("not poisoned");
+                    started.push(i);
+                    started.len()
+                };
+                if count <= 2 {
+                    both_started.wait();
+                }
                 // The assembly of a run stays on its thread.
                 assert!(flexmech_integrators::threads::sequential(usize::MAX));
                 i * 10
