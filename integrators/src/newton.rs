@@ -262,13 +262,7 @@ fn iterate<S: NewtonSystem>(
                 res < MODIFIED_CONTRACTION * history[it - 1]
             }
         } else if *factored && it > 0 {
-            chord = chord_licence(sys, norm, &history, settings.tolerance)
-                .filter(|_| !settings.exact_tangent)
-                .map(Licence::Chord)
-                .or_else(|| {
-                    floor_reuse(sys, norm, history[it - 1])
-                        .then(|| Licence::FloorReuse(res / history[it - 1]))
-                });
+            chord = licence(sys, norm, &history, settings);
             chord.is_some()
         } else {
             false
@@ -423,6 +417,26 @@ fn quadratic_at_floor<S: NewtonSystem>(
             Some(Licence::FloorReuse(c)) => sys.tangent_is_exact() || promised(c),
             None => sys.tangent_is_exact() || history[it] <= previous * previous,
         }
+}
+
+/// Whether full Newton corrects the last iterate of `history` (of norm
+/// `norm`) with the factorisation it has, and why: a chord step
+/// ([`chord_licence`], not under `newton = "exact"`) or a correction from
+/// the round-off floor ([`floor_reuse`]), with the contraction last
+/// measured with that factorisation.
+fn licence<S: NewtonSystem>(
+    sys: &S,
+    norm: f64,
+    history: &[f64],
+    settings: &NewtonSettings,
+) -> Option<Licence> {
+    let [.., previous, res] = *history else {
+        return None;
+    };
+    chord_licence(sys, norm, history, settings.tolerance)
+        .filter(|_| !settings.exact_tangent)
+        .map(Licence::Chord)
+        .or_else(|| floor_reuse(sys, norm, previous).then(|| Licence::FloorReuse(res / previous)))
 }
 
 /// Why full Newton reused its factorisation for the correction that made
