@@ -8,11 +8,12 @@ use crate::dofs::{DofMap, NodeMap};
 use crate::error::SolveError;
 use crate::mechanism::Mechanism;
 use crate::record::JointRecord;
+use crate::step_maps::StepMaps;
 use crate::threads::for_each_pose;
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::state::increment_pose;
 use flexmech_core::Configuration;
-use flexmech_joints::{JointStep, ReleasedState, LOCAL, MAX_RELEASED};
+use flexmech_joints::{JointStep, ReleasedState, StepDual, LOCAL, MAX_RELEASED};
 use nalgebra::{DMatrix, Matrix3, SMatrix, SVector, Vector3, Vector6};
 use smallvec::SmallVec;
 
@@ -27,6 +28,15 @@ pub struct MechanismState {
     /// Current value of every prescribed nodal DOF (same order as
     /// [`Mechanism::prescribed`]).
     pub prescribed: Vec<f64>,
+}
+
+/// How slaves' residuals fold into their masters'.
+#[derive(Clone, Copy)]
+enum Fold<'a> {
+    /// Through `Nᵀ` at this state (the variational schemes and statics).
+    Variation(&'a MechanismState),
+    /// Through the step's `Ñᵀ`, one map per joint (the conserving schemes).
+    Incremental(&'a [JointStep]),
 }
 
 /// The joint structure of a mechanism, fixed for a run.
@@ -160,26 +170,20 @@ impl Topology {
         }
     }
 
-    /// Sets every slave's rows to those of the incremental map `Ñ` of the
-    /// step `start → end` (`R_s = Ñ [R_m; E]`, masters first), so that the
-    /// assembled tangent's rows are those of the conserving schemes'
-    /// reduced residual `Ñᵀ g` ([`Topology::reduce_incremental`]).
-    pub fn refresh_rows(&mut self, mech: &Mechanism, start: &MechanismState, end: &MechanismState) {
+    /// Sets every slave's rows to those of its joint's incremental map `Ñ`
+    /// of the step (`steps[j]`, [`StepMaps`]; `R_s = Ñ [R_m; E]`, masters
+    /// first), so that the assembled tangent's rows are those of the
+    /// conserving schemes' reduced residual `Ñᵀ g`
+    /// ([`Topology::reduce_incremental`]).
+    pub fn refresh_rows(&mut self, mech: &Mechanism, steps: &[JointStep]) {
         for &j in &self.order {
             let joint = &mech.joints[j];
-            let m = joint.master;
-            let n = JointStep::new(
-                joint.map.as_ref(),
-                [
-                    (&start.config.x[m], &start.config.rot[m]),
-                    (&end.config.x[m], &end.config.rot[m]),
-                ],
-                [&start.released[j], &end.released[j]],
-            )
-            .matrix();
+            let n = steps[j].matrix();
             let nm = n.fixed_columns::<6>(0).into_owned();
-            let mut rows: Vec<Vector6<f64>> =
-                self.dofs.nodes[m].rows().iter().map(|r| nm * r).collect();
+            // The slave's own vector, refilled (no allocation per iteration).
+            let mut rows = self.dofs.nodes[joint.slave].rows.take().unwrap_or_default();
+            rows.clear();
+            rows.extend(self.dofs.nodes[joint.master].rows().iter().map(|r| nm * r));
             for (c, eq) in self.released_eqs[j].iter().enumerate() {
                 if eq.is_some() {
                     rows.push(n.column(6 + c).into_owned());
@@ -236,24 +240,17 @@ impl Topology {
     /// `Σ_j L_j,rowᵀ ∂(Ñ_jᵀ g_s)/∂q L_j,col` with the slaves' residuals held
     /// (deepest slaves first, each handing `Ñᵀ g_s` to its master, as
     /// [`Topology::reduce_incremental`] does): `Ñ` follows the step's end
-    /// state (AD through `Ñ`, [`flexmech_joints::JointMap::incremental_transfer`]);
-    /// rows through the masters' rows, columns through their columns.
+    /// state (AD through `Ñ`: the seeded maps `seeded[j]` of [`StepMaps`],
+    /// [`JointStep::seeded_transfer`]); rows through the masters' rows,
+    /// columns through their columns.
     pub fn incremental_blocks(
         &self,
         mech: &Mechanism,
-        start: &MechanismState,
-        end: &MechanismState,
+        seeded: &[JointStep<StepDual>],
         g: &[f64],
     ) -> Vec<DMatrix<f64>> {
-        self.joint_blocks(mech, g, true, |j, m, gs| {
-            mech.joints[j].map.incremental_transfer(
-                [
-                    (&start.config.x[m], &start.config.rot[m]),
-                    (&end.config.x[m], &end.config.rot[m]),
-                ],
-                [&start.released[j], &end.released[j]],
-                gs,
-            )
+        self.joint_blocks(mech, g, true, |j, _, gs| {
+            seeded[j].seeded_transfer(gs, mech.joints[j].map.released_count())
         })
     }
 
@@ -293,20 +290,19 @@ impl Topology {
     /// The reduced residual of the conserving schemes, `Ñᵀ g` (paper eqs
     /// 21–23): every slave's nodal residual goes to its master and its
     /// released equations through the exact incremental map of the step
-    /// `start → end` ([`JointStep`]), deepest slaves first; independent nodes
+    /// (`steps[j]`, [`StepMaps`]), deepest slaves first; independent nodes
     /// reduce as usual. With these equations `Σ pᵢ·gᵢ = 0` over all nodes, so
     /// the beams' energy balance and momentum conservation hold for the
     /// joined system.
     pub fn reduce_incremental(
         &self,
         mech: &Mechanism,
-        start: &MechanismState,
-        end: &MechanismState,
+        steps: &[JointStep],
         g: &[f64],
         out: &mut [f64],
     ) {
         out.iter_mut().for_each(|v| *v = 0.0);
-        let acc = self.fold_slaves(mech, Some(start), end, g, |j, _, t| {
+        let acc = self.fold_slaves(mech, Fold::Incremental(steps), g, |j, _, t| {
             for (c, eq) in self.released_eqs[j].iter().enumerate() {
                 if let Some(e) = eq {
                     out[*e] += t[6 + c];
@@ -345,7 +341,8 @@ impl Topology {
     ) -> Result<Vec<(usize, f64)>, usize> {
         let mut extra = Vec::new();
         let mut missing = None;
-        self.fold_slaves(mech, Some(start), end, g, |j, gs, _| {
+        let maps = StepMaps::new(mech, start, end, false);
+        self.fold_slaves(mech, Fold::Incremental(&maps.values), g, |j, gs, _| {
             let m = mech.joints[j].master;
             let from = [
                 dx[m].x, dx[m].y, dx[m].z, theta[m].x, theta[m].y, theta[m].z,
@@ -379,16 +376,15 @@ impl Topology {
     }
 
     /// Folds every slave's nodal residual into its master's, deepest slaves
-    /// first — through `Nᵀ` at `end`, or through the step's `Ñᵀ` when `start`
-    /// is given (the conserving schemes) — calling `each(j, g_s, t)` with
-    /// joint `j`'s slave residual `g_s` (its own slaves' already folded in)
-    /// and its transfer `t` (master part, then released). Returns the nodal
-    /// residuals with every slave's carried by the independent nodes.
+    /// first — through `Nᵀ` at a state, or through the step's `Ñᵀ` (the
+    /// conserving schemes) — calling `each(j, g_s, t)` with joint `j`'s slave
+    /// residual `g_s` (its own slaves' already folded in) and its transfer
+    /// `t` (master part, then released). Returns the nodal residuals with
+    /// every slave's carried by the independent nodes.
     fn fold_slaves(
         &self,
         mech: &Mechanism,
-        start: Option<&MechanismState>,
-        end: &MechanismState,
+        fold: Fold<'_>,
         g: &[f64],
         mut each: impl FnMut(usize, &Vector6<f64>, &SVector<f64, LOCAL>),
     ) -> Vec<f64> {
@@ -397,17 +393,9 @@ impl Topology {
             let joint = &mech.joints[j];
             let (m, s) = (joint.master, joint.slave);
             let gs = Vector6::from_column_slice(&acc[6 * s..6 * s + 6]);
-            let t = match start {
-                Some(start) => JointStep::new(
-                    joint.map.as_ref(),
-                    [
-                        (&start.config.x[m], &start.config.rot[m]),
-                        (&end.config.x[m], &end.config.rot[m]),
-                    ],
-                    [&start.released[j], &end.released[j]],
-                )
-                .transfer(&gs),
-                None => {
+            let t = match fold {
+                Fold::Incremental(steps) => steps[j].transfer(&gs),
+                Fold::Variation(end) => {
                     joint
                         .map
                         .variation(&end.config.x[m], &end.config.rot[m], &end.released[j])
@@ -438,7 +426,12 @@ impl Topology {
         g: &[f64],
     ) -> (Vec<[f64; 6]>, Vec<[f64; 6]>) {
         let mut joints = vec![[0.0; 6]; mech.joints.len()];
-        let acc = self.fold_slaves(mech, start, end, g, |j, gs, _| {
+        let maps = start.map(|start| StepMaps::new(mech, start, end, false));
+        let fold = match &maps {
+            Some(maps) => Fold::Incremental(&maps.values),
+            None => Fold::Variation(end),
+        };
+        let acc = self.fold_slaves(mech, fold, g, |j, gs, _| {
             joints[j].copy_from_slice(gs.as_slice());
         });
         let supports = mech
@@ -467,7 +460,7 @@ impl Topology {
         g: &[f64],
     ) -> (Vec<Vec<f64>>, Vec<f64>) {
         let mut joints = vec![Vec::new(); mech.joints.len()];
-        let acc = self.fold_slaves(mech, None, state, g, |j, _, t| {
+        let acc = self.fold_slaves(mech, Fold::Variation(state), g, |j, _, t| {
             joints[j] = (0..mech.joints[j].map.released_count())
                 .map(|c| t[6 + c])
                 .collect();

@@ -31,6 +31,7 @@ pub mod stability;
 mod start_shift;
 pub mod statics;
 pub mod step_control;
+pub mod step_maps;
 pub mod system;
 pub mod team;
 pub mod threads;

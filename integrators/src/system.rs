@@ -27,6 +27,7 @@ use crate::linsolve::TangentRef;
 use crate::mechanism::Mechanism;
 use crate::newton::NewtonSystem;
 use crate::record::StepRecord;
+use crate::step_maps::StepMaps;
 use flexmech_core::rotation::skew;
 use flexmech_core::{Configuration, Inertia};
 
@@ -162,12 +163,26 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
     /// The reduced residual of nodal residuals `g` into `out`, through the
     /// scheme's [`Reduction`].
     pub fn reduce(&self, g: &[f64], out: &mut [f64]) {
-        match self.terms.reduction() {
-            Reduction::Variation => self.topo.dofs.reduce(g, out),
-            Reduction::Incremental => {
-                self.topo
-                    .reduce_incremental(self.mech, &self.start, &self.end, g, out)
-            }
+        let maps = self.step_maps(false);
+        self.reduce_with(maps.as_ref(), g, out);
+    }
+
+    /// The joints' incremental maps of the step `start → end` for the
+    /// conserving schemes' [`Reduction::Incremental`] (seeded along the end
+    /// state with `seeded`); `None` for [`Reduction::Variation`].
+    fn step_maps(&self, seeded: bool) -> Option<StepMaps> {
+        (self.terms.reduction() == Reduction::Incremental)
+            .then(|| StepMaps::new(self.mech, &self.start, &self.end, seeded))
+    }
+
+    /// [`Self::reduce`] with the step's maps (given for
+    /// [`Reduction::Incremental`]).
+    fn reduce_with(&self, maps: Option<&StepMaps>, g: &[f64], out: &mut [f64]) {
+        match maps {
+            None => self.topo.dofs.reduce(g, out),
+            Some(maps) => self
+                .topo
+                .reduce_incremental(self.mech, &maps.values, g, out),
         }
     }
 
@@ -192,8 +207,11 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
         let joints = !mech.joints.is_empty();
         let reduction = self.terms.reduction();
         self.topo.refresh(mech, &self.end);
-        if joints && reduction == Reduction::Incremental {
-            self.topo.refresh_rows(mech, &self.start, &self.end);
+        // One map per joint serves the rows, the residual and the tangent;
+        // the rows only matter to the tangent.
+        let maps = self.step_maps(tangent && joints);
+        if let Some(maps) = maps.as_ref().filter(|_| tangent && joints) {
+            self.topo.refresh_rows(mech, &maps.values);
         }
         let (start, end) = (&self.start.config, &self.end.config);
         self.terms
@@ -217,14 +235,13 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
             let residual = (&mut self.nodal[..], &mut self.abs[..]);
             spin.add_steady(inertia, &self.end.config, self.load_time, residual, blocks);
         }
-        self.reduce(&self.nodal, r);
+        self.reduce_with(maps.as_ref(), &self.nodal, r);
         if tangent && joints {
-            let blocks = match reduction {
-                Reduction::Variation => self.topo.geometric_blocks(mech, &self.end, &self.nodal),
-                Reduction::Incremental => {
-                    self.topo
-                        .incremental_blocks(mech, &self.start, &self.end, &self.nodal)
-                }
+            let blocks = match &maps {
+                None => self.topo.geometric_blocks(mech, &self.end, &self.nodal),
+                Some(maps) => self
+                    .topo
+                    .incremental_blocks(mech, &maps.seeded, &self.nodal),
             };
             for (b, block) in blocks.iter().enumerate() {
                 self.asm.add_block(b, block);

@@ -27,10 +27,17 @@
 //! reaction's moment is taken about the mid-step positions, as the beams'
 //! internal forces are: linear *and* angular momentum are conserved exactly.
 
-use crate::kinematics::{released_at, JointKinematics, ReleasedState, LOCAL, MAX_RELEASED};
-use flexmech_core::rotation::{cayley_inverse, exp, mm, mmt, mtv, mv, skew};
+use crate::kinematics::{
+    released_at, released_count, JointKinematics, ReleasedState, LOCAL, MAX_RELEASED,
+};
+use flexmech_core::rotation::{cayley_inverse, exp, mm, mmt, mtv, mv, skew, skew_squared};
 use flexmech_core::{cst, Scalar};
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector6};
+use nalgebra::{Const, Matrix3, SMatrix, SVector, Vector3, Vector6, U1};
+use num_dual::{Derivative, DualSVec64};
+
+/// The dual number of a step map seeded along the step's end state: one lane
+/// per local increment `(δx, δφ, τ)` of [`JointStep::of`]'s seed.
+pub type StepDual = DualSVec64<LOCAL>;
 
 /// A node's pose: position and rotation.
 pub type NodePose<'a> = (&'a Vector3<f64>, &'a Matrix3<f64>);
@@ -103,15 +110,9 @@ impl<T: Scalar> JointStep<T> {
         let x0 = x0.map(cst::<T>) + Vector3::new(from.0[0], from.0[1], from.0[2]);
         // Products written out (`mm`, `mmt`, `mv`): nalgebra's general
         // product multiplies every term by a unit dual number besides.
-        let r0 = mm(
-            &exp(&Vector3::new(from.0[3], from.0[4], from.0[5])),
-            &r0.map(cst::<T>),
-        );
+        let r0 = spun(&Vector3::new(from.0[3], from.0[4], from.0[5]), r0);
         let x1 = x1.map(cst::<T>) + Vector3::new(seed[0], seed[1], seed[2]);
-        let r1 = mm(
-            &exp(&Vector3::new(seed[3], seed[4], seed[5])),
-            &r1.map(cst::<T>),
-        );
+        let r1 = spun(&Vector3::new(seed[3], seed[4], seed[5]), r1);
         let theta_m = cayley_inverse(&mmt(&r1, &r0));
         let (rr0, l0) = released_at(joint, released[0], from.1);
         let (rr1, l1) = released_at(joint, released[1], inc);
@@ -172,5 +173,116 @@ impl<T: Scalar> JointStep<T> {
             out[6 + j] = (0..6).fold(T::zero(), |acc, i| acc + self.b[(i, j)] * h[i]);
         }
         out
+    }
+}
+
+/// `exp(ŝ) R`. A seed `s` with no real part (a pure derivative direction)
+/// takes `exp(ŝ) = I + ŝ + ½ŝ²`, exact through second derivatives, instead
+/// of the exponential's series in dual numbers.
+fn spun<T: Scalar>(s: &Vector3<T>, r: &Matrix3<f64>) -> Matrix3<T> {
+    let rotation = if s.iter().all(|v| v.value() == 0.0) {
+        Matrix3::identity() + skew(s) + skew_squared(s) * cst::<T>(0.5)
+    } else {
+        exp(s)
+    };
+    mm(&rotation, &r.map(cst::<T>))
+}
+
+impl JointStep<StepDual> {
+    /// The seeded map `Ñ(δx, δφ, τ)` of `joint` over a step: the master's end
+    /// pose and the released end state moved along the local increments, one
+    /// AD lane each (see [`Self::of`]).
+    ///
+    /// `Ñ` does not depend on the master's end position: it enters the
+    /// offset as `x_s,ₙ₊₁ − x_m,ₙ₊₁ = Λ_m,ₙ₊₁ r_R,ₙ₊₁` and nowhere else. So
+    /// the map is computed over the lanes of `δφ` and of the kind's released
+    /// coordinates only (4 for a one-coordinate kind instead of 10) and
+    /// widened; the lanes of `δx` are zero.
+    pub fn seeded<J: JointKinematics + ?Sized>(
+        joint: &J,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+    ) -> Self {
+        match released_count::<J>() {
+            0 => seeded_over::<J, 3>(joint, master, released),
+            1 => seeded_over::<J, 4>(joint, master, released),
+            2 => seeded_over::<J, 5>(joint, master, released),
+            3 => seeded_over::<J, 6>(joint, master, released),
+            _ => seeded_over::<J, { 3 + MAX_RELEASED }>(joint, master, released),
+        }
+    }
+
+    /// The real parts: `Ñ` itself, computed with the same arithmetic as the
+    /// unseeded map.
+    pub fn value(&self) -> JointStep<f64> {
+        JointStep {
+            offset: self.offset.map(|v| v.re),
+            lever: self.lever.map(|v| v.re),
+            a: self.a.map(|v| v.re),
+            b: self.b.map(|v| v.re),
+        }
+    }
+
+    /// `Ñᵀ g` for a slave residual `g` held fixed and its derivative with
+    /// respect to the step's end state, from the seeded map; the columns and
+    /// rows of the released coordinates past `released` are zero.
+    pub fn seeded_transfer(
+        &self,
+        g: &Vector6<f64>,
+        released: usize,
+    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>) {
+        let t = self.transfer(&g.map(StepDual::from_re));
+        let mut value = t.map(|v| v.re);
+        let mut k = SMatrix::<f64, LOCAL, LOCAL>::zeros();
+        for r in 0..LOCAL {
+            k.set_row(r, &t[r].eps.unwrap_generic(Const::<LOCAL>, U1).transpose());
+        }
+        for c in 6 + released..LOCAL {
+            value[c] = 0.0;
+            k.row_mut(c).fill(0.0);
+            k.column_mut(c).fill(0.0);
+        }
+        (value, k)
+    }
+}
+
+/// [`JointStep::seeded`] over `L` lanes: `δφ` in lanes 0–2, the first
+/// `L − 3` released coordinates after them.
+fn seeded_over<J: JointKinematics + ?Sized, const L: usize>(
+    joint: &J,
+    master: [NodePose<'_>; 2],
+    released: [&ReleasedState; 2],
+) -> JointStep<StepDual> {
+    type D<const L: usize> = DualSVec64<L>;
+    let e: [D<L>; L] = std::array::from_fn(|i| D::<L>::from_re(0.0).derivative(i));
+    let seed: [D<L>; 6] = std::array::from_fn(|i| {
+        if i < 3 {
+            D::<L>::from_re(0.0)
+        } else {
+            e[i - 3]
+        }
+    });
+    let inc: [D<L>; MAX_RELEASED] = std::array::from_fn(|k| {
+        if 3 + k < L {
+            e[3 + k]
+        } else {
+            D::<L>::from_re(0.0)
+        }
+    });
+    let step = JointStep::of(joint, master, released, &seed, &inc);
+    // Lane `i` of `L` is local lane `3 + i`.
+    let widen = |v: D<L>| {
+        let eps = v.eps.0.map(|eps| {
+            let mut out = SVector::<f64, LOCAL>::zeros();
+            out.fixed_rows_mut::<L>(3).copy_from(&eps);
+            out
+        });
+        StepDual::new(v.re, Derivative::new(eps))
+    };
+    JointStep {
+        offset: step.offset.map(widen),
+        lever: step.lever.map(widen),
+        a: step.a.map(widen),
+        b: step.b.map(widen),
     }
 }

@@ -23,7 +23,7 @@
 //! [`JointMap::transfer_ad`] keep the full AD as the oracle the tests compare
 //! with.
 
-use crate::incremental::{JointStep, NodePose};
+use crate::incremental::{JointStep, NodePose, StepDual};
 use crate::kinematics::{
     released_count, Increments, JointKinematics, ReleasedState, LOCAL, MAX_RELEASED, TAYLOR_BELOW,
 };
@@ -94,6 +94,18 @@ pub trait JointMap: Send + Sync + Debug {
         released: [&ReleasedState; 2],
     ) -> JointStep;
 
+    /// `Ñ` seeded along the local increments of the step's end state — the
+    /// master's end pose (`x ← x + δx`, `R ← exp(δφ̂)R`) and the released
+    /// coordinates — one forward-AD lane each ([`JointStep::seeded`]). Its
+    /// real parts are [`Self::incremental_step`]'s map
+    /// ([`JointStep::value`]); one seeded map serves a Newton evaluation's
+    /// rows, residual and tangent.
+    fn incremental_step_seeded(
+        &self,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+    ) -> JointStep<StepDual>;
+
     /// `Ñᵀ g` for a slave residual `g` held fixed, and its exact derivative
     /// with respect to the local increments of the step's end state —
     /// the master's end pose (`x ← x + δx`, `R ← exp(δφ̂)R`) and the released
@@ -104,7 +116,10 @@ pub trait JointMap: Send + Sync + Debug {
         master: [NodePose<'_>; 2],
         released: [&ReleasedState; 2],
         g: &Vector6<f64>,
-    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>);
+    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>) {
+        self.incremental_step_seeded(master, released)
+            .seeded_transfer(g, self.released_count())
+    }
 
     /// The derivative of `Ñᵀ g` (slave residual `g` held, the step's end
     /// held) along the step's start state: the master's start pose moved by
@@ -503,29 +518,12 @@ impl<J: JointKinematics> JointMap for J {
         JointStep::of(self, master, released, &[0.0; 6], &[0.0; MAX_RELEASED])
     }
 
-    fn incremental_transfer(
+    fn incremental_step_seeded(
         &self,
         master: [NodePose<'_>; 2],
         released: [&ReleasedState; 2],
-        g: &Vector6<f64>,
-    ) -> (SVector<f64, LOCAL>, SMatrix<f64, LOCAL, LOCAL>) {
-        type D = DualSVec64<LOCAL>;
-        let e: [D; LOCAL] = std::array::from_fn(|i| D::from_re(0.0).derivative(i));
-        let seed: [D; 6] = std::array::from_fn(|i| e[i]);
-        let inc: [D; MAX_RELEASED] = std::array::from_fn(|i| e[6 + i]);
-        let step = JointStep::of(self, master, released, &seed, &inc);
-        let t = step.transfer(&g.map(D::from_re));
-        let mut value = t.map(|v| v.re);
-        let mut k = SMatrix::<f64, LOCAL, LOCAL>::zeros();
-        for r in 0..LOCAL {
-            k.set_row(r, &t[r].eps.unwrap_generic(Const::<LOCAL>, U1).transpose());
-        }
-        for c in 6 + released_count::<J>()..LOCAL {
-            value[c] = 0.0;
-            k.row_mut(c).fill(0.0);
-            k.column_mut(c).fill(0.0);
-        }
-        (value, k)
+    ) -> JointStep<StepDual> {
+        JointStep::seeded(self, master, released)
     }
 
     fn incremental_transfer_start(

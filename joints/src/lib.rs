@@ -34,7 +34,7 @@ pub use cam::Cam;
 pub use cylindrical::Cylindrical;
 pub use dependent::{parameter_slopes, DependentJoint, DependentJointMaps};
 pub use expression::ExpressionJoint;
-pub use incremental::JointStep;
+pub use incremental::{JointStep, StepDual};
 pub use joint_map::JointMap;
 pub use kinematics::{
     Angle, AngleAt, AngleSlide, BallRotation, Coordinates, CoordinatesOf, JointKinematics,
