@@ -1,11 +1,15 @@
 //! The conserving schemes' joints: every joint's incremental map `Ñ` of a
 //! step (paper eqs 21–23, [`JointStep`]) evaluated once per Newton
 //! evaluation and shared by the three places that need it — the slaves'
-//! tangent rows ([`Topology::refresh_rows`](crate::constraints::Topology::refresh_rows)), the reduced residual `Ñᵀ g`
-//! ([`Topology::reduce_incremental`](crate::constraints::Topology::reduce_incremental)) and the joints' tangent blocks
-//! ([`Topology::incremental_blocks`](crate::constraints::Topology::incremental_blocks)). With the tangent, one seeded map per
+//! tangent rows ([`Topology::refresh_rows`]), the reduced residual `Ñᵀ g`
+//! ([`Topology::reduce_incremental`]) and the joints' tangent blocks
+//! ([`Topology::incremental_blocks`]). With the tangent, one seeded map per
 //! joint ([`JointStep::seeded`]) gives all three: its real parts are the map
 //! and its lanes the derivative along the step's end state.
+//!
+//! [`Topology::refresh_rows`]: crate::constraints::Topology::refresh_rows
+//! [`Topology::reduce_incremental`]: crate::constraints::Topology::reduce_incremental
+//! [`Topology::incremental_blocks`]: crate::constraints::Topology::incremental_blocks
 
 use crate::constraints::MechanismState;
 use crate::mechanism::Mechanism;
@@ -25,8 +29,9 @@ pub struct StepMaps {
 
 impl StepMaps {
     /// The maps of every joint of `mech` over `start → end`; `seeded` adds
-    /// the seeded maps (and takes the values from their real parts, the
-    /// same numbers).
+    /// the seeded maps and takes the values from their real parts (equal to
+    /// the unseeded maps to round-off: a dual division multiplies by the
+    /// reciprocal).
     pub fn new(
         mech: &Mechanism,
         start: &MechanismState,
@@ -59,7 +64,7 @@ impl StepMaps {
 }
 
 /// Joint `j`'s master poses and released states at both ends of the step.
-pub(crate) fn ends<'a>(
+fn ends<'a>(
     mech: &Mechanism,
     j: usize,
     start: &'a MechanismState,
