@@ -212,8 +212,8 @@ impl JointStep<StepDual> {
         }
     }
 
-    /// The real parts: `Ñ` itself, computed with the same arithmetic as the
-    /// unseeded map.
+    /// The real parts: `Ñ` itself, equal to the unseeded map to round-off
+    /// (a dual division multiplies by the reciprocal).
     pub fn value(&self) -> JointStep<f64> {
         JointStep {
             offset: self.offset.map(|v| v.re),
