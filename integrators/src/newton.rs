@@ -11,9 +11,12 @@
 //! are tiny, e.g. the first steps of a ramp, and stiff internal forces round).
 //!
 //! An iterate at the floor reached from an iterate within
-//! [`FLOOR_ACCEPT_FROM`] by an exact full-Newton correction is converged
-//! (its error is of the order of that residual squared). Reached from
-//! farther, an iterate at the floor that is still falling gets one more correction,
+//! [`FLOOR_ACCEPT_FROM`] by an exact full-Newton correction is closed: one
+//! more correction with the factorisation at hand, accepted without
+//! evaluating its residual (see `floor_end`: the floor bounds the round-off
+//! from above, so such an iterate is not yet at the noise, and accepting it
+//! as it stood made the solution jump by up to the floor where a parameter
+//! moved it across). Reached from farther, an iterate at the floor that is still falling gets one more correction,
 //! with the factorisation already made in this solve (at an iterate within
 //! [`FLOOR_REUSE_RESIDUAL`]) rather than a new tangent: a correction of round-off size gains nothing from the exact
 //! tangent there (the old one is off by terms of the size of the last
@@ -170,7 +173,10 @@ pub struct NewtonReport {
     pub factorizations: usize,
     /// Final scaled residual.
     pub residual: f64,
-    /// Scaled residual before each solve and at the end.
+    /// Scaled residual before each solve and at the end — except after a
+    /// closing correction (an iterate at the round-off floor corrected once
+    /// more, its result not evaluated: FORMULATION §4), where the history
+    /// has one entry per solve.
     pub history: Vec<f64>,
 }
 
@@ -228,22 +234,25 @@ fn iterate<S: NewtonSystem>(
         } else {
             sys.residual(r)
         };
-        let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let res = if norm == 0.0 {
-            0.0
-        } else {
-            norm / scale.max(f64::MIN_POSITIVE)
-        };
+        let (norm, res) = scaled_norm(r, scale);
         history.push(res);
         if !res.is_finite() {
             return Err(NewtonFailure::NotFinite { iteration: it });
         }
-        let floored = at_floor(norm, &mut previous_norm, sys.floor())
-            || quadratic_at_floor(it, norm, &history, sys, settings, chord);
-        if res <= settings.tolerance || floored {
+        let end = if at_floor(norm, &mut previous_norm, sys.floor()) {
+            Some(FloorEnd::Accept)
+        } else {
+            floor_end(it, norm, &history, sys, settings, chord)
+        };
+        if res <= settings.tolerance || end.is_some() {
+            let mut iterations = it;
+            if res > settings.tolerance && end == Some(FloorEnd::Close) {
+                close(sys, lu, r, dq, it)?;
+                iterations += 1;
+            }
             let residual = reported_residual(res, norm, scale, sys.floor());
             return Ok(NewtonReport {
-                iterations: it,
+                iterations,
                 factorizations,
                 residual,
                 history,
@@ -298,6 +307,18 @@ fn iterate<S: NewtonSystem>(
         iterations: settings.max_iterations,
         residual: *history.last().unwrap_or(&f64::NAN),
     })
+}
+
+/// The residual's norm and its scaled norm `‖r‖₂ / scale` (0 for a zero
+/// residual, whatever the scale).
+fn scaled_norm(r: &[f64], scale: f64) -> (f64, f64) {
+    let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let res = if norm == 0.0 {
+        0.0
+    } else {
+        norm / scale.max(f64::MIN_POSITIVE)
+    };
+    (norm, res)
 }
 
 /// Factorises the tangent at the current iterate (brought up to date
@@ -373,50 +394,103 @@ fn chord_licence<S: NewtonSystem>(
 pub const CHORD_CONTRACTION: f64 = 1e-3;
 
 /// Largest scaled residual of the previous iterate from which an exact
-/// Newton correction lands at the solution: its error is of the order of
+/// Newton correction lands near the solution: its error is of the order of
 /// that residual squared (1e-6 here), so an iterate it brings to the
-/// round-off floor is accepted there without the stall test's extra
-/// correction (on the slider-crank of `data/benchmarks` that test was a
-/// third of every step's solves: `1, 1.6e-6, 2.1e-9 (floor), 2.1e-9
-/// (stalled)`). From farther the floor may have been reached by a
-/// correction still short of the solution (a floor that overestimates the
-/// round-off), and the stall test stays.
+/// round-off floor ends the solve there without the stall test's extra
+/// evaluation (accepted or closed, see `floor_end`; on the slider-crank of
+/// `data/benchmarks` that test was a third of every step's solves: `1,
+/// 1.6e-6, 2.1e-9 (floor), 2.1e-9 (stalled)`). From farther the floor may
+/// have been reached by a correction still short of the solution (a floor
+/// that overestimates the round-off), and the stall test stays.
 pub const FLOOR_ACCEPT_FROM: f64 = 1e-3;
 
-/// Whether the iterate `it` is at the round-off floor straight from an
-/// iterate within [`FLOOR_ACCEPT_FROM`] by a full-Newton correction with the
-/// exact tangent (quadratic convergence), or with a cheaper tangent
-/// ([`NewtonSystem::tangent_is_exact`] `false`) whose correction contracted
-/// the scaled residual at least as a quadratic one would (to the square of
-/// the residual it started from or below: the cheaper tangent then did as
-/// well as the exact one) — or by a chord step (`chord`: its
-/// licence, [`chord_licence`]) whose expected residual, the licence times
-/// the scaled residual it started from, is within the tolerance (the chord
-/// converges linearly: from farther, the stall test stays). The licence is
-/// the contraction measured with the factorisation the chord reuses, so it
-/// bounds a chord of the cheaper tangent as it does one of the exact; a
-/// cheaper tangent's correction from an iterate already at the floor
-/// ([`floor_reuse`]) is judged the same way, by the contraction that brought
-/// that iterate there.
-fn quadratic_at_floor<S: NewtonSystem>(
+/// How an iterate at the round-off floor ends the solve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum FloorEnd {
+    /// The iterate is the solution.
+    Accept,
+    /// One more correction with the factorisation at hand, accepted
+    /// without evaluating its residual ([`close`]).
+    Close,
+}
+
+/// How the iterate `it`, at the round-off floor from an iterate within
+/// [`FLOOR_ACCEPT_FROM`], ends a full-Newton solve (none: it does not).
+///
+/// - Reached by a chord step (`chord`: its licence, [`chord_licence`])
+///   whose expected residual, the licence times the scaled residual it
+///   started from, is within the tolerance: accepted (the chord converges
+///   linearly: from farther, the stall test stays). The licence is the
+///   contraction measured with the factorisation the chord reuses, so it
+///   bounds a chord of the cheaper tangent as it does one of the exact; a
+///   cheaper tangent's correction from an iterate already at the floor
+///   ([`floor_reuse`]) is judged the same way, by the contraction that
+///   brought that iterate there, and an exact one's is accepted.
+/// - Reached by a correction with a new factorisation — the exact tangent
+///   (quadratic convergence), or a cheaper one
+///   ([`NewtonSystem::tangent_is_exact`] `false`) whose correction contracted
+///   the scaled residual at least as a quadratic one would (to the square of
+///   the residual it started from or below) — or by any correction whose
+///   contraction, repeated from this iterate, promises a residual within the
+///   tolerance: closed ([`FloorEnd::Close`]).
+///   Such an iterate is not yet at the noise: the floor is a bound on the
+///   round-off, and sits one to two orders above the noise the iterates
+///   reach (the four-bar and the slider-crank of `data/benchmarks`). Accepted
+///   as it is, a solution would jump by up to the floor where a parameter's
+///   small change moves the iterate across it; closed, it is the same
+///   correction either way — the one the chord step or the stall test would
+///   have made from it.
+fn floor_end<S: NewtonSystem>(
     it: usize,
     norm: f64,
     history: &[f64],
     sys: &S,
     settings: &NewtonSettings,
     chord: Option<Licence>,
-) -> bool {
+) -> Option<FloorEnd> {
     let previous = history[it.saturating_sub(1)];
+    if it == 0 || settings.modified || norm > sys.floor() || previous > FLOOR_ACCEPT_FROM {
+        return None;
+    }
     let promised = |c: f64| c * previous <= settings.tolerance;
-    it > 0
-        && !settings.modified
-        && norm <= sys.floor()
-        && previous <= FLOOR_ACCEPT_FROM
-        && match chord {
-            Some(Licence::Chord(c)) => promised(c),
-            Some(Licence::FloorReuse(c)) => sys.tangent_is_exact() || promised(c),
-            None => sys.tangent_is_exact() || history[it] <= previous * previous,
-        }
+    let res = history[it];
+    let accepted = match chord {
+        Some(Licence::Chord(c)) => promised(c),
+        Some(Licence::FloorReuse(c)) => sys.tangent_is_exact() || promised(c),
+        None => false,
+    };
+    let quadratic = chord.is_none() && (sys.tangent_is_exact() || res <= previous * previous);
+    if accepted {
+        Some(FloorEnd::Accept)
+    } else if quadratic || (res / previous) * res <= settings.tolerance {
+        Some(FloorEnd::Close)
+    } else {
+        None
+    }
+}
+
+/// The closing correction of an iterate at the round-off floor
+/// ([`FloorEnd::Close`]): `r` is its residual, `lu` the factorisation that
+/// brought it there, at an iterate within [`FLOOR_ACCEPT_FROM`]. The
+/// correction contracts about as much as the last one, so its result is at
+/// the noise (the tolerance where the floor is below it); its residual is
+/// not evaluated — the stall test would evaluate it only to find it there.
+fn close<S: NewtonSystem>(
+    sys: &mut S,
+    lu: &mut SparseLu,
+    r: &[f64],
+    dq: &mut [f64],
+    it: usize,
+) -> Result<(), NewtonFailure> {
+    for (d, v) in dq.iter_mut().zip(r) {
+        *d = -v;
+    }
+    lu.solve(dq).map_err(NewtonFailure::LinearSolve)?;
+    if !dq.iter().all(|d| d.is_finite()) {
+        return Err(NewtonFailure::NotFinite { iteration: it + 1 });
+    }
+    sys.apply(dq);
+    Ok(())
 }
 
 /// Whether full Newton corrects the last iterate of `history` (of norm

@@ -326,7 +326,8 @@ impl TimeScheme for MidpointTerms {
         match sys.terms.scheme {
             Scheme::Momentum => newton::solve(sys, lu, settings, r, dq).map(|rep| (rep, f64::NAN)),
             Scheme::EnergyMomentum => newton::solve(sys, lu, settings, r, dq).map(|rep| {
-                // Newton's last evaluation was at the accepted iterate.
+                // Newton's last evaluation was at the accepted iterate, or
+                // at the one a closing correction moved on by round-off.
                 let size = sys
                     .terms
                     .tally

@@ -406,7 +406,8 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
         rec.energy.potential += dissipated - self.follower_work;
         rec.energy.total += dissipated - self.follower_work;
         if report.is_some() {
-            // The converged iterate's residual, the last one Newton evaluated.
+            // The converged iterate's residual, the last one Newton evaluated
+            // (before a closing correction, which moves it by round-off).
             sys.record_reactions(&mut rec);
         }
         if let Some((_, now)) = &self.sensitivities {
