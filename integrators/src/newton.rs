@@ -152,6 +152,25 @@ pub trait NewtonSystem {
     fn tangent_is_exact(&self) -> bool {
         true
     }
+    /// Whether an iterate within the tolerance is closed like one at the
+    /// round-off floor (closed: one more correction with the
+    /// factorisation at hand, its residual not evaluated) where a
+    /// correction has been made (default `false`: accepted as it stands).
+    /// The conserving schemes ask for it: they conserve energy and momenta
+    /// to what the step converged to, and the correction takes a step
+    /// accepted at the tolerance about as far again below it for a solve.
+    fn closes_converged(&self) -> bool {
+        false
+    }
+    /// Whether a closing correction's result is evaluated after all (its
+    /// residual only, into `r`; default `false`): where something the
+    /// system reports after the solve is taken from the last evaluation and
+    /// must match the state exactly (the energy–momentum scheme's drivers'
+    /// work). The result is accepted whatever its residual, unless it is not
+    /// finite.
+    fn evaluates_closing(&self) -> bool {
+        false
+    }
     /// Asks for the exact tangent (`true`) or the system's cheaper one
     /// (`false`) at the next tangent evaluation. Default: nothing to switch.
     fn set_exact_tangent(&mut self, _exact: bool) {}
@@ -175,8 +194,10 @@ pub struct NewtonReport {
     pub residual: f64,
     /// Scaled residual before each solve and at the end — except after a
     /// closing correction (an iterate at the round-off floor corrected once
-    /// more, its result not evaluated: FORMULATION §4), where the history
-    /// has one entry per solve.
+    /// more, its result not evaluated: FORMULATION §4) of a system that
+    /// does not ask for its evaluation
+    /// ([`NewtonSystem::evaluates_closing`]), where the history has one
+    /// entry per solve.
     pub history: Vec<f64>,
 }
 
@@ -245,11 +266,11 @@ fn iterate<S: NewtonSystem>(
             floor_end(it, norm, &history, sys, settings, chord)
         };
         if res <= settings.tolerance || end.is_some() {
-            let mut iterations = it;
-            if res > settings.tolerance && end == Some(FloorEnd::Close) {
-                close(sys, lu, r, dq, it)?;
-                iterations += 1;
-            }
+            let iterations = if closes(res, end, it, sys, settings) {
+                close(sys, lu, r, dq, it, &mut history)?
+            } else {
+                it
+            };
             let residual = reported_residual(res, norm, scale, sys.floor());
             return Ok(NewtonReport {
                 iterations,
@@ -469,28 +490,60 @@ fn floor_end<S: NewtonSystem>(
     }
 }
 
+/// Whether the accepted iterate `it` (scaled residual `res`, ended by
+/// `end` where it is above the tolerance) is closed ([`close`]): at the
+/// floor by [`floor_end`], within the tolerance where the system asks for
+/// it ([`NewtonSystem::closes_converged`]) and a correction has been made
+/// by full Newton.
+fn closes<S: NewtonSystem>(
+    res: f64,
+    end: Option<FloorEnd>,
+    it: usize,
+    sys: &S,
+    settings: &NewtonSettings,
+) -> bool {
+    if res > settings.tolerance {
+        end == Some(FloorEnd::Close)
+    } else {
+        it > 0 && !settings.modified && sys.closes_converged()
+    }
+}
+
 /// The closing correction of an iterate at the round-off floor
 /// ([`FloorEnd::Close`]): `r` is its residual, `lu` the factorisation that
 /// brought it there, at an iterate within [`FLOOR_ACCEPT_FROM`]. The
 /// correction contracts about as much as the last one, so its result is at
 /// the noise (the tolerance where the floor is below it); its residual is
 /// not evaluated — the stall test would evaluate it only to find it there.
+/// Returns the solves made, `it + 1`; where the system asks for it
+/// ([`NewtonSystem::evaluates_closing`]) the result's residual is evaluated
+/// into `r` and its scaled norm ends the `history`.
 fn close<S: NewtonSystem>(
     sys: &mut S,
     lu: &mut SparseLu,
-    r: &[f64],
+    r: &mut [f64],
     dq: &mut [f64],
     it: usize,
-) -> Result<(), NewtonFailure> {
-    for (d, v) in dq.iter_mut().zip(r) {
+    history: &mut Vec<f64>,
+) -> Result<usize, NewtonFailure> {
+    let not_finite = NewtonFailure::NotFinite { iteration: it + 1 };
+    for (d, v) in dq.iter_mut().zip(r.iter()) {
         *d = -v;
     }
     lu.solve(dq).map_err(NewtonFailure::LinearSolve)?;
     if !dq.iter().all(|d| d.is_finite()) {
-        return Err(NewtonFailure::NotFinite { iteration: it + 1 });
+        return Err(not_finite);
     }
     sys.apply(dq);
-    Ok(())
+    if sys.evaluates_closing() {
+        let scale = sys.residual(r);
+        let (_, res) = scaled_norm(r, scale);
+        history.push(res);
+        if !res.is_finite() {
+            return Err(not_finite);
+        }
+    }
+    Ok(it + 1)
 }
 
 /// Whether full Newton corrects the last iterate of `history` (of norm

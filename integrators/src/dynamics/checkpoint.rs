@@ -186,12 +186,12 @@ impl Tape {
             .collect()
     }
 
-    /// Refuses values left over.
     /// Whether every saved value has been read.
     pub(crate) fn is_done(&self) -> bool {
         self.at == self.data.len()
     }
 
+    /// Refuses values left over.
     pub(crate) fn done(&self) -> Result<(), CheckpointMismatch> {
         if self.at == self.data.len() {
             Ok(())

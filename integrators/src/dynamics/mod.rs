@@ -29,6 +29,7 @@ mod midpoint_geometry;
 mod midpoint_history;
 mod midpoint_joint;
 pub mod midpoint_kernels;
+mod midpoint_predictor;
 mod midpoint_sensitivity;
 pub mod momentum;
 pub mod newmark;

@@ -368,7 +368,7 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
         let sys = &mut self.sys;
         let mech = sys.mech;
         sys.start.clone_from(&sys.end);
-        let (v, w) = sys.terms.velocities();
+        let (v, w) = sys.terms.predictor_velocities();
         let (topo, start_rot) = (&sys.topo, &sys.start.config.rot);
         let end = &mut sys.end.config;
         crate::threads::for_each_pose(&mut end.x, &mut end.rot, |i, x, rot| {

@@ -46,6 +46,11 @@ pub(crate) trait TimeScheme: StepTerms + Sized {
     /// translational `v` and body angular `W`.
     fn velocities(&self) -> (&[Vector3<f64>], &[Vector3<f64>]);
 
+    /// The velocities the predictor carries on (default: [`Self::velocities`]).
+    fn predictor_velocities(&self) -> (&[Vector3<f64>], &[Vector3<f64>]) {
+        self.velocities()
+    }
+
     /// Rates of each joint's released coordinates, for the predictor
     /// (empty: the joints' coordinates start from their last values).
     fn joint_rates(&self) -> &[Vec<f64>] {
