@@ -267,7 +267,8 @@ fn iterate<S: NewtonSystem>(
         };
         if res <= settings.tolerance || end.is_some() {
             let iterations = if closes(res, end, it, sys, settings) {
-                close(sys, lu, r, dq, it, &mut history)?
+                factorizations += usize::from(settings.exact_tangent);
+                close(sys, lu, r, dq, it, &mut history, settings.exact_tangent)?
             } else {
                 it
             };
@@ -430,8 +431,9 @@ pub const FLOOR_ACCEPT_FROM: f64 = 1e-3;
 enum FloorEnd {
     /// The iterate is the solution.
     Accept,
-    /// One more correction with the factorisation at hand, accepted
-    /// without evaluating its residual ([`close`]).
+    /// One more correction with the factorisation at hand (a new one under
+    /// `newton = "exact"`), accepted without evaluating its residual
+    /// ([`close`]).
     Close,
 }
 
@@ -511,11 +513,13 @@ fn closes<S: NewtonSystem>(
 
 /// The closing correction of an iterate at the round-off floor
 /// ([`FloorEnd::Close`]): `r` is its residual, `lu` the factorisation that
-/// brought it there, at an iterate within [`FLOOR_ACCEPT_FROM`]. The
-/// correction contracts about as much as the last one, so its result is at
-/// the noise (the tolerance where the floor is below it); its residual is
-/// not evaluated — the stall test would evaluate it only to find it there.
-/// Returns the solves made, `it + 1`; where the system asks for it
+/// brought it there, at an iterate within [`FLOOR_ACCEPT_FROM`] — or, with
+/// `exact` (`newton = "exact"`: a new tangent at every iterate), a new
+/// factorisation at this iterate, made here. The correction contracts
+/// about as much as the last one, so its result is at the noise (the
+/// tolerance where the floor is below it); its residual is not evaluated —
+/// the stall test would evaluate it only to find it there. Returns the
+/// solves made, `it + 1`; where the system asks for it
 /// ([`NewtonSystem::evaluates_closing`]) the result's residual is evaluated
 /// into `r` and its scaled norm ends the `history`.
 fn close<S: NewtonSystem>(
@@ -525,8 +529,12 @@ fn close<S: NewtonSystem>(
     dq: &mut [f64],
     it: usize,
     history: &mut Vec<f64>,
+    exact: bool,
 ) -> Result<usize, NewtonFailure> {
     let not_finite = NewtonFailure::NotFinite { iteration: it + 1 };
+    if exact {
+        refactor(sys, lu, true, false, dq)?;
+    }
     for (d, v) in dq.iter_mut().zip(r.iter()) {
         *d = -v;
     }

@@ -314,16 +314,25 @@ fn the_solution_is_the_same_whether_an_iterate_lands_just_inside_the_floor_or_ju
     let h = run(&mut probe, true).history;
     let norm = 2.0 * h[2];
     assert!(h[1] <= FLOOR_ACCEPT_FROM && h[2] > 1e-9, "{h:?}");
-    let solve_with_floor = |floor: f64| {
-        let mut sys = Cubic::new(1.0);
-        sys.floor_at = floor;
-        let report = run_to(&mut sys, false, 1e-10);
-        (sys.q, report)
-    };
-    let (inside, closed) = solve_with_floor(norm * (1.0 + 1e-9));
-    let (outside, chord) = solve_with_floor(norm * (1.0 - 1e-9));
-    assert_eq!(closed.history.len(), 3, "closed at the third: {closed:?}");
-    assert_eq!(closed.iterations, 3, "{closed:?}");
-    assert_eq!(chord.history.len(), 4, "{chord:?}");
-    assert_eq!(inside, outside, "{closed:?} {chord:?}");
+    // With `newton = "exact"` the closing and the correction from outside
+    // both take a new tangent at that iterate: the same again, and as many
+    // factorisations as solves.
+    for exact in [false, true] {
+        let solve_with_floor = |floor: f64| {
+            let mut sys = Cubic::new(1.0);
+            sys.floor_at = floor;
+            let report = run_to(&mut sys, exact, 1e-10);
+            (sys.q, report)
+        };
+        let (inside, closed) = solve_with_floor(norm * (1.0 + 1e-9));
+        let (outside, other) = solve_with_floor(norm * (1.0 - 1e-9));
+        assert_eq!(closed.history.len(), 3, "closed at the third: {closed:?}");
+        assert_eq!(closed.iterations, 3, "{closed:?}");
+        assert_eq!(other.history.len(), 4, "{other:?}");
+        assert_eq!(inside, outside, "{closed:?} {other:?}");
+        if exact {
+            assert_eq!(closed.factorizations, 3, "{closed:?}");
+            assert_eq!(other.factorizations, 3, "{other:?}");
+        }
+    }
 }
