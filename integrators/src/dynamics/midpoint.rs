@@ -357,7 +357,8 @@ impl TimeScheme for MidpointTerms {
             Scheme::Momentum => newton::solve(sys, lu, settings, r, dq).map(|rep| (rep, f64::NAN)),
             Scheme::EnergyMomentum => newton::solve(sys, lu, settings, r, dq).map(|rep| {
                 // Newton's last evaluation was at the accepted iterate, or
-                // at the one a closing correction moved on by round-off.
+                // at the one a closing correction moved on (by less than the
+                // tolerance or the floor allow).
                 let size = sys
                     .terms
                     .tally
@@ -389,12 +390,16 @@ impl TimeScheme for MidpointTerms {
         };
         let terms = &mut sys.terms;
         let (v1, w1) = end_motion(&start.config, &end.config, &terms.v_n, &terms.w_n, dt);
-        let mid = |a: &[Vector3<f64>], b: &[Vector3<f64>]| -> Vec<Vector3<f64>> {
-            a.iter().zip(b).map(|(a, b)| (a + b) * 0.5).collect()
-        };
-        let mid = (mid(&terms.v_n, &v1), mid(&terms.w_n, &w1));
-        let ends = ((&terms.v_n[..], &terms.w_n[..]), (&v1[..], &w1[..]));
-        terms.predictor.finish(&terms.inertia, dt, ends, mid);
+        // The paper's scheme predicts with the end velocities alone
+        // (`predictor_velocities`): no memory to keep.
+        if terms.scheme != Scheme::EnergyMomentumPaper {
+            let mid = |a: &[Vector3<f64>], b: &[Vector3<f64>]| -> Vec<Vector3<f64>> {
+                a.iter().zip(b).map(|(a, b)| (a + b) * 0.5).collect()
+            };
+            let mid = (mid(&terms.v_n, &v1), mid(&terms.w_n, &w1));
+            let ends = ((&terms.v_n[..], &terms.w_n[..]), (&v1[..], &w1[..]));
+            terms.predictor.finish(&terms.inertia, dt, ends, mid);
+        }
         for (j, rate) in terms.rates.iter_mut().enumerate() {
             *rate = released_rate(&start.released[j], &end.released[j], rate.len(), dt);
         }

@@ -407,7 +407,8 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
         rec.energy.total += dissipated - self.follower_work;
         if report.is_some() {
             // The converged iterate's residual, the last one Newton evaluated
-            // (before a closing correction, which moves it by round-off).
+            // (before a closing correction, which moves the state by less
+            // than the tolerance or the floor allow).
             sys.record_reactions(&mut rec);
         }
         if let Some((_, now)) = &self.sensitivities {
