@@ -328,11 +328,105 @@ fn the_solution_is_the_same_whether_an_iterate_lands_just_inside_the_floor_or_ju
         let (outside, other) = solve_with_floor(norm * (1.0 - 1e-9));
         assert_eq!(closed.history.len(), 3, "closed at the third: {closed:?}");
         assert_eq!(closed.iterations, 3, "{closed:?}");
-        assert_eq!(other.history.len(), 4, "{other:?}");
+        // Outside the floor the chord step's contraction (2e-4 of 1.3e-7)
+        // promises the tolerance: made and accepted unevaluated too
+        // (`promised_end`); under `newton = "exact"` evaluated.
+        let evaluated = if exact { 4 } else { 3 };
+        assert_eq!(other.history.len(), evaluated, "{other:?}");
         assert_eq!(inside, outside, "{closed:?} {other:?}");
         if exact {
             assert_eq!(closed.factorizations, 3, "{closed:?}");
             assert_eq!(other.factorizations, 3, "{other:?}");
         }
     }
+}
+
+#[test]
+fn a_chord_step_that_promises_the_tolerance_ends_the_solve_unevaluated() {
+    // The exact tangent from (1.02, 0.99): scaled residuals 4.5e-2, 6e-4,
+    // 1.3e-7 (no floor to speak of). The chord step from the third
+    // contracts about as the correction before it, 2.2e-4: it promises
+    // 2.8e-11. Against a tolerance of 1e-8 that is within its hundredth,
+    // so the chord step is made and accepted without an evaluation: three
+    // evaluations, three solves, two factorisations, and the root within
+    // the tolerance (checked by evaluating it here).
+    let mut sys = Cubic::new(1.0);
+    let report = run_to(&mut sys, false, 1e-8);
+    assert_eq!(report.history.len(), 3, "{report:?}");
+    assert_eq!(report.iterations, 3, "{report:?}");
+    assert_eq!(report.factorizations, 2, "{report:?}");
+    let mut r = vec![0.0; 2];
+    let scale = sys.evaluate(&mut r);
+    let res = r.iter().map(|v| v * v).sum::<f64>().sqrt() / scale;
+    assert!(res <= PROMISE_SHARE * 1e-8, "{res:e} {report:?}");
+    // The report gives the promise: the last contraction times the last
+    // residual evaluated.
+    let h = &report.history;
+    assert_eq!(report.residual, h[2] / h[1] * h[2], "{report:?}");
+    // Against 1e-10 the promise is not within the tolerance's hundredth:
+    // the chord step's result is evaluated.
+    let mut strict = Cubic::new(1.0);
+    let report = run_to(&mut strict, false, 1e-10);
+    assert_eq!(report.history.len(), 4, "{report:?}");
+    // Under `newton = "exact"` (a new tangent at every iterate) no chord
+    // step, so no promise: the last iterate is evaluated.
+    let mut exact = Cubic::new(1.0);
+    let report = run_to(&mut exact, true, 1e-8);
+    assert_eq!(report.history.len(), report.iterations + 1, "{report:?}");
+}
+
+#[test]
+fn a_promise_needs_a_contraction_measured_near_the_solution_and_an_iterate_above_the_floor() {
+    // Scale 2: the norm is twice the scaled residual. From 1e-3 to 1e-7 the
+    // contraction 1e-4 promises 1e-11, within a hundredth of 1e-8.
+    let settings = NewtonSettings {
+        tolerance: 1e-8,
+        max_iterations: 40,
+        modified: false,
+        exact_tangent: false,
+    };
+    let mut sys = Cubic::new(1.0);
+    let promise = |sys: &Cubic, history: &[f64], factored: bool| {
+        promised_end(
+            2.0 * history[history.len() - 1],
+            history,
+            sys,
+            &settings,
+            factored,
+        )
+    };
+    assert_eq!(
+        promise(&sys, &[1e-3, 1e-7], true),
+        Some(End::Promise(1e-4 * 1e-7))
+    );
+    // A contraction measured from farther promises nothing (far off, a
+    // correction may contract a lot by chance).
+    assert_eq!(promise(&sys, &[0.5, 1e-7], true), None);
+    // Nor one without a factorisation of this solve, nor a contraction
+    // that promises too little (1e-2 of 1e-7: 1e-9 is not within 1e-10).
+    assert_eq!(promise(&sys, &[1e-3, 1e-7], false), None);
+    assert_eq!(promise(&sys, &[1e-5, 1e-7], true), None);
+    // At the floor the residual is noise: the floor's own tests end it.
+    sys.floor_at = 1e-6;
+    assert_eq!(promise(&sys, &[1e-3, 1e-7], true), None);
+    // A floor below the norm but above the tolerance's norm (2e-8) sets
+    // the bound: from 1e-3 to 5e-7 the promise, 5e-10 as a norm, is not
+    // within a hundredth of the tolerance but is within one of a floor of
+    // 1e-7.
+    sys.floor_at = 0.0;
+    assert_eq!(promise(&sys, &[1e-3, 5e-7], true), None);
+    sys.floor_at = 1e-7;
+    assert!(matches!(
+        promise(&sys, &[1e-3, 5e-7], true),
+        Some(End::Promise(_))
+    ));
+    let modified = NewtonSettings {
+        modified: true,
+        ..settings
+    };
+    let history = [1e-3, 1e-7];
+    assert_eq!(
+        promised_end(2e-7, &history, &Cubic::new(1.0), &modified, true),
+        None
+    );
 }
