@@ -278,10 +278,7 @@ fn iterate<S: NewtonSystem>(
             } else {
                 it
             };
-            let residual = match end {
-                Some(End::Promise(promised)) => promised,
-                _ => reported_residual(res, norm, scale, sys.floor()),
-            };
+            let residual = reported_residual(end, res, norm, scale, sys.floor());
             return Ok(NewtonReport {
                 iterations,
                 factorizations,
@@ -663,9 +660,12 @@ const DEGENERATE_SCALE: f64 = 1e3;
 /// (below [`DEGENERATE_SCALE`] round-off floors), where `res` is round-off
 /// over round-off (≈ 1) and says nothing; there the norm is measured
 /// against the structure's own force scale, the one the round-off floor
-/// `4 ε ‖force scales‖` is made of. Newton's decisions never use it.
-fn reported_residual(res: f64, norm: f64, scale: f64, floor: f64) -> f64 {
-    if floor > 0.0 && scale <= DEGENERATE_SCALE * floor {
+/// `4 ε ‖force scales‖` is made of. A solve ended by a promised chord step
+/// (`end`) reports the promise. Newton's decisions never use it.
+fn reported_residual(end: Option<End>, res: f64, norm: f64, scale: f64, floor: f64) -> f64 {
+    if let Some(End::Promise(promised)) = end {
+        promised
+    } else if floor > 0.0 && scale <= DEGENERATE_SCALE * floor {
         norm * 4.0 * f64::EPSILON / floor
     } else {
         res
