@@ -278,7 +278,7 @@ fn iterate<S: NewtonSystem>(
             } else {
                 it
             };
-            let residual = reported_residual(end, res, norm, scale, sys.floor());
+            let residual = reported_residual(end, &history[it..], norm, scale, sys.floor());
             return Ok(NewtonReport {
                 iterations,
                 factorizations,
@@ -576,7 +576,8 @@ fn closes<S: NewtonSystem>(
 }
 
 /// The closing correction of an iterate at the round-off floor
-/// ([`End::Close`]): `r` is its residual, `lu` the factorisation that
+/// ([`End::Close`]) — or the promised chord step of one above it
+/// ([`End::Promise`], with the factorisation at hand): `r` is its residual, `lu` the factorisation that
 /// brought it there, at an iterate within [`FLOOR_ACCEPT_FROM`] — or, with
 /// `exact` (`newton = "exact"`: a new tangent at every iterate), a new
 /// factorisation at this iterate, made here. The correction contracts
@@ -660,11 +661,15 @@ const DEGENERATE_SCALE: f64 = 1e3;
 /// (below [`DEGENERATE_SCALE`] round-off floors), where `res` is round-off
 /// over round-off (≈ 1) and says nothing; there the norm is measured
 /// against the structure's own force scale, the one the round-off floor
-/// `4 ε ‖force scales‖` is made of. A solve ended by a promised chord step
-/// (`end`) reports the promise. Newton's decisions never use it.
-fn reported_residual(end: Option<End>, res: f64, norm: f64, scale: f64, floor: f64) -> f64 {
+/// `4 ε ‖force scales‖` is made of. `after`: the scaled residuals from the
+/// accepted iterate's on (`res` first, then the closing's where the system
+/// evaluates it). A solve ended by a promised chord step (`end`) reports
+/// the promise, or the chord's residual where it was evaluated. Newton's
+/// decisions never use it.
+fn reported_residual(end: Option<End>, after: &[f64], norm: f64, scale: f64, floor: f64) -> f64 {
+    let res = after[0];
     if let Some(End::Promise(promised)) = end {
-        promised
+        after.get(1).copied().unwrap_or(promised)
     } else if floor > 0.0 && scale <= DEGENERATE_SCALE * floor {
         norm * 4.0 * f64::EPSILON / floor
     } else {
