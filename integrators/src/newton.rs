@@ -451,7 +451,7 @@ enum End {
 /// The share of the tolerance (or of the round-off floor, where that is
 /// above it) a chord step's promised residual — its last measured
 /// contraction times the residual — must be within for its result to be
-/// accepted unevaluated ([`promised_end`]): `0.01`. The promise is a
+/// accepted unevaluated (`promised_end`): `0.01`. The promise is a
 /// bound on the correction's effect, not on the noise: the residuals these
 /// results turn out to have (evaluated for the check, every such step of
 /// the models of `data/benchmarks` and the 512-element cantilever of
