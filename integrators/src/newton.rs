@@ -470,9 +470,10 @@ pub const PROMISE_SHARE: f64 = 0.01;
 /// the convergence test on a vanishing correction that implicit codes make
 /// alongside the residual's, measured here in the residual the correction
 /// leaves. The contraction must have been measured near the solution (from
-/// an iterate within [`FLOOR_ACCEPT_FROM`]) and the iterate must be above
-/// the floor (at the floor the floor's own tests end the solve: a chord
-/// there promises nothing — the residual is noise). It is the same
+/// an iterate within [`FLOOR_ACCEPT_FROM`]); the iterate is above the
+/// floor, since one at the floor corrected from there has no chord licence
+/// ([`floor_reuse`] takes over, and the floor's own tests end the solve: a
+/// chord there promises nothing — the residual is noise). It is the same
 /// correction the chord step would make from the iterate, so the solution
 /// is the one the evaluation would have accepted wherever the promise
 /// holds. `/solver/residual` reports the promised residual (an estimate:
@@ -488,9 +489,8 @@ fn promised_end<S: NewtonSystem>(
     let [.., previous, res] = *history else {
         return None;
     };
-    let measured_near = previous <= FLOOR_ACCEPT_FROM && norm > sys.floor();
     let full = !settings.modified && !settings.exact_tangent;
-    if !full || !factored || !measured_near || res <= settings.tolerance {
+    if !full || !factored || previous > FLOOR_ACCEPT_FROM || res <= settings.tolerance {
         return None;
     }
     // The tolerance as a norm, or the floor where that is above it.

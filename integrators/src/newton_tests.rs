@@ -406,7 +406,8 @@ fn a_promise_needs_a_contraction_measured_near_the_solution_and_an_iterate_above
     // that promises too little (1e-2 of 1e-7: 1e-9 is not within 1e-10).
     assert_eq!(promise(&sys, &[1e-3, 1e-7], false), None);
     assert_eq!(promise(&sys, &[1e-5, 1e-7], true), None);
-    // At the floor the residual is noise: the floor's own tests end it.
+    // At the floor the residual is noise: no chord licence there (the
+    // correction is a floor reuse), and the floor's own tests end it.
     sys.floor_at = 1e-6;
     assert_eq!(promise(&sys, &[1e-3, 1e-7], true), None);
     // A floor below the norm but above the tolerance's norm (2e-8) sets
