@@ -1,6 +1,6 @@
 //! Time per step of the energy–momentum scheme on a free flexible beam, and
 //! its scaling with the number of elements (250, 500, 1000).
-//! `cargo bench -p flexmech-integrators --bench dynamics_step`
+//! `cargo bench -p flexmech-benches --bench dynamics_step`
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use flexmech_core::{MassKind, Mesh, Section};

@@ -1,7 +1,7 @@
 //! Static solve of a 1000-element cantilever bent through a half turn by an
 //! end moment (10 load steps), one assembly of it, and one factorisation and
 //! one solve of its tangent by the band LU the solvers choose for it.
-//! `cargo bench -p flexmech-integrators --bench static_solve`
+//! `cargo bench -p flexmech-benches --bench static_solve`
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexmech_core::{Configuration, Mesh, Section};

@@ -1,7 +1,7 @@
 //! Element kernel speed: residual + tangent of one element in a deformed state
 //! (and of the conserving schemes' forces over a step), the solvers' kernels
 //! next to the AD formulations they replaced (which stay the test oracles).
-//! `cargo bench -p flexmech-core --bench element`
+//! `cargo bench -p flexmech-benches --bench element`
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexmech_core::rotation::exp;
