@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite: unit, property and integration tests of every crate
 # (benchmarks against analytic and published solutions included), then the
-# formatting, lint and API-doc checks the project keeps clean.
+# formatting and lint checks the project keeps clean.
 source "$(dirname "$0")/env.sh"
 # The VTK library reads the ParaView series back in the tests
 # (scripts/check_vtk.py); with its Python modules installed the check is
@@ -28,26 +28,11 @@ fi
 # compilation's caches; a developer's repeated runs keep them.
 if [ -n "${CI:-}" ]; then export CARGO_INCREMENTAL=0; fi
 # Every test target but the criterion benchmarks (bench/, a crate of
-# benchmarks only; clippy below still checks that they compile): unit, integration, the examples' (`test = true`) and
-# doc tests. The Python extension (python/) has no Rust tests (`test = false`,
+# benchmarks only; clippy below still checks that they compile): unit,
+# integration, the examples' (`test = true`) and doc tests. The Python extension (python/) has no Rust tests (`test = false`,
 # `doctest = false`; its pytest suite runs below), but as a member it takes
 # part in the feature resolution, so the extension maturin builds below
 # reuses this build's dependencies instead of building them again.
-cargo test --workspace --no-run
-echo "flexmech tests: test build done at ${SECONDS} s" >&2
-# The lints and the API docs (warnings are errors in both) run beside the
-# tests and the Python package, in a target directory of their own (the two
-# cargo runs do not wait for each other's lock; neither can reuse the
-# other's artifacts anyway): the tests leave a core idle much of the time.
-LINTS_LOG="$ROOT/target/lints.log"
-mkdir -p "$ROOT/target"
-(
-  export CARGO_TARGET_DIR="$ROOT/target/lints"
-  cargo clippy --workspace --all-targets -- -D warnings &&
-    RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps
-) >"$LINTS_LOG" 2>&1 &
-LINTS=$!
-trap 'kill "$LINTS" 2>/dev/null || true' EXIT
 cargo test --workspace
 echo "flexmech tests: unit, integration, example and doc tests done at ${SECONDS} s" >&2
 # The Python package: a virtual environment in target/pyenv, `pip install
@@ -63,10 +48,4 @@ echo "flexmech tests: Python package installed at ${SECONDS} s" >&2
 FLEXMECH_BIN="$ROOT/target/debug/flexmech" MPLBACKEND=Agg "$PYENV/bin/python" -m pytest -q python/tests
 echo "flexmech tests: Python tests done at ${SECONDS} s" >&2
 cargo fmt --all -- --check
-if ! wait "$LINTS"; then
-  cat "$LINTS_LOG" >&2
-  echo "flexmech tests: clippy or rustdoc found warnings (above; log in target/lints.log)" >&2
-  exit 1
-fi
-trap - EXIT
-echo "flexmech tests: clippy and rustdoc clean at ${SECONDS} s (log in target/lints.log)" >&2
+cargo clippy --workspace --all-targets -- -D warnings

@@ -15,8 +15,9 @@ fn data() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../data")
 }
 
-/// Wall time of the suite's campaign.
-const BUDGET: Duration = Duration::from_secs(20);
+/// Wall time of the suite's campaign (about 750 mutants alone on 2 cores;
+/// `scripts/fuzz.sh` runs the long campaigns).
+const BUDGET: Duration = Duration::from_secs(12);
 /// Fewest mutants it must have run (a slow machine still runs this many).
 const FEWEST: usize = 200;
 
