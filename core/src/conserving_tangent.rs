@@ -35,7 +35,6 @@
 //!   `∂q/∂x₂ = −∂q/∂x₁ = ∂q/∂d₂`.
 
 use crate::conserving::{Frames, Pose};
-use crate::discrete_gradient::{dg_step_of, step_force};
 use crate::element::BeamElement;
 use crate::rotation::{exp, log, tangent, tangent_inverse};
 use nalgebra::{Const, Matrix3, SMatrix, SVector, Vector3, U1};
@@ -96,10 +95,7 @@ impl BeamElement<2> {
         start: &Pose<f64>,
         end: &Pose<f64>,
     ) -> (SVector<f64, 12>, SMatrix<f64, 12, 12>) {
-        let (s0, s1) = (self.frames(start), self.frames(end));
-        let (nbar, mbar) = self.averaged_resultants(&s0, &s1);
-        let q = step_force(&dg_step_of(&s0, &s1), &nbar, &mbar).0;
-        (q, self.momentum_tangent_of(&s0, &s1).1)
+        self.energy_momentum_force_cheap_tangent_from(&self.step_start(start), end)
     }
 
     /// [`Self::momentum_force_tangent`] from the poses' [`Frames`]: the chain
@@ -107,7 +103,7 @@ impl BeamElement<2> {
     /// `(η₁, ε₁, η₂, ε₂)` that a term depends on are formed — `δd` on the
     /// `η`, `w_r` and `δφ` on the `ε` — and the `η₁` blocks are the negated
     /// `η₂` ones.
-    fn momentum_tangent_of(
+    pub(crate) fn momentum_tangent_of(
         &self,
         s0: &Frames<f64>,
         s1: &Frames<f64>,

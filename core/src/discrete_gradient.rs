@@ -65,9 +65,9 @@
 use crate::conserving::{Frames, Pose};
 use crate::element::BeamElement;
 use crate::rotation::{
-    cayley_inverse, cayley_of_quaternion, cayley_quaternion, exp_quaternion, log_quaternion, mm,
-    mmt, mtm, mv, quaternion_conjugate, quaternion_half, quaternion_product, skew, tangent,
-    tangent_inverse,
+    cayley_inverse, cayley_of_quaternion, cayley_quaternion, cayley_tangent_inverse,
+    exp_quaternion, log_quaternion, mm, mmt, mtm, mv, quaternion_conjugate, quaternion_half,
+    quaternion_product, skew, tangent, tangent_inverse,
 };
 use crate::scalar::{cst, Scalar};
 use nalgebra::{Matrix3, SVector, Vector3, Vector4};
@@ -102,11 +102,6 @@ pub(crate) struct Step<T: Scalar> {
 fn cayley_tangent<T: Scalar>(c: &Vector3<T>) -> Matrix3<T> {
     (Matrix3::identity() + skew(c) * cst::<T>(0.5))
         * (T::one() / (T::one() + c.norm_squared() * cst::<T>(0.25)))
-}
-
-/// `Q(c)⁻¹ = I − ½ĉ + ¼ c⊗c`.
-fn cayley_tangent_inverse<T: Scalar>(c: &Vector3<T>) -> Matrix3<T> {
-    Matrix3::identity() - skew(c) * cst::<T>(0.5) + c * c.transpose() * cst::<T>(0.25)
 }
 
 /// The smooth secant operators `(B, T)` of a step seen from one end, from

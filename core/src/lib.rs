@@ -27,6 +27,7 @@ pub use section::Section;
 pub mod mesh;
 pub mod prestress;
 pub mod state;
+pub mod step_start;
 
 pub use mesh::{Element, Mesh, MeshError};
 pub use state::Configuration;

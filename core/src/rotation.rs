@@ -358,6 +358,13 @@ pub fn cayley_inverse<T: Scalar>(r: &Matrix3<T>) -> Vector3<T> {
     Vector3::new(q.y, q.z, q.w) * (cst::<T>(2.0) / q.x)
 }
 
+/// The inverse of the Cayley map's tangent, `Q(θ)⁻¹ = I − ½θ̂ + ¼ θ⊗θ`:
+/// `δθ = Q(θ)⁻¹ δφ` for `cay(θ) ← exp(δφ̂) cay(θ)` (a spatial spin; from
+/// `θ = 2v/w` of the quaternion `(w, v)` and `(w, v) ← (1, ½δφ) ⊗ (w, v)`).
+pub fn cayley_tangent_inverse<T: Scalar>(theta: &Vector3<T>) -> Matrix3<T> {
+    Matrix3::identity() - skew(theta) * cst::<T>(0.5) + theta * theta.transpose() * cst::<T>(0.25)
+}
+
 /// Tangent-scaled rotation: `θ = tan(|ω|/2)/(|ω|/2)·ω`, so that `cay(θ) = exp(ω̂)`.
 pub fn tan_scaled<T: Scalar>(omega: &Vector3<T>) -> Vector3<T> {
     let x2 = omega.norm_squared() * cst::<T>(0.25);

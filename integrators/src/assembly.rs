@@ -405,7 +405,7 @@ impl Assembler {
     /// the tangent values are left as they were): for a residual check that
     /// no factorisation follows.
     pub fn assemble_residual(&mut self, mesh: &Mesh, config: &Configuration) {
-        self.assemble_residual_with(mesh, |el, r| {
+        self.assemble_residual_with(mesh, |el, _, r| {
             el.internal_force_into(&config.x, &config.rot, r)
         });
     }
@@ -414,15 +414,15 @@ impl Assembler {
     /// (element, its force out, ordered as the element's nodes).
     pub fn assemble_residual_with<F>(&mut self, mesh: &Mesh, kernel: F)
     where
-        F: Fn(&Element, &mut [f64]) + Sync,
+        F: Fn(&Element, usize, &mut [f64]) + Sync,
     {
         let n = mesh.elements.len();
         if !self.residual_cost.split(n) {
             let start = self.residual_cost.probing(n).then(Instant::now);
             self.clear_forces();
-            for el in &mesh.elements {
+            for (index, el) in mesh.elements.iter().enumerate() {
                 let w = scratch_for(&mut self.scratch, el.dofs());
-                kernel(el, w.r.as_mut_slice());
+                kernel(el, index, w.r.as_mut_slice());
                 add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
             }
             if let Some(start) = start {
@@ -430,7 +430,9 @@ impl Assembler {
             }
             return;
         }
-        self.split_loop(mesh, false, |w, _, el, _| kernel(el, w.r.as_mut_slice()));
+        self.split_loop(mesh, false, |w, index, el, _| {
+            kernel(el, index, w.r.as_mut_slice())
+        });
     }
 
     /// Adds the dense matrix `m` (column-major over block `b`'s equations) to

@@ -13,7 +13,7 @@ use crate::threads::for_each_pose;
 use flexmech_core::rotation::{exp, log};
 use flexmech_core::state::increment_pose;
 use flexmech_core::Configuration;
-use flexmech_joints::{JointStep, ReleasedState, StepDual, LOCAL, MAX_RELEASED};
+use flexmech_joints::{JointStep, ReleasedState, SeededStep, StepLanes, LOCAL, MAX_RELEASED};
 use nalgebra::{DMatrix, Matrix3, SMatrix, SVector, Vector3, Vector6};
 use smallvec::SmallVec;
 
@@ -193,6 +193,27 @@ impl Topology {
         }
     }
 
+    /// The lanes along which each joint's step map is differentiated for the
+    /// conserving schemes' tangent ([`StepLanes`]): those of the columns
+    /// [`Self::incremental_blocks`] keeps — the master's spin where a column
+    /// of the master's map turns it (not for the ground or a node whose
+    /// rotation is held), the released coordinates up to the last with an
+    /// equation (a driven one has none).
+    pub fn step_lanes(&self, mech: &Mechanism) -> Vec<StepLanes> {
+        (0..mech.joints.len())
+            .map(|j| {
+                let master = &self.dofs.nodes[mech.joints[j].master];
+                let spin = master
+                    .cols
+                    .iter()
+                    .any(|c| c.fixed_rows::<3>(3).iter().any(|&v| v != 0.0));
+                let eqs = &self.released_eqs[j];
+                let released = eqs.iter().rposition(Option::is_some).map_or(0, |c| c + 1);
+                StepLanes { spin, released }
+            })
+            .collect()
+    }
+
     /// The local-to-global map of joint `j`, one entry per column (following
     /// `local_eqs[j]`): the master's node map (its rows when `rows`, else
     /// its columns) in local rows 0..6, then the released coordinates, each
@@ -240,17 +261,17 @@ impl Topology {
     /// `Σ_j L_j,rowᵀ ∂(Ñ_jᵀ g_s)/∂q L_j,col` with the slaves' residuals held
     /// (deepest slaves first, each handing `Ñᵀ g_s` to its master, as
     /// [`Topology::reduce_incremental`] does): `Ñ` follows the step's end
-    /// state (AD through `Ñ`: the seeded maps `seeded[j]` of [`StepMaps`],
-    /// [`JointStep::seeded_transfer`]); rows through the masters' rows,
+    /// state (the seeded maps `seeded[j]` of [`StepMaps`] along the lanes of
+    /// [`Self::step_lanes`], [`SeededStep::transfer`]); rows through the masters' rows,
     /// columns through their columns.
     pub fn incremental_blocks(
         &self,
         mech: &Mechanism,
-        seeded: &[JointStep<StepDual>],
+        seeded: &[SeededStep],
         g: &[f64],
     ) -> Vec<DMatrix<f64>> {
         self.joint_blocks(mech, g, true, |j, _, gs| {
-            seeded[j].seeded_transfer(gs, mech.joints[j].map.released_count())
+            seeded[j].transfer(gs, mech.joints[j].map.released_count())
         })
     }
 
@@ -341,7 +362,7 @@ impl Topology {
     ) -> Result<Vec<(usize, f64)>, usize> {
         let mut extra = Vec::new();
         let mut missing = None;
-        let maps = StepMaps::new(mech, start, end, false);
+        let maps = StepMaps::new(mech, start, end, None);
         self.fold_slaves(mech, Fold::Incremental(&maps.values), g, |j, gs, _| {
             let m = mech.joints[j].master;
             let from = [
@@ -426,7 +447,7 @@ impl Topology {
         g: &[f64],
     ) -> (Vec<[f64; 6]>, Vec<[f64; 6]>) {
         let mut joints = vec![[0.0; 6]; mech.joints.len()];
-        let maps = start.map(|start| StepMaps::new(mech, start, end, false));
+        let maps = start.map(|start| StepMaps::new(mech, start, end, None));
         let fold = match &maps {
             Some(maps) => Fold::Incremental(&maps.values),
             None => Fold::Variation(end),

@@ -4,8 +4,9 @@
 //! tangent rows ([`Topology::refresh_rows`]), the reduced residual `Ñᵀ g`
 //! ([`Topology::reduce_incremental`]) and the joints' tangent blocks
 //! ([`Topology::incremental_blocks`]). With the tangent, one seeded map per
-//! joint ([`JointStep::seeded`]) gives all three: its real parts are the map
-//! and its lanes the derivative along the step's end state.
+//! joint ([`SeededStep`], along the lanes that reach the unknowns) gives all
+//! three: its value is the map and its lanes the derivative along the step's
+//! end state.
 //!
 //! [`Topology::refresh_rows`]: crate::constraints::Topology::refresh_rows
 //! [`Topology::reduce_incremental`]: crate::constraints::Topology::reduce_incremental
@@ -14,39 +15,43 @@
 use crate::constraints::MechanismState;
 use crate::mechanism::Mechanism;
 use flexmech_joints::incremental::NodePose;
-use flexmech_joints::{JointStep, StepDual};
+use flexmech_joints::{JointStep, SeededStep, StepLanes};
 
 /// Every joint's `Ñ` over the step `start → end` (model order), and, when
-/// the tangent is wanted, the same maps seeded along the end state.
+/// the tangent is wanted, the same maps seeded along the lanes of the end
+/// state that reach the unknowns.
 #[derive(Debug, Clone, Default)]
 pub struct StepMaps {
     /// `Ñ` of each joint.
     pub values: Vec<JointStep>,
-    /// `Ñ` of each joint seeded along the step's end state (empty without the
-    /// tangent).
-    pub seeded: Vec<JointStep<StepDual>>,
+    /// `Ñ` of each joint with its derivative along the step's end state
+    /// (empty without the tangent).
+    pub seeded: Vec<SeededStep>,
 }
 
 impl StepMaps {
-    /// The maps of every joint of `mech` over `start → end`; `seeded` adds
-    /// the seeded maps and takes the values from their real parts (equal to
-    /// the unseeded maps to round-off: a dual division multiplies by the
-    /// reciprocal).
+    /// The maps of every joint of `mech` over `start → end`; with `lanes`
+    /// (one per joint, [`Topology::step_lanes`]) the seeded maps too, and
+    /// the values from them.
+    ///
+    /// [`Topology::step_lanes`]: crate::constraints::Topology::step_lanes
     pub fn new(
         mech: &Mechanism,
         start: &MechanismState,
         end: &MechanismState,
-        seeded: bool,
+        lanes: Option<&[StepLanes]>,
     ) -> Self {
         let joints = 0..mech.joints.len();
-        if seeded {
+        if let Some(lanes) = lanes {
             let seeded: Vec<_> = joints
                 .map(|j| {
                     let (master, released) = ends(mech, j, start, end);
-                    mech.joints[j].map.incremental_step_seeded(master, released)
+                    mech.joints[j]
+                        .map
+                        .incremental_step_lanes(master, released, lanes[j])
                 })
                 .collect();
-            let values = seeded.iter().map(JointStep::value).collect();
+            let values = seeded.iter().map(|s| s.value.clone()).collect();
             Self { values, seeded }
         } else {
             let values = joints

@@ -183,8 +183,10 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
     /// conserving schemes' [`Reduction::Incremental`] (seeded along the end
     /// state with `seeded`); `None` for [`Reduction::Variation`].
     fn step_maps(&self, seeded: bool) -> Option<StepMaps> {
-        (self.terms.reduction() == Reduction::Incremental)
-            .then(|| StepMaps::new(self.mech, &self.start, &self.end, seeded))
+        (self.terms.reduction() == Reduction::Incremental).then(|| {
+            let lanes = seeded.then(|| self.topo.step_lanes(self.mech));
+            StepMaps::new(self.mech, &self.start, &self.end, lanes.as_deref())
+        })
     }
 
     /// [`Self::reduce`] with the step's maps (given for

@@ -58,6 +58,26 @@ pub struct JointStep<T: Scalar = f64> {
 }
 
 impl<T: Scalar> JointStep<T> {
+    /// The map with `f` applied to every entry.
+    pub fn map<U: Scalar>(&self, f: impl Fn(T) -> U) -> JointStep<U> {
+        JointStep {
+            offset: self.offset.map(&f),
+            lever: self.lever.map(&f),
+            a: self.a.map(&f),
+            b: self.b.map(&f),
+        }
+    }
+
+    /// The map whose entries are all zero.
+    pub fn zeros() -> Self {
+        Self {
+            offset: Vector3::zeros(),
+            lever: Matrix3::zeros(),
+            a: Matrix3::zeros(),
+            b: SMatrix::zeros(),
+        }
+    }
+
     /// `Ñ` of `joint` over a step whose end is seeded: the master's end pose
     /// `(x₁ + δx, exp(δφ̂) R₁)` and the released end state `end ⊕ inc`, with
     /// `δ = (δx, δφ)` given as `seed`.
@@ -98,7 +118,7 @@ impl<T: Scalar> JointStep<T> {
     }
 
     /// `Ñ` from the seeded ends and the step's `B`.
-    fn with_map<J: JointKinematics + ?Sized>(
+    pub(crate) fn with_map<J: JointKinematics + ?Sized>(
         joint: &J,
         master: [NodePose<'_>; 2],
         released: [&ReleasedState; 2],
@@ -215,12 +235,7 @@ impl JointStep<StepDual> {
     /// The real parts: `Ñ` itself, equal to the unseeded map to round-off
     /// (a dual division multiplies by the reciprocal).
     pub fn value(&self) -> JointStep<f64> {
-        JointStep {
-            offset: self.offset.map(|v| v.re),
-            lever: self.lever.map(|v| v.re),
-            a: self.a.map(|v| v.re),
-            b: self.b.map(|v| v.re),
-        }
+        self.map(|v| v.re)
     }
 
     /// `Ñᵀ g` for a slave residual `g` held fixed and its derivative with

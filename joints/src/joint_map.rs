@@ -27,6 +27,7 @@ use crate::incremental::{JointStep, NodePose, StepDual};
 use crate::kinematics::{
     released_count, Increments, JointKinematics, ReleasedState, LOCAL, MAX_RELEASED, TAYLOR_BELOW,
 };
+use crate::seeded_step::{SeededStep, StepLanes};
 use flexmech_core::rotation::exp;
 use flexmech_core::{cst, Scalar};
 use nalgebra::{Const, Matrix3, SMatrix, SVector, Vector3, Vector6, U1};
@@ -105,6 +106,20 @@ pub trait JointMap: Send + Sync + Debug {
         master: [NodePose<'_>; 2],
         released: [&ReleasedState; 2],
     ) -> JointStep<StepDual>;
+
+    /// [`Self::incremental_step_seeded`] along `lanes` only, the lanes that
+    /// reach the unknowns ([`SeededStep`]): what a Newton evaluation of the
+    /// conserving schemes uses. The default takes the ten-lane map; the
+    /// kinds of [`JointKinematics`] seed the released coordinates alone and
+    /// take the master's spin in closed form ([`SeededStep::of`]).
+    fn incremental_step_lanes(
+        &self,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+        lanes: StepLanes,
+    ) -> SeededStep {
+        SeededStep::from_seeded(&self.incremental_step_seeded(master, released), lanes)
+    }
 
     /// `Ñᵀ g` for a slave residual `g` held fixed, and its exact derivative
     /// with respect to the local increments of the step's end state —
@@ -524,6 +539,15 @@ impl<J: JointKinematics> JointMap for J {
         released: [&ReleasedState; 2],
     ) -> JointStep<StepDual> {
         JointStep::seeded(self, master, released)
+    }
+
+    fn incremental_step_lanes(
+        &self,
+        master: [NodePose<'_>; 2],
+        released: [&ReleasedState; 2],
+        lanes: StepLanes,
+    ) -> SeededStep {
+        SeededStep::of(self, master, released, lanes)
     }
 
     fn incremental_transfer_start(

@@ -28,6 +28,7 @@ pub mod revolute;
 pub mod rigid;
 pub mod rigid_link;
 pub mod screw;
+pub mod seeded_step;
 pub mod spherical;
 
 pub use cam::Cam;
@@ -48,4 +49,5 @@ pub use revolute::Revolute;
 pub use rigid::Rigid;
 pub use rigid_link::RigidLink;
 pub use screw::Screw;
+pub use seeded_step::{SeededStep, StepLanes};
 pub use spherical::{Spherical, SphericalParams};

@@ -21,7 +21,8 @@ use flexmech_core::rotation::{cayley, cayley_inverse, cayley_mid, exp, log, skew
 use flexmech_core::{cst, Scalar};
 use flexmech_joints::{
     Cam, Cylindrical, DependentJoint, DependentJointMaps, JointMap, JointStep, Lift, Lobe,
-    Prismatic, RackPinion, ReleasedState, Revolute, Rigid, Screw, Spherical, LOCAL, MAX_RELEASED,
+    Prismatic, RackPinion, ReleasedState, Revolute, Rigid, Screw, Spherical, StepLanes, LOCAL,
+    MAX_RELEASED,
 };
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector6};
 use proptest::prelude::*;
@@ -1479,6 +1480,60 @@ fn incremental_transfer_derivative_matches_differences() {
                         (fd - ad.column(c)).norm() / (1.0 + ad.column(c).norm()),
                         FD_TOL,
                     )?;
+                }
+            }
+            Ok(())
+        },
+    );
+}
+
+/// The seeded map along chosen lanes (released lanes by AD, the master's
+/// spin closed form) agrees with the ten-lane AD of `Ñᵀg`: the value and
+/// every seeded column to round-off, the other columns zero.
+#[test]
+fn seeded_step_lanes_match_the_ten_lane_ad() {
+    property(
+        "6e. Ntilde^T g and its derivative along chosen lanes = ten-lane AD, every kind",
+        CASES,
+        steps(),
+        |Step {
+             m,
+             x1,
+             r1,
+             g,
+             d: [d0, d1, d2],
+             p,
+             q,
+         },
+         w| {
+            for kind in all_kinds(&p, &q) {
+                let end = step_of(&kind, &[d0, d1, d2]);
+                let k = kind.map.released_count();
+                let (master, released) = ([(&m.x, &m.r), (&x1, &r1)], [&kind.state, &end]);
+                let (value, ad) = kind.map.incremental_transfer(master, released, &g);
+                let scale = 1.0 + ad.norm() + value.norm();
+                for spin in [true, false] {
+                    for seeded in 0..=k {
+                        let lanes = StepLanes {
+                            spin,
+                            released: seeded,
+                        };
+                        let step = kind.map.incremental_step_lanes(master, released, lanes);
+                        let (v, kk) = step.transfer(&g, k);
+                        let at = format!("{}: {lanes:?}", kind.name);
+                        w.check(&format!("{at} value"), (v - value).norm() / scale, 1e-12)?;
+                        for c in 0..LOCAL {
+                            let wanted =
+                                (3..6).contains(&c) && spin || (6..6 + seeded).contains(&c);
+                            let expected = if wanted {
+                                ad.column(c).into_owned()
+                            } else {
+                                SVector::zeros()
+                            };
+                            let err = (kk.column(c) - expected).norm() / scale;
+                            w.check(&format!("{at} column {c}"), err, 1e-12)?;
+                        }
+                    }
                 }
             }
             Ok(())

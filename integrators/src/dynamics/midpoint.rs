@@ -25,7 +25,10 @@
 use super::bordered::{self, Bordered};
 use super::checkpoint::{CheckpointMismatch, Tape};
 use super::mass_slots::MassSlots;
-use super::midpoint_kernels::{correction_size, element_force, element_kernel, CorrectionTally};
+use super::midpoint_kernels::{
+    correction_size, element_force, element_kernel, start_of, started_force, started_kernel,
+    step_starts, CorrectionTally,
+};
 use super::midpoint_sensitivity::MidpointSensitivities;
 use super::time_scheme::{SchemeSensitivities, TimeScheme};
 pub use super::Scheme;
@@ -42,7 +45,8 @@ use crate::newton::{self, NewtonReport, NewtonSettings};
 use crate::record::Sensitivity;
 use crate::sensitivity::Parameter;
 use crate::system::{ReducedSystem, Reduction, StepTerms};
-use flexmech_core::rotation::{cayley_inverse, log};
+use flexmech_core::rotation::{cayley_inverse, cayley_tangent_inverse, log};
+use flexmech_core::step_start::StepStart;
 use flexmech_core::{Configuration, Inertia};
 use nalgebra::{Matrix3, Vector3};
 
@@ -92,9 +96,9 @@ fn inertial_moment(
     let theta = cayley_inverse(&(r_end * r_n.transpose()));
     let w1 = r_n.transpose() * theta * (2.0 / dt) - w_n;
     let pi1 = r_end * (j0 * w1);
-    let cayley_tangent =
-        Matrix3::identity() - theta.cross_matrix() * 0.5 + theta * theta.transpose() * 0.25;
-    let k = (r_end * j0 * r_n.transpose() * cayley_tangent * (2.0 / dt) - pi1.cross_matrix()) / dt;
+    let k = (r_end * j0 * r_n.transpose() * cayley_tangent_inverse(&theta) * (2.0 / dt)
+        - pi1.cross_matrix())
+        / dt;
     (m, k)
 }
 
@@ -141,6 +145,10 @@ pub(crate) struct MidpointTerms {
     /// The energy–momentum scheme's correction sizes at the last residual
     /// evaluation.
     tally: CorrectionTally,
+    /// The energy–momentum scheme's 2-node elements' [`StepStart`]s of the
+    /// step being solved (empty for the other schemes; an entry is used only
+    /// for the start it was computed at).
+    starts: Vec<Option<StepStart>>,
 }
 
 impl MidpointTerms {
@@ -171,6 +179,7 @@ impl MidpointTerms {
             predictor: MidpointPredictor::default(),
             exact_tangent: true,
             tally: CorrectionTally::default(),
+            starts: Vec::new(),
         }
     }
 }
@@ -192,13 +201,20 @@ impl StepTerms for MidpointTerms {
         let (scheme, beta, exact, tally) =
             (self.scheme, self.beta, self.exact_tangent, &self.tally);
         tally.start(!tangent);
+        let starts = &self.starts;
         if tangent {
-            asm.assemble_with(&mech.mesh, dofs, |el, _, re, ke| {
-                element_kernel(el, start, end, scheme, beta, exact, re, ke)
+            asm.assemble_with(&mech.mesh, dofs, |el, i, re, ke| {
+                match start_of(starts, el, i, start).filter(|_| !exact) {
+                    Some(from) => started_kernel(from, end, re, ke),
+                    None => element_kernel(el, start, end, scheme, beta, exact, re, ke),
+                }
             });
         } else {
-            asm.assemble_residual_with(&mech.mesh, |el, re| {
-                element_force(el, start, end, scheme, beta, tally, re)
+            asm.assemble_residual_with(&mech.mesh, |el, i, re| {
+                match start_of(starts, el, i, start) {
+                    Some(from) => started_force(from, end, tally, re),
+                    None => element_force(el, start, end, scheme, beta, tally, re),
+                }
             });
         }
     }
@@ -355,19 +371,22 @@ impl TimeScheme for MidpointTerms {
         sys.terms.beta = 0.0;
         match sys.terms.scheme {
             Scheme::Momentum => newton::solve(sys, lu, settings, r, dq).map(|rep| (rep, f64::NAN)),
-            Scheme::EnergyMomentum => newton::solve(sys, lu, settings, r, dq).map(|rep| {
-                // Newton's last evaluation was at the accepted iterate, or
-                // at the one a closing correction moved on (by less than the
-                // tolerance or the floor allow).
-                let size = sys
-                    .terms
-                    .tally
-                    .correction_size(sys.mech)
-                    .unwrap_or_else(|| {
-                        correction_size(sys.mech, &sys.start.config, &sys.end.config)
-                    });
-                (rep, size)
-            }),
+            Scheme::EnergyMomentum => {
+                sys.terms.starts = step_starts(sys.mech, &sys.start.config);
+                newton::solve(sys, lu, settings, r, dq).map(|rep| {
+                    // Newton's last evaluation was at the accepted iterate, or
+                    // at the one a closing correction moved on (by less than the
+                    // tolerance or the floor allow).
+                    let size = sys
+                        .terms
+                        .tally
+                        .correction_size(sys.mech)
+                        .unwrap_or_else(|| {
+                            correction_size(sys.mech, &sys.start.config, &sys.end.config)
+                        });
+                    (rep, size)
+                })
+            }
             Scheme::EnergyMomentumPaper => {
                 let solved = bordered::solve_step(sys, lu, settings);
                 // β took part in the step's equations (else it was left out).

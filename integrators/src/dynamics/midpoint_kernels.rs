@@ -5,8 +5,10 @@
 
 use super::Scheme;
 use crate::mechanism::Mechanism;
+use crate::threads;
 use flexmech_core::conserving::{MidRotation, Pose, Pose3};
 use flexmech_core::rotation::exp;
+use flexmech_core::step_start::StepStart;
 use flexmech_core::{cst, BeamElement, Configuration, Element, Scalar};
 use nalgebra::{Const, SVector, Vector3, U1};
 use num_dual::DualSVec64;
@@ -178,6 +180,59 @@ pub(crate) fn element_force(
     r.copy_from_slice(q.as_slice());
 }
 
+/// Every 2-node element's [`StepStart`] at the step's start (`None` for
+/// 3-node elements): the energy–momentum scheme's kernels look the start
+/// pose's rotation pieces up instead of recomputing them at every Newton
+/// evaluation of the step.
+pub(crate) fn step_starts(mech: &Mechanism, start: &Configuration) -> Vec<Option<StepStart>> {
+    let elements = &mech.mesh.elements;
+    threads::map_each(elements.len(), |i| match &elements[i] {
+        Element::Linear(e) => Some(e.step_start(&pose_of(e, start))),
+        Element::Quadratic(_) => None,
+    })
+}
+
+/// Element `index`'s entry of `starts` when `el` is a 2-node element and the
+/// entry is the start of a step from `start` (else `None`: the kernel
+/// computes its own).
+pub(crate) fn start_of<'a>(
+    starts: &'a [Option<StepStart>],
+    el: &'a Element,
+    index: usize,
+    start: &Configuration,
+) -> Option<(&'a BeamElement<2>, &'a StepStart)> {
+    match (el, starts.get(index)) {
+        (Element::Linear(e), Some(Some(s))) if s.is_of(&pose_of(e, start)) => Some((e, s)),
+        _ => None,
+    }
+}
+
+/// The energy–momentum scheme's force with its cheap tangent
+/// ([`element_kernel`] with `exact = false`) from the element's step start.
+pub(crate) fn started_kernel(
+    (e, s): (&BeamElement<2>, &StepStart),
+    end: &Configuration,
+    r: &mut [f64],
+    k: &mut [f64],
+) {
+    let (q, jac) = e.energy_momentum_force_cheap_tangent_from(s, &pose_of(e, end));
+    r.copy_from_slice(q.as_slice());
+    k.copy_from_slice(jac.as_slice());
+}
+
+/// The energy–momentum scheme's force ([`element_force`]) from the
+/// element's step start.
+pub(crate) fn started_force(
+    (e, s): (&BeamElement<2>, &StepStart),
+    end: &Configuration,
+    tally: &CorrectionTally,
+    r: &mut [f64],
+) {
+    let (q, c) = e.energy_momentum_force_parts_from(s, &pose_of(e, end));
+    tally.add(c.norm(), q.norm());
+    r.copy_from_slice(q.as_slice());
+}
+
 /// Element kernel for 3-node elements, in both conserving schemes: the
 /// energy-consistent discrete gradient (FORMULATION §4.3; there is no
 /// paper form for them, so the momentum scheme uses it too and conserves
@@ -230,7 +285,7 @@ fn averaged_resultants<T: Scalar>(
 }
 
 /// A 2-node element's nodal positions and rotations in a configuration.
-fn pose_of(e: &BeamElement<2>, c: &Configuration) -> Pose<f64> {
+pub(crate) fn pose_of(e: &BeamElement<2>, c: &Configuration) -> Pose<f64> {
     let n = e.nodes;
     ([c.x[n[0]], c.x[n[1]]], [c.rot[n[0]], c.rot[n[1]]])
 }

@@ -1,0 +1,105 @@
+//! A 2-node element's start of a time step, computed once per step: the
+//! start pose's rotation pieces ([`Frames`]: triads, relative rotation, its
+//! logarithm and half, reference rotation) that every Newton evaluation of
+//! the conserving schemes needs again, since the start pose stays put while
+//! the end pose is iterated. The kernels taking a [`StepStart`] are the ones
+//! taking both poses with the start's pieces looked up instead of
+//! recomputed: the same arithmetic, so the same results to the bit (tested).
+
+use crate::conserving::{Frames, Pose};
+use crate::discrete_gradient::{dg_step_of, step_force};
+use crate::element::BeamElement;
+use nalgebra::{SMatrix, SVector};
+
+/// An element's pose at the start of a step with its rotation pieces.
+#[derive(Debug, Clone)]
+pub struct StepStart {
+    pose: Pose<f64>,
+    frames: Frames<f64>,
+}
+
+impl StepStart {
+    /// Whether this is the start of a step from `pose` (exactly: any other
+    /// pose recomputes its pieces, so a start kept past its step is never
+    /// used for another).
+    pub fn is_of(&self, pose: &Pose<f64>) -> bool {
+        self.pose == *pose
+    }
+}
+
+impl BeamElement<2> {
+    /// The element's [`StepStart`] at `pose`.
+    pub fn step_start(&self, pose: &Pose<f64>) -> StepStart {
+        StepStart {
+            pose: *pose,
+            frames: self.frames(pose),
+        }
+    }
+
+    /// [`Self::energy_momentum_force_parts`] from a step's start.
+    pub fn energy_momentum_force_parts_from(
+        &self,
+        start: &StepStart,
+        end: &Pose<f64>,
+    ) -> (SVector<f64, 12>, SVector<f64, 12>) {
+        let (s, e) = (&start.frames, &self.frames(end));
+        let (nbar, mbar) = self.averaged_resultants(s, e);
+        step_force(&dg_step_of(s, e), &nbar, &mbar)
+    }
+
+    /// [`Self::energy_momentum_force_cheap_tangent`] from a step's start.
+    pub fn energy_momentum_force_cheap_tangent_from(
+        &self,
+        start: &StepStart,
+        end: &Pose<f64>,
+    ) -> (SVector<f64, 12>, SMatrix<f64, 12, 12>) {
+        let (s0, s1) = (&start.frames, &self.frames(end));
+        let (nbar, mbar) = self.averaged_resultants(s0, s1);
+        let q = step_force(&dg_step_of(s0, s1), &nbar, &mbar).0;
+        (q, self.momentum_tangent_of(s0, s1).1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rotation::exp;
+    use crate::Section;
+    use nalgebra::{Matrix3, Vector3};
+
+    #[test]
+    fn kernels_from_a_step_start_equal_those_from_both_poses_to_the_bit() {
+        let sec = Section::new(
+            [1.0e7, 5.0e6, 5.0e6],
+            [7.0e5, 8.0e5, 8.3e5],
+            1.0,
+            [0.2, 0.1, 0.1],
+        );
+        let x0 = [Vector3::zeros(), Vector3::new(1.0, 0.0, 0.0)];
+        let e = BeamElement::new([0, 1], sec, 1.0, &x0, [Matrix3::identity(); 2]);
+        let start: Pose<f64> = (
+            [Vector3::new(0.01, 0.02, 0.0), Vector3::new(0.9, 0.3, 0.1)],
+            [
+                exp(&Vector3::new(0.1, 0.2, 0.3)),
+                exp(&Vector3::new(-0.2, 0.5, 0.9)),
+            ],
+        );
+        let end: Pose<f64> = (
+            [start.0[0] + Vector3::new(0.01, -0.02, 0.005), start.0[1]],
+            [
+                exp(&Vector3::new(0.02, -0.01, 0.03)) * start.1[0],
+                start.1[1],
+            ],
+        );
+        let s = e.step_start(&start);
+        assert!(s.is_of(&start) && !s.is_of(&end));
+        assert_eq!(
+            e.energy_momentum_force_parts_from(&s, &end),
+            e.energy_momentum_force_parts(&start, &end)
+        );
+        assert_eq!(
+            e.energy_momentum_force_cheap_tangent_from(&s, &end),
+            e.energy_momentum_force_cheap_tangent(&start, &end)
+        );
+    }
+}
