@@ -1,5 +1,5 @@
 //! A 2-node element's start of a time step, computed once per step: the
-//! start pose's rotation pieces ([`Frames`]: triads, relative rotation, its
+//! start pose's rotation pieces (`Frames`: triads, relative rotation, its
 //! logarithm and half, reference rotation) that every Newton evaluation of
 //! the conserving schemes needs again, since the start pose stays put while
 //! the end pose is iterated. The kernels taking a [`StepStart`] are the ones
