@@ -88,6 +88,28 @@ fn bench(c: &mut Criterion) {
             })
         },
     );
+    c.bench_function("energy-momentum step: force only (the residual's)", |b| {
+        b.iter(|| black_box(e2.energy_momentum_force_parts(black_box(&start), black_box(&end))))
+    });
+    let from = e2.step_start(&start);
+    c.bench_function(
+        "energy-momentum step: force only, from the step's start",
+        |b| {
+            b.iter(|| {
+                black_box(e2.energy_momentum_force_parts_from(black_box(&from), black_box(&end)))
+            })
+        },
+    );
+    c.bench_function(
+        "energy-momentum step: force+cheap tangent, from the step's start",
+        |b| {
+            b.iter(|| {
+                black_box(
+                    e2.energy_momentum_force_cheap_tangent_from(black_box(&from), black_box(&end)),
+                )
+            })
+        },
+    );
     c.bench_function("energy-momentum step: force+tangent (12-lane AD)", |b| {
         b.iter(|| black_box(ad12(&e2, &start, &end, true)))
     });
