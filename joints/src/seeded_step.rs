@@ -196,9 +196,13 @@ struct StepEnds {
     r1: Matrix3<f64>,
     /// `Λ_m,ₙ₊₁ r_R,ₙ₊₁`.
     y: Vector3<f64>,
-    /// `θ_m`.
-    theta: Matrix3<f64>,
+    /// `θ_m`, its skew matrix and `C(θ_m)`.
     theta_m: Vector3<f64>,
+    theta: Matrix3<f64>,
+    c: Matrix3<f64>,
+    /// `I − ¼θ̂_m²` and `M = ½(Λ_m,ₙ + Λ_m,ₙ₊₁)`: the lever's factors.
+    squeeze: Matrix3<f64>,
+    mid: Matrix3<f64>,
     /// `θ_R = cay⁻¹(Λ_R,ₙ₊₁Λ_R,ₙᵀ)` and `θ_r = Λ_m,ₙ θ_R`.
     theta_rel: Vector3<f64>,
     theta_r: Vector3<f64>,
@@ -219,12 +223,16 @@ impl StepEnds {
         let theta_m = cayley_inverse(&mmt(r1, r0));
         let theta_rel = cayley_inverse(&mmt(&l1, &l0));
         let theta_r = r0 * theta_rel;
+        let theta = skew(&theta_m);
         Self {
             r0: *r0,
             r1: *r1,
             y: r1 * rr1,
-            theta: skew(&theta_m),
             theta_m,
+            theta,
+            c: cayley_tangent_inverse(&theta_m),
+            squeeze: Matrix3::identity() - theta * theta * 0.25,
+            mid: (r0 + r1) * 0.5,
             theta_rel,
             theta_r,
             s: 1.0 - 0.25 * theta_m.dot(&theta_r),
@@ -235,14 +243,12 @@ impl StepEnds {
     fn spin_lane(&self, value: &JointStep, i: usize) -> JointStep {
         let (t, theta) = (&self.theta, &self.theta_m);
         let e = Vector3::ith(i, 1.0);
-        let dt = cayley_tangent_inverse(theta).column(i).into_owned();
+        let dt = self.c.column(i).into_owned();
         let dth = skew(&dt);
         let dp = dth * 0.5 + (dt * theta.transpose() + theta * dt.transpose()) * 0.25;
-        let squeeze = Matrix3::identity() - t * t * 0.25;
-        let mid = (self.r0 + self.r1) * 0.5;
         JointStep {
             offset: e.cross(&self.y) * 0.5,
-            lever: -(dth * t + t * dth) * mid * 0.25 + squeeze * skew(&e) * self.r1 * 0.5,
+            lever: -(dth * t + t * dth) * self.mid * 0.25 + self.squeeze * skew(&e) * self.r1 * 0.5,
             a: (dp * self.r0 + value.a * (0.25 * dt.dot(&self.theta_r))) / self.s,
             b: SMatrix::zeros(),
         }
