@@ -42,6 +42,10 @@ pub struct BeamElement<const N: usize> {
     pub lambda0: [Matrix3<f64>; N],
     /// Strains of the initial configuration at the Gauss points (first `N − 1` used).
     strain0: [Strains<f64>; 2],
+    /// For `N = 2`, the same strains through the invariant coordinates
+    /// ([`BeamElement::energy_linear`]'s formula, so that its energy is
+    /// exactly zero in the initial configuration); zero otherwise.
+    linear0: Strains<f64>,
 }
 
 /// The two middle nodes `(I, J)` that define the reference rotation.
@@ -67,8 +71,17 @@ impl<const N: usize> BeamElement<N> {
             length,
             lambda0,
             strain0: [(Vector3::zeros(), Vector3::zeros()); 2],
+            linear0: (Vector3::zeros(), Vector3::zeros()),
         };
         element.strain0 = element.total_strains(x0, &[Matrix3::identity(); N]);
+        if N == 2 {
+            let lam = element.triads(&[Matrix3::identity(); N]);
+            element.linear0 = crate::element_linear::invariant_strains(
+                (&lam[0], &lam[1]),
+                &(x0[N - 1] - x0[0]),
+                length,
+            );
+        }
         element
     }
 
@@ -82,12 +95,22 @@ impl<const N: usize> BeamElement<N> {
             s0.0 -= d.0;
             s0.1 -= d.1;
         }
+        if let (2, Some(d)) = (N, delta.first()) {
+            e.linear0.0 -= d.0;
+            e.linear0.1 -= d.1;
+        }
         e
     }
 
     /// Strains of the initial configuration at the Gauss points.
     pub fn initial_strains(&self) -> &[Strains<f64>] {
         &self.strain0[..N - 1]
+    }
+
+    /// [`Self::linear0`]: a 2-node element's initial strains through its
+    /// invariant coordinates.
+    pub(crate) fn initial_invariant_strains(&self) -> Strains<f64> {
+        self.linear0
     }
 
     /// Nodal triads `Λᵢ = Rᵢ Λ₀ᵢ` (public form of the kernels' helper).

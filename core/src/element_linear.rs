@@ -34,12 +34,44 @@
 //! equal to the hyper-dual Hessian of the element energy
 //! ([`BeamElement::residual_tangent_ad`], the oracle) to round-off.
 
-use crate::element::BeamElement;
-use crate::rotation::{log, tangent_inverse};
+use crate::element::{BeamElement, Strains};
+use crate::rotation::{exp, log, tangent_inverse};
 use crate::rotation_derivatives::{exp_transpose_first, tangent_inverse_transpose_derivative};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
+/// The total strains `(Γ, K) = (exp(½φ̂)ᵀΛ₁ᵀd/L, φ/L)`, `φ = log(Λ₁ᵀΛ₂)`,
+/// of a 2-node element with nodal triads `lam`, chord `d = x₂ − x₁` and
+/// length `l` (module docs).
+pub(crate) fn invariant_strains(
+    lam: (&Matrix3<f64>, &Matrix3<f64>),
+    d: &Vector3<f64>,
+    l: f64,
+) -> Strains<f64> {
+    let lt = lam.0.transpose();
+    let phi = log(&(lt * lam.1));
+    (exp(&(phi * 0.5)).transpose() * (lt * d) / l, phi / l)
+}
+
 impl BeamElement<2> {
+    /// Strain energy through the invariant coordinates (module docs):
+    /// `E = ½L (Γ·C_N Γ + K·C_M K)` with `Γ = exp(½φ̂)ᵀ a/L − Γ₀`,
+    /// `K = φ/L − K₀` (`Γ₀`, `K₀` of the initial configuration by the same
+    /// formula, so that `E` is exactly zero there) — one logarithm and one exponential, where
+    /// [`BeamElement::energy`]'s interpolation takes three logarithms and two
+    /// exponentials (the nodes' rotation vectors relative to the mid triad
+    /// are `∓½φ`, which it computes). Equal to it to round-off; the
+    /// records' strain energy (the conserving schemes' energy equations
+    /// keep [`BeamElement::energy`], which their derivatives are of).
+    pub fn energy_linear(&self, x: &[Vector3<f64>; 2], rot: &[Matrix3<f64>; 2]) -> f64 {
+        let lam = self.nodal_triads(rot);
+        let (total, initial) = (
+            invariant_strains((&lam[0], &lam[1]), &(x[1] - x[0]), self.length),
+            self.initial_invariant_strains(),
+        );
+        let (gam, kap) = (total.0 - initial.0, total.1 - initial.1);
+        let (cn, cm) = (self.section.c_n, self.section.c_m);
+        0.5 * self.length * (gam.component_mul(&cn).dot(&gam) + kap.component_mul(&cm).dot(&kap))
+    }
     /// Residual and consistent tangent of the 2-node element (module docs);
     /// equal to [`BeamElement::residual_tangent_ad`].
     pub fn residual_tangent_linear(

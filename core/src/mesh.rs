@@ -144,25 +144,44 @@ impl Element {
         }
     }
 
+    /// Strain energy in a global configuration as the step records give it:
+    /// [`Element::energy`], for a 2-node element by its invariant
+    /// coordinates ([`BeamElement::energy_linear`], equal to round-off).
+    pub fn recorded_energy(&self, x: &[Vector3<f64>], rot: &[Matrix3<f64>]) -> f64 {
+        match self {
+            Element::Linear(e) => {
+                let (xe, re) = gather(&e.nodes, x, rot);
+                e.energy_linear(&xe, &re)
+            }
+            Element::Quadratic(_) => self.energy(x, rot),
+        }
+    }
+
     /// The rotation vectors between the element's nodal triads that its
     /// interpolation takes principal logarithms of: `log(Λ₁ᵀΛ₂)` (2-node), or
     /// `log(Λ_rᵀΛᵢ)` of the end nodes relative to the middle one (3-node). A
     /// logarithm is principal (`|·| ≤ π`): past π it wraps silently, so the
     /// solvers watch these ([`Element::ROTATION_LIMIT`]).
-    pub fn relative_rotations(&self, rot: &[Matrix3<f64>]) -> Vec<Vector3<f64>> {
+    pub fn relative_rotations(&self, rot: &[Matrix3<f64>]) -> RelativeRotations {
         match self {
             Element::Linear(e) => {
                 let (_, r) = gather(&e.nodes, &[], rot);
                 let l = e.nodal_triads(&r);
-                vec![log(&(l[0].transpose() * l[1]))]
+                RelativeRotations {
+                    values: [log(&(l[0].transpose() * l[1])), Vector3::zeros()],
+                    len: 1,
+                }
             }
             Element::Quadratic(e) => {
                 let (_, r) = gather(&e.nodes, &[], rot);
                 let l = e.nodal_triads(&r);
-                vec![
-                    log(&(l[1].transpose() * l[0])),
-                    log(&(l[1].transpose() * l[2])),
-                ]
+                RelativeRotations {
+                    values: [
+                        log(&(l[1].transpose() * l[0])),
+                        log(&(l[1].transpose() * l[2])),
+                    ],
+                    len: 2,
+                }
             }
         }
     }
@@ -345,6 +364,23 @@ pub(crate) fn gather<const N: usize>(
         std::array::from_fn(|i| x.get(nodes[i]).copied().unwrap_or_default()),
         std::array::from_fn(|i| rot[nodes[i]]),
     )
+}
+
+/// An element's relative rotations ([`Element::relative_rotations`]): one
+/// for a 2-node element, two for a 3-node one, as a slice (no allocation:
+/// the solvers check them after every step).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RelativeRotations {
+    values: [Vector3<f64>; 2],
+    len: usize,
+}
+
+impl std::ops::Deref for RelativeRotations {
+    type Target = [Vector3<f64>];
+
+    fn deref(&self) -> &[Vector3<f64>] {
+        &self.values[..self.len]
+    }
 }
 
 /// Nodes and elements of a mechanism's beams.

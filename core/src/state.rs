@@ -4,12 +4,28 @@ use crate::rotation::{exp, matrix_from_quaternion, quaternion_from_matrix};
 use nalgebra::{Matrix3, Vector3, Vector4};
 
 /// Positions `xᵢ` and rotations `Rᵢ` (from the initial configuration) of every node.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct Configuration {
     /// Nodal positions.
     pub x: Vec<Vector3<f64>>,
     /// Nodal rotations from the initial triads (`Λᵢ = Rᵢ Λᵢ,₀`).
     pub rot: Vec<Matrix3<f64>>,
+}
+
+impl Clone for Configuration {
+    fn clone(&self) -> Self {
+        Self {
+            x: self.x.clone(),
+            rot: self.rot.clone(),
+        }
+    }
+
+    /// Into the storage already there (the solvers save every step's start
+    /// this way).
+    fn clone_from(&mut self, source: &Self) {
+        self.x.clone_from(&source.x);
+        self.rot.clone_from(&source.rot);
+    }
 }
 
 impl Configuration {

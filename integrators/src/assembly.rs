@@ -56,16 +56,15 @@ fn direct_pairs(el: &Element, dofs: &DofMap, eqs: &[usize]) -> Option<Vec<(usize
 }
 
 /// Every element's slots (its sorted, unique equations; positions still to
-/// be found), its direct pairs ([`direct_pairs`]) and its buffers, with its
-/// equation pairs added to the pattern's columns `cols`.
+/// be found) and its direct pairs ([`direct_pairs`]), with its equation
+/// pairs added to the pattern's columns `cols`.
 fn element_slots(
     mesh: &Mesh,
     dofs: &DofMap,
     cols: &mut [Vec<usize>],
-) -> (Vec<Slots>, Vec<DirectPairs>, Vec<Work>) {
+) -> (Vec<Slots>, Vec<DirectPairs>) {
     let mut slots = Vec::with_capacity(mesh.elements.len());
     let mut direct = Vec::with_capacity(mesh.elements.len());
-    let mut work = Vec::with_capacity(mesh.elements.len());
     for el in &mesh.elements {
         let mut eqs: Vec<usize> = el
             .nodes()
@@ -77,7 +76,6 @@ fn element_slots(
         for &j in &eqs {
             cols[j].extend(eqs.iter().copied());
         }
-        work.push(Work::new(el.dofs(), eqs.len()));
         direct.push(direct_pairs(el, dofs, &eqs));
         slots.push(Slots {
             eqs,
@@ -85,7 +83,7 @@ fn element_slots(
             direct: None,
         });
     }
-    (slots, direct, work)
+    (slots, direct)
 }
 
 /// The slots of the extra dense blocks over the equation lists `blocks`
@@ -121,16 +119,21 @@ fn compressed_columns(cols: &mut [Vec<usize>]) -> (Vec<usize>, Vec<usize>) {
 }
 
 /// The positions in the CSC value array of the pattern `(col_ptr, row_idx)`
-/// of every pair `(eqs[i], eqs[j])`, column-major `j·m + i` ([`Slots::pos`]).
+/// of every pair `(eqs[i], eqs[j])`, column-major `j·m + i` ([`Slots::pos`]):
+/// `eqs` and each column's rows are sorted, so one walk down the column
+/// finds them all.
 fn value_positions(eqs: &[usize], col_ptr: &[usize], row_idx: &[usize]) -> Vec<usize> {
     let m = eqs.len();
     let mut pos = Vec::with_capacity(m * m);
     for &cj in eqs {
         let rows = &row_idx[col_ptr[cj]..col_ptr[cj + 1]];
+        let mut p = 0;
         for &ri in eqs {
-            let p = rows
-                .binary_search(&ri)
-                .expect("pattern contains every element pair");
+            p += rows[p..].partition_point(|&r| r < ri);
+            assert!(
+                rows.get(p) == Some(&ri),
+                "pattern contains every element pair"
+            );
             pos.push(col_ptr[cj] + p);
         }
     }
@@ -192,6 +195,9 @@ pub struct Assembler {
     slots: Vec<Slots>,
     /// Extra dense blocks (joints' configuration-dependent terms).
     blocks: Vec<Slots>,
+    /// Every element's own buffers, made when first needed
+    /// ([`Self::own_work`]): by an element a joint touches (its tangent is
+    /// reduced through the node maps) and by the split loop.
     work: Vec<Work>,
     /// One buffer per element kind (its number of unknowns) for the
     /// one-thread path, which sums each element as soon as it is evaluated.
@@ -223,7 +229,7 @@ impl Assembler {
         for (e, c) in cols.iter_mut().enumerate() {
             c.push(e);
         }
-        let (mut slots, direct, work) = element_slots(mesh, dofs, &mut cols);
+        let (mut slots, direct) = element_slots(mesh, dofs, &mut cols);
         let mut extra = block_slots(blocks, &mut cols);
         let (col_ptr, row_idx) = compressed_columns(&mut cols);
         for s in slots.iter_mut().chain(extra.iter_mut()) {
@@ -240,7 +246,7 @@ impl Assembler {
             pattern,
             slots,
             blocks: extra,
-            work,
+            work: Vec::new(),
             scratch: kind_scratch(mesh),
             split: None,
             chunk_scratch: Vec::new(),
@@ -284,6 +290,9 @@ impl Assembler {
             // from a buffer that stays in cache (the same sums in the same
             // order as below).
             let start = self.tangent_cost.probing(n).then(Instant::now);
+            if self.slots.iter().any(|s| s.direct.is_none()) {
+                self.own_work(mesh);
+            }
             self.clear();
             for (index, (el, s)) in mesh.elements.iter().zip(&self.slots).enumerate() {
                 let w = match &s.direct {
@@ -360,8 +369,18 @@ impl Assembler {
         }
     }
 
+    /// Makes every element's own buffers ([`Self::work`]) if they are not.
+    fn own_work(&mut self, mesh: &Mesh) {
+        if self.work.is_empty() {
+            self.work = (mesh.elements.iter().zip(&self.slots))
+                .map(|(el, s)| Work::new(el.dofs(), s.eqs.len()))
+                .collect();
+        }
+    }
+
     /// Makes [`Self::split`] for the current thread count if it is not.
     fn split_for(&mut self, mesh: &Mesh) {
+        self.own_work(mesh);
         let threads = rayon::current_num_threads();
         if self.split.as_ref().is_some_and(|s| s.is_for(threads)) {
             return;

@@ -19,7 +19,7 @@ use smallvec::SmallVec;
 
 /// Positions and rotations of every node and the released coordinates of
 /// every joint: the complete state of a mechanism.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct MechanismState {
     /// Nodal positions and rotations.
     pub config: Configuration,
@@ -28,6 +28,24 @@ pub struct MechanismState {
     /// Current value of every prescribed nodal DOF (same order as
     /// [`Mechanism::prescribed`]).
     pub prescribed: Vec<f64>,
+}
+
+impl Clone for MechanismState {
+    fn clone(&self) -> Self {
+        Self {
+            config: self.config.clone(),
+            released: self.released.clone(),
+            prescribed: self.prescribed.clone(),
+        }
+    }
+
+    /// Into the storage already there (every step's start and every retry
+    /// are saved and restored this way).
+    fn clone_from(&mut self, source: &Self) {
+        self.config.clone_from(&source.config);
+        self.released.clone_from(&source.released);
+        self.prescribed.clone_from(&source.prescribed);
+    }
 }
 
 /// How slaves' residuals fold into their masters'.

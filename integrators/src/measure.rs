@@ -10,11 +10,12 @@ use crate::threads::map_each;
 use flexmech_core::{Configuration, Inertia};
 use nalgebra::Vector3;
 
-/// Strain energy of the whole mesh (element energies summed in element order).
+/// Strain energy of the whole mesh (element energies summed in element
+/// order, each [`flexmech_core::Element::recorded_energy`]).
 pub fn strain_energy(mech: &Mechanism, config: &Configuration) -> f64 {
     let elements = &mech.mesh.elements;
     let per = map_each(elements.len(), |e| {
-        elements[e].energy(&config.x, &config.rot)
+        elements[e].recorded_energy(&config.x, &config.rot)
     });
     per.iter().sum::<f64>()
 }

@@ -17,8 +17,8 @@
 use crate::constraints::MechanismState;
 use crate::error::{NewtonFailure, SolveError};
 use crate::mechanism::Mechanism;
+use flexmech_core::mesh::RelativeRotations;
 use flexmech_core::{Configuration, Element};
-use nalgebra::Vector3;
 
 /// Whether a smaller step cures the guard's objection (a change too large
 /// for one step, not a rotation beyond the limit): the solvers then retry
@@ -43,7 +43,7 @@ pub(crate) fn as_step_failure(error: SolveError) -> Result<NewtonFailure, SolveE
 /// The relative rotations of the last accepted state.
 #[derive(Debug, Clone)]
 pub(crate) struct RotationGuard {
-    previous: Vec<Vec<Vector3<f64>>>,
+    previous: Vec<RelativeRotations>,
     prescribed: Vec<f64>,
 }
 
@@ -80,7 +80,7 @@ impl RotationGuard {
         }
         let now = rotations(mech, &state.config);
         for (element, (a, b)) in now.iter().zip(&self.previous).enumerate() {
-            for (phi, before) in a.iter().zip(b) {
+            for (phi, before) in a.iter().zip(b.iter()) {
                 let (angle, change) = (phi.norm(), (phi - before).norm());
                 if angle > Element::ROTATION_LIMIT || change > Element::ROTATION_STEP_LIMIT {
                     return Err(SolveError::ElementRotation {
@@ -99,7 +99,7 @@ impl RotationGuard {
     }
 }
 
-fn rotations(mech: &Mechanism, config: &Configuration) -> Vec<Vec<Vector3<f64>>> {
+fn rotations(mech: &Mechanism, config: &Configuration) -> Vec<RelativeRotations> {
     let elements = &mech.mesh.elements;
     // Each element's on its own: on two threads for a large mesh.
     crate::threads::map_nodes(elements.len(), |e| {

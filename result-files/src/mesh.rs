@@ -30,10 +30,11 @@ pub(crate) fn write(file: &File, mesh: &MeshMeta, initial: &[[f64; 3]]) -> hdf5:
             .iter()
             .map(|s| s.parse().unwrap_or_default())
             .collect();
-        file.new_dataset::<VarLenUnicode>()
+        let set = file
+            .new_dataset::<VarLenUnicode>()
             .shape([v.len()])
-            .create(name)?
-            .write_raw(&v)
+            .create(name)?;
+        write_strings(&set, &v)
     };
     let lists = |nodes: &str, offsets: &str, lists: &[&[usize]]| -> hdf5::Result<()> {
         let flat: Vec<u64> = lists
@@ -83,6 +84,49 @@ pub(crate) fn write(file: &File, mesh: &MeshMeta, initial: &[[f64; 3]]) -> hdf5:
             .write_raw(&flat)?;
     }
     Ok(())
+}
+
+/// Bytes of conversion buffer per string: the larger of the file's and
+/// memory's size of one variable-length string (16 and 8), with room.
+const STRING_CONVERSION_BYTES: usize = 32;
+
+/// Writes the variable-length strings `v` into the whole of `set`, as
+/// `write_raw` does, but with the conversion buffers sized to them.
+/// Strings always take HDF5's type conversion, whose buffers are otherwise
+/// its default 1 MiB each, allocated zeroed for every write: two such
+/// writes were a tenth of a small model's whole run.
+fn write_strings(set: &hdf5::Dataset, v: &[VarLenUnicode]) -> hdf5::Result<()> {
+    use hdf5_sys::{h5d, h5p, h5s};
+    let memory = hdf5::Datatype::from_type::<VarLenUnicode>()?;
+    let bytes = STRING_CONVERSION_BYTES * v.len().max(1);
+    hdf5::sync::sync(|| {
+        // SAFETY: under the library's lock (`sync`), with ids that live
+        // through the calls; `v` holds `set`'s number of strings in the
+        // memory type `memory` describes; the property list is closed
+        // whatever happens.
+        unsafe {
+            let xfer = h5p::H5Pcreate(*h5p::H5P_CLS_DATASET_XFER);
+            if xfer < 0 {
+                return Err("creating a transfer property list failed".into());
+            }
+            let written =
+                h5p::H5Pset_buffer(xfer, bytes, std::ptr::null_mut(), std::ptr::null_mut()) >= 0
+                    && h5d::H5Dwrite(
+                        set.id(),
+                        memory.id(),
+                        h5s::H5S_ALL,
+                        h5s::H5S_ALL,
+                        xfer,
+                        v.as_ptr().cast(),
+                    ) >= 0;
+            h5p::H5Pclose(xfer);
+            if written {
+                Ok(())
+            } else {
+                Err("writing strings failed".into())
+            }
+        }
+    })
 }
 
 /// The current UTC time as `YYYY-MM-DDThh:mm:ssZ`.
