@@ -1028,8 +1028,13 @@ const MIDPOINT_SCHEMES: [&str; 2] = ["momentum", "energy-momentum"];
 /// The paper's scheme accepts its energy equation at that equation's
 /// round-off floor, so its runs carry ~1e-12 of solution noise that central
 /// differences of step 1e-4 amplify to ~1e-5 of the derivative late in the
-/// spin-up (the gap scales as 1/h: 4e-8 at 1e-5, 1e-10 at 1e-3); step 1e-3
-/// keeps both that and the O(h²) truncation below 1e-6.
+/// spin-up (the gap scales as 1/h: 4e-8 at 1e-5, 1e-10 at 1e-3). The
+/// spin-up's energy derivative is the tightest: its mismatch measured
+/// 3.9e-4, 6.8e-5, 7.6e-5 and 1.3e-4 at steps 5e-4, 1e-3, 2e-3 and 4e-3
+/// (noise falling as 1/h meets the truncation growing as h² near 1e-3), so
+/// [`AGREE_DYNAMICS`] has little room there: a change of round-off alone
+/// (the band solve multiplying by its pivots' reciprocals instead of
+/// dividing) took it to 1.25e-4 and was not kept.
 const PAPER_STEP: f64 = 1e-3;
 
 // The bordered step on (q, β): dβ/dp from the energy equation's row (eq. 18)

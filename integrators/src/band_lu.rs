@@ -322,10 +322,7 @@ impl BandLu {
             let diagonal = column[kv].abs() * d[c];
             let below = &column[kv + 1..=kv + km];
             let scales = &d[c + 1..=c + km];
-            let largest = below
-                .iter()
-                .zip(scales)
-                .fold(0.0f64, |m, (a, di)| m.max(a.abs() * di));
+            let largest = largest_scaled(below, scales);
             let mut jp = 0;
             let mut best = diagonal;
             if diagonal < PIVOT_THRESHOLD * largest {
@@ -512,6 +509,25 @@ fn eliminate_fixed<const KL: usize, const KU: usize, const W: usize>(
         }
     }
     true
+}
+
+/// The largest `|aᵢ| dᵢ` (0 for none; a NaN counts as nothing, as in
+/// `f64::max`), in four running maxima: a column's pivot waited on one
+/// chain of comparisons. The maximum of the same numbers in any order is
+/// the same number.
+fn largest_scaled(a: &[f64], d: &[f64]) -> f64 {
+    let bigger = |m: f64, v: f64| if v > m { v } else { m };
+    let mut lanes = [0.0f64; 4];
+    for (ac, dc) in a.chunks_exact(4).zip(d.chunks_exact(4)) {
+        for k in 0..4 {
+            lanes[k] = bigger(lanes[k], ac[k].abs() * dc[k]);
+        }
+    }
+    let tail = a.len() - a.len() % 4;
+    for (&x, &s) in a[tail..].iter().zip(&d[tail..]) {
+        lanes[0] = bigger(lanes[0], x.abs() * s);
+    }
+    bigger(bigger(lanes[0], lanes[1]), bigger(lanes[2], lanes[3]))
 }
 
 /// `t ← t − u l`.
