@@ -199,6 +199,9 @@ pub struct Assembler {
     /// ([`Self::own_work`]): by an element a joint touches (its tangent is
     /// reduced through the node maps) and by the split loop.
     work: Vec<Work>,
+    /// Whether a joint touches some element (its tangent is reduced
+    /// through the node maps, in its own buffers).
+    any_reduced: bool,
     /// One buffer per element kind (its number of unknowns) for the
     /// one-thread path, which sums each element as soon as it is evaluated.
     scratch: Vec<Work>,
@@ -247,6 +250,7 @@ impl Assembler {
             slots,
             blocks: extra,
             work: Vec::new(),
+            any_reduced: direct.iter().any(Option::is_none),
             scratch: kind_scratch(mesh),
             split: None,
             chunk_scratch: Vec::new(),
@@ -290,7 +294,7 @@ impl Assembler {
             // from a buffer that stays in cache (the same sums in the same
             // order as below).
             let start = self.tangent_cost.probing(n).then(Instant::now);
-            if self.slots.iter().any(|s| s.direct.is_none()) {
+            if self.any_reduced {
                 self.own_work(mesh);
             }
             self.clear();
