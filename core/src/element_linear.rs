@@ -47,9 +47,22 @@ pub(crate) fn invariant_strains(
     d: &Vector3<f64>,
     l: f64,
 ) -> Strains<f64> {
-    let lt = lam.0.transpose();
-    let phi = log(&(lt * lam.1));
-    (exp(&(phi * 0.5)).transpose() * (lt * d) / l, phi / l)
+    let phi = log(&(lam.0.transpose() * lam.1));
+    invariant_strains_with(&phi, lam.0, d, l)
+}
+
+/// [`invariant_strains`] with `φ = log(Λ₁ᵀΛ₂)` given (the relative rotation
+/// the solvers' rotation guard has just computed, the same bits).
+fn invariant_strains_with(
+    phi: &Vector3<f64>,
+    lam1: &Matrix3<f64>,
+    d: &Vector3<f64>,
+    l: f64,
+) -> Strains<f64> {
+    (
+        exp(&(phi * 0.5)).transpose() * (lam1.transpose() * d) / l,
+        phi / l,
+    )
 }
 
 impl BeamElement<2> {
@@ -64,14 +77,33 @@ impl BeamElement<2> {
     /// keep [`BeamElement::energy`], which their derivatives are of).
     pub fn energy_linear(&self, x: &[Vector3<f64>; 2], rot: &[Matrix3<f64>; 2]) -> f64 {
         let lam = self.nodal_triads(rot);
-        let (total, initial) = (
-            invariant_strains((&lam[0], &lam[1]), &(x[1] - x[0]), self.length),
-            self.initial_invariant_strains(),
-        );
+        let total = invariant_strains((&lam[0], &lam[1]), &(x[1] - x[0]), self.length);
+        self.energy_of_strains(total)
+    }
+
+    /// [`Self::energy_linear`] with the relative rotation `φ = log(Λ₁ᵀΛ₂)`
+    /// given ([`crate::Element::relative_rotations`] at the same
+    /// configuration): the same value to the bit, one logarithm fewer.
+    pub fn energy_linear_with(
+        &self,
+        phi: &Vector3<f64>,
+        x: &[Vector3<f64>; 2],
+        rot: &[Matrix3<f64>; 2],
+    ) -> f64 {
+        let lam = self.nodal_triads(rot);
+        let total = invariant_strains_with(phi, &lam[0], &(x[1] - x[0]), self.length);
+        self.energy_of_strains(total)
+    }
+
+    /// `½L (Γ·C_N Γ + K·C_M K)` of the total strains `total` less the
+    /// initial ones.
+    fn energy_of_strains(&self, total: Strains<f64>) -> f64 {
+        let initial = self.initial_invariant_strains();
         let (gam, kap) = (total.0 - initial.0, total.1 - initial.1);
         let (cn, cm) = (self.section.c_n, self.section.c_m);
         0.5 * self.length * (gam.component_mul(&cn).dot(&gam) + kap.component_mul(&cm).dot(&kap))
     }
+
     /// Residual and consistent tangent of the 2-node element (module docs);
     /// equal to [`BeamElement::residual_tangent_ad`].
     pub fn residual_tangent_linear(

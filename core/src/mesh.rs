@@ -157,6 +157,25 @@ impl Element {
         }
     }
 
+    /// [`Element::recorded_energy`] given the element's
+    /// [`Element::relative_rotations`] in the same configuration (as the
+    /// solvers' rotation guard has them after a step): the same value to the
+    /// bit, without computing a 2-node element's relative rotation again.
+    pub fn recorded_energy_with(
+        &self,
+        relative: &RelativeRotations,
+        x: &[Vector3<f64>],
+        rot: &[Matrix3<f64>],
+    ) -> f64 {
+        match self {
+            Element::Linear(e) => {
+                let (xe, re) = gather(&e.nodes, x, rot);
+                e.energy_linear_with(&relative.values[0], &xe, &re)
+            }
+            Element::Quadratic(_) => self.energy(x, rot),
+        }
+    }
+
     /// The rotation vectors between the element's nodal triads that its
     /// interpolation takes principal logarithms of: `log(Λ₁ᵀΛ₂)` (2-node), or
     /// `log(Λ_rᵀΛᵢ)` of the end nodes relative to the middle one (3-node). A

@@ -33,6 +33,7 @@
 use faer::sparse::SymbolicSparseColMat;
 use std::collections::VecDeque;
 
+use crate::band_solve::{backward_window, forward_window};
 use crate::tolerances::TOLERANCES;
 
 /// A column keeps its diagonal pivot while `|bⱼⱼ| ≥ τ maxᵢ |bᵢⱼ|` on the
@@ -43,21 +44,27 @@ pub const PIVOT_THRESHOLD: f64 = TOLERANCES.pivot_threshold;
 /// `diag`: `dᵢ = |aᵢᵢ|^-½`, the mean diagonal standing in for a zero (or
 /// non-finite) one, and `1` where the whole diagonal vanishes.
 pub fn equilibrating_scale(diag: &[f64]) -> Vec<f64> {
-    let finite = diag.iter().filter(|a| a.is_finite());
+    let mut scale = diag.to_vec();
+    equilibrate_in_place(&mut scale);
+    scale
+}
+
+/// [`equilibrating_scale`] in place: the diagonal given in `v` becomes its
+/// scale (no allocation: a band factorisation takes it every time).
+fn equilibrate_in_place(v: &mut [f64]) {
+    let finite = v.iter().filter(|a| a.is_finite());
     let (sum, count) = finite.fold((0.0, 0usize), |(s, c), &a| (s + a.abs(), c + 1));
     let mean = if count > 0 { sum / count as f64 } else { 0.0 };
-    diag.iter()
-        .map(|&a| {
-            let a = a.abs();
-            if a > 0.0 && a.is_finite() {
-                1.0 / a.sqrt()
-            } else if mean > 0.0 && mean.is_finite() {
-                1.0 / mean.sqrt()
-            } else {
-                1.0
-            }
-        })
-        .collect()
+    for x in v.iter_mut() {
+        let a = x.abs();
+        *x = if a > 0.0 && a.is_finite() {
+            1.0 / a.sqrt()
+        } else if mean > 0.0 && mean.is_finite() {
+            1.0 / mean.sqrt()
+        } else {
+            1.0
+        };
+    }
 }
 
 /// The renumbering and band structure of a square pattern.
@@ -246,12 +253,14 @@ impl BandLu {
 
     /// The equilibrating scale of the rows of `A` (renumbered).
     fn scale_rows(&mut self, values: &[f64]) {
-        let diag: Vec<f64> = self
-            .diagonal
-            .iter()
-            .map(|k| k.map_or(0.0, |k| values[k]))
-            .collect();
-        for (&p, d) in self.band.perm.iter().zip(equilibrating_scale(&diag)) {
+        // The diagonal, then its scale, in the original numbering in
+        // `col_scale` (as scratch).
+        let scale = &mut self.col_scale;
+        for (v, k) in scale.iter_mut().zip(&self.diagonal) {
+            *v = k.map_or(0.0, |k| values[k]);
+        }
+        equilibrate_in_place(scale);
+        for (&p, &d) in self.band.perm.iter().zip(scale.iter()) {
             self.row_scale[p] = d;
         }
         self.col_scale.copy_from_slice(&self.row_scale);
@@ -391,7 +400,11 @@ impl BandLu {
     pub(crate) fn forward(&self, b: &mut [f64], from: usize) {
         let n = self.piv.len();
         let (kl, kv, ld) = (self.band.kl, self.band.kl + self.band.ku, self.ld);
-        for j in from..n {
+        // Without interchanges, the columns with a full band in registers.
+        let to = n.saturating_sub(kl).max(from);
+        let windowed =
+            self.u_width == self.band.ku && forward_window((kl, kv, ld), &self.ab, b, (from, to));
+        for j in if windowed { to } else { from }..n {
             let l = self.piv[j];
             if l != j {
                 b.swap(l, j);
@@ -406,8 +419,12 @@ impl BandLu {
     /// `b ← U⁻¹ b` in the renumbered unknowns: upper bandwidth `ku` plus the
     /// farthest interchange (≤ `kl + ku`).
     pub(crate) fn backward(&self, b: &mut [f64]) {
-        let (kv, ld) = (self.band.kl + self.band.ku, self.ld);
-        for j in (0..self.piv.len()).rev() {
+        let (ku, kv, ld) = (self.band.ku, self.band.kl + self.band.ku, self.ld);
+        let n = self.piv.len();
+        // Without interchanges, the columns with a full band in registers.
+        let to = ku.min(n);
+        let windowed = self.u_width == ku && backward_window((ku, kv, ld), &self.ab, b, (to, n));
+        for j in (0..if windowed { to } else { n }).rev() {
             let col = j * ld + kv;
             b[j] /= self.ab[col];
             let bj = b[j];

@@ -7,6 +7,7 @@
 pub mod arc_length;
 pub mod assembly;
 pub mod band_lu;
+mod band_solve;
 pub mod band_split;
 pub mod builder;
 pub mod constraints;

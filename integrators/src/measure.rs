@@ -7,15 +7,29 @@ use crate::mechanism::Mechanism;
 use crate::newton::NewtonReport;
 use crate::record::{Energies, StepRecord};
 use crate::threads::map_each;
+use flexmech_core::mesh::RelativeRotations;
 use flexmech_core::{Configuration, Inertia};
 use nalgebra::Vector3;
 
 /// Strain energy of the whole mesh (element energies summed in element
 /// order, each [`flexmech_core::Element::recorded_energy`]).
 pub fn strain_energy(mech: &Mechanism, config: &Configuration) -> f64 {
+    strain_energy_with(mech, config, None)
+}
+
+/// [`strain_energy`] given each element's relative rotations in `config`
+/// (`relative`, as the solvers' rotation guard keeps them for the state it
+/// has accepted; [`flexmech_core::Element::recorded_energy_with`]): the same
+/// sum to the bit, one logarithm per 2-node element fewer.
+pub fn strain_energy_with(
+    mech: &Mechanism,
+    config: &Configuration,
+    relative: Option<&[RelativeRotations]>,
+) -> f64 {
     let elements = &mech.mesh.elements;
-    let per = map_each(elements.len(), |e| {
-        elements[e].recorded_energy(&config.x, &config.rot)
+    let per = map_each(elements.len(), |e| match relative {
+        Some(relative) => elements[e].recorded_energy_with(&relative[e], &config.x, &config.rot),
+        None => elements[e].recorded_energy(&config.x, &config.rot),
     });
     per.iter().sum::<f64>()
 }
@@ -76,8 +90,20 @@ pub fn static_record(
     dt: f64,
     report: Option<&NewtonReport>,
 ) -> StepRecord {
+    let strain = strain_energy(mech, &state.config);
+    record_with_strain(mech, state, strain, fext, (time, dt), report)
+}
+
+/// [`static_record`] with the strain energy given.
+fn record_with_strain(
+    mech: &Mechanism,
+    state: &MechanismState,
+    strain: f64,
+    fext: &[f64],
+    (time, dt): (f64, f64),
+    report: Option<&NewtonReport>,
+) -> StepRecord {
     let config = &state.config;
-    let strain = strain_energy(mech, config);
     let potential = load_potential(mech, config, fext);
     StepRecord {
         time,
@@ -110,7 +136,9 @@ pub fn static_record(
 }
 
 /// [`static_record`] with the kinetic energy and the linear and angular
-/// momenta of nodal velocities `v` (spatial) and `w` (body angular).
+/// momenta of nodal velocities `v` (spatial) and `w` (body angular), at
+/// `(time, dt)`; `relative`: the elements' relative rotations in the
+/// state where known ([`strain_energy_with`]).
 #[allow(clippy::too_many_arguments)]
 pub fn dynamic_record(
     mech: &Mechanism,
@@ -118,11 +146,12 @@ pub fn dynamic_record(
     state: &MechanismState,
     (v, w): (&[Vector3<f64>], &[Vector3<f64>]),
     fext: &[f64],
-    time: f64,
-    dt: f64,
+    (time, dt): (f64, f64),
+    relative: Option<&[RelativeRotations]>,
     report: Option<&NewtonReport>,
 ) -> StepRecord {
-    let mut rec = static_record(mech, state, fext, time, dt, report);
+    let strain = strain_energy_with(mech, &state.config, relative);
+    let mut rec = record_with_strain(mech, state, strain, fext, (time, dt), report);
     let config = &state.config;
     let kinetic = inertia.kinetic_energy(v, w);
     rec.energy.kinetic = kinetic;

@@ -56,6 +56,12 @@ impl RotationGuard {
         }
     }
 
+    /// The elements' relative rotations in the last accepted state (the
+    /// records' strain energy takes them, [`crate::measure::strain_energy_with`]).
+    pub(crate) fn accepted(&self) -> &[RelativeRotations] {
+        &self.previous
+    }
+
     /// Checks the converged state at `time` and accepts it.
     pub(crate) fn accept(
         &mut self,

@@ -37,6 +37,8 @@ pub(crate) struct Balance {
     load_work: f64,
     /// The previous step's node positions, orientations and loads.
     previous: Option<Snapshot>,
+    /// The loads' storage of the step before the previous, reused.
+    spare: Vec<f64>,
 }
 
 /// Node positions, orientations (quaternions) and nodal loads of a step.
@@ -54,7 +56,9 @@ impl Balance {
 
     /// Takes in a converged step of `mech`.
     pub(crate) fn push(&mut self, mech: &Mechanism, s: &StepRecord) {
-        let mut loads = vec![0.0; 6 * s.positions.len()];
+        let mut loads = std::mem::take(&mut self.spare);
+        loads.clear();
+        loads.resize(6 * s.positions.len(), 0.0);
         mech.external_forces(s.time, &mut loads);
         if !mech.follower_loads.is_empty() {
             let rot: Vec<_> = s
@@ -95,7 +99,15 @@ impl Balance {
                 self.scale = self.scale.max(v.abs());
             }
         }
-        self.previous = Some((s.positions.clone(), s.quaternions.clone(), loads));
+        // Into the storage the previous step's took (no allocation per step).
+        match &mut self.previous {
+            Some((x0, q0, f0)) => {
+                x0.clone_from(&s.positions);
+                q0.clone_from(&s.quaternions);
+                self.spare = std::mem::replace(f0, loads);
+            }
+            None => self.previous = Some((s.positions.clone(), s.quaternions.clone(), loads)),
+        }
     }
 
     /// The warning, when the balance is off by more than the threshold.

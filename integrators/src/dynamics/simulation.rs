@@ -394,8 +394,8 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
             &sys.end,
             sys.terms.velocities(),
             &self.fext_now,
-            self.t,
-            self.last_dt,
+            (self.t, self.last_dt),
+            Some(self.guard.accepted()),
             report,
         );
         rec.energy.driver_work = self.driver_work;
