@@ -121,7 +121,8 @@ fn compressed_columns(cols: &mut [Vec<usize>]) -> (Vec<usize>, Vec<usize>) {
 /// The positions in the CSC value array of the pattern `(col_ptr, row_idx)`
 /// of every pair `(eqs[i], eqs[j])`, column-major `j·m + i` ([`Slots::pos`]):
 /// `eqs` and each column's rows are sorted, so one walk down the column
-/// finds them all.
+/// finds them all (step by step: a column holds a few dozen rows, where a
+/// binary search for each of the element's rows cost more than the walk).
 fn value_positions(eqs: &[usize], col_ptr: &[usize], row_idx: &[usize]) -> Vec<usize> {
     let m = eqs.len();
     let mut pos = Vec::with_capacity(m * m);
@@ -129,7 +130,9 @@ fn value_positions(eqs: &[usize], col_ptr: &[usize], row_idx: &[usize]) -> Vec<u
         let rows = &row_idx[col_ptr[cj]..col_ptr[cj + 1]];
         let mut p = 0;
         for &ri in eqs {
-            p += rows[p..].partition_point(|&r| r < ri);
+            while rows.get(p).is_some_and(|&r| r < ri) {
+                p += 1;
+            }
             assert!(
                 rows.get(p) == Some(&ri),
                 "pattern contains every element pair"

@@ -84,25 +84,14 @@ impl BandStructure {
     /// degree.
     pub fn of(pattern: &SymbolicSparseColMat<usize>) -> Self {
         let n = pattern.nrows();
-        let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
-        let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
-        for j in 0..n {
-            for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
-                if i != j {
-                    adj[i].push(j);
-                    adj[j].push(i);
-                }
-            }
-        }
-        for a in adj.iter_mut() {
-            a.sort_unstable();
-            a.dedup();
-        }
-        let degree: Vec<usize> = adj.iter().map(Vec::len).collect();
+        let (adj_ptr, adj) = symmetric_adjacency(pattern);
+        let neighbours = |v: usize| &adj[adj_ptr[v]..adj_ptr[v + 1]];
+        let degree: Vec<usize> = (0..n).map(|v| neighbours(v).len()).collect();
         let mut order = Vec::with_capacity(n);
         let mut seen = vec![false; n];
         let mut by_degree: Vec<usize> = (0..n).collect();
         by_degree.sort_by_key(|&i| (degree[i], i));
+        let mut next = Vec::new();
         for &root in &by_degree {
             if seen[root] {
                 continue;
@@ -111,9 +100,10 @@ impl BandStructure {
             let mut queue = VecDeque::from([root]);
             while let Some(v) = queue.pop_front() {
                 order.push(v);
-                let mut next: Vec<usize> = adj[v].iter().copied().filter(|&w| !seen[w]).collect();
+                next.clear();
+                next.extend(neighbours(v).iter().copied().filter(|&w| !seen[w]));
                 next.sort_by_key(|&w| (degree[w], w));
-                for w in next {
+                for &w in &next {
                     seen[w] = true;
                     queue.push_back(w);
                 }
@@ -157,6 +147,58 @@ impl BandStructure {
     pub fn storage(&self) -> usize {
         (2 * self.kl + self.ku + 1) * self.perm.len()
     }
+}
+
+/// The neighbours of every unknown in the symmetric pattern `A + Aᵀ`
+/// (the diagonal left out), sorted and unique, as compressed rows: those of
+/// `v` at `adj[ptr[v]..ptr[v + 1]]` (in flat storage: a list per unknown
+/// was most of the renumbering's time).
+fn symmetric_adjacency(pattern: &SymbolicSparseColMat<usize>) -> (Vec<usize>, Vec<usize>) {
+    let n = pattern.nrows();
+    let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
+    // Aᵀ by columns: the columns of each row of A.
+    let mut t_ptr = vec![0usize; n + 1];
+    for &i in row_idx {
+        t_ptr[i + 1] += 1;
+    }
+    for v in 0..n {
+        t_ptr[v + 1] += t_ptr[v];
+    }
+    let mut fill = t_ptr.clone();
+    let mut t_idx = vec![0usize; row_idx.len()];
+    for j in 0..n {
+        for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+            t_idx[fill[i]] = j;
+            fill[i] += 1;
+        }
+    }
+    let mut ptr = Vec::with_capacity(n + 1);
+    let mut adj = Vec::with_capacity(2 * row_idx.len());
+    ptr.push(0);
+    for v in 0..n {
+        let start = adj.len();
+        let column = &row_idx[col_ptr[v]..col_ptr[v + 1]];
+        let row = &t_idx[t_ptr[v]..t_ptr[v + 1]];
+        adj.extend(column.iter().chain(row).copied().filter(|&w| w != v));
+        adj[start..].sort_unstable();
+        let unique = dedup_in_place(&mut adj[start..]);
+        adj.truncate(start + unique);
+        ptr.push(adj.len());
+    }
+    (ptr, adj)
+}
+
+/// Moves the distinct values of the sorted `v` to its front; returns their
+/// count.
+fn dedup_in_place(v: &mut [usize]) -> usize {
+    let mut k = 0;
+    for i in 0..v.len() {
+        if i == 0 || v[i] != v[k - 1] {
+            v[k] = v[i];
+            k += 1;
+        }
+    }
+    k
 }
 
 /// A band LU factorisation bound to one pattern.
@@ -597,6 +639,46 @@ pub(crate) mod tests {
         let row_idx = entries.iter().map(|e| e.0).collect();
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         (pattern, entries.iter().map(|e| e.2).collect())
+    }
+
+    /// `A + Aᵀ`'s neighbour lists built the plain way: a list per unknown.
+    fn adjacency_by_lists(pattern: &SymbolicSparseColMat<usize>) -> Vec<Vec<usize>> {
+        let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
+        let mut adj = vec![Vec::new(); pattern.nrows()];
+        for j in 0..pattern.nrows() {
+            for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                if i != j {
+                    adj[i].push(j);
+                    adj[j].push(i);
+                }
+            }
+        }
+        for a in adj.iter_mut() {
+            a.sort_unstable();
+            a.dedup();
+        }
+        adj
+    }
+
+    #[test]
+    fn the_flat_adjacency_is_the_symmetric_patterns() {
+        // An unsymmetric pattern (entries (i, j) by columns) and scrambled bands.
+        let columns: [&[usize]; 6] = [&[0, 1, 3], &[1, 2], &[2, 5], &[3], &[0, 4], &[4, 5]];
+        let mut col_ptr = vec![0];
+        let mut row_idx = Vec::new();
+        for c in columns {
+            row_idx.extend_from_slice(c);
+            col_ptr.push(row_idx.len());
+        }
+        let mut patterns = vec![SymbolicSparseColMat::new_checked(
+            6, 6, col_ptr, None, row_idx,
+        )];
+        patterns.extend([(40, 3, 1), (61, 6, 2)].map(|(n, w, seed)| scrambled(n, w, seed).0));
+        for pattern in &patterns {
+            let (ptr, adj) = symmetric_adjacency(pattern);
+            let flat: Vec<Vec<usize>> = ptr.windows(2).map(|w| adj[w[0]..w[1]].to_vec()).collect();
+            assert_eq!(flat, adjacency_by_lists(pattern));
+        }
     }
 
     #[test]
