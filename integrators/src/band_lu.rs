@@ -241,6 +241,10 @@ pub struct BandLu {
     u_width: usize,
     /// Scratch for the permuted right-hand side.
     work: Vec<f64>,
+    /// `1/uⱼⱼ` of the last factorisation's pivots: the backward solve
+    /// multiplies by them (each column's division was its solve's longest
+    /// wait).
+    pivot_inverse: Vec<f64>,
 }
 
 impl BandLu {
@@ -278,6 +282,7 @@ impl BandLu {
             pivot_range: (0.0, 0.0),
             u_width: band.ku,
             work: vec![0.0; n],
+            pivot_inverse: vec![0.0; n],
             band,
         }
     }
@@ -321,6 +326,7 @@ impl BandLu {
         // last factorisation interchanged rows.
         let from = if self.u_width > ku { 0 } else { kl };
         let (ab, d, piv) = (&mut self.ab, &mut self.row_scale, &mut self.piv);
+        let inverse = &mut self.pivot_inverse;
         let mut farthest = 0usize;
         let (mut smallest, mut largest_pivot) = (f64::INFINITY, 0.0f64);
         for c in 0..n {
@@ -386,6 +392,8 @@ impl BandLu {
             }
             piv[c] = c + jp;
             if best == 0.0 || !best.is_finite() {
+                // Not finite: the solves give non-finite values.
+                inverse[c] = 1.0 / column[kv];
                 smallest = 0.0;
                 continue;
             }
@@ -401,6 +409,7 @@ impl BandLu {
             smallest = smallest.min(pivot);
             largest_pivot = largest_pivot.max(pivot);
             let reciprocal = 1.0 / column[kv];
+            inverse[c] = reciprocal;
             column[kv + 1..=kv + km]
                 .iter_mut()
                 .for_each(|v| *v *= reciprocal);
@@ -459,16 +468,19 @@ impl BandLu {
     }
 
     /// `b ← U⁻¹ b` in the renumbered unknowns: upper bandwidth `ku` plus the
-    /// farthest interchange (≤ `kl + ku`).
+    /// farthest interchange (≤ `kl + ku`), each `bⱼ` times its pivot's
+    /// inverse.
     pub(crate) fn backward(&self, b: &mut [f64]) {
         let (ku, kv, ld) = (self.band.ku, self.band.kl + self.band.ku, self.ld);
         let n = self.piv.len();
         // Without interchanges, the columns with a full band in registers.
         let to = ku.min(n);
-        let windowed = self.u_width == ku && backward_window((ku, kv, ld), &self.ab, b, (to, n));
+        let (ab, inverse) = (&self.ab[..], &self.pivot_inverse[..]);
+        let windowed =
+            self.u_width == ku && backward_window((ku, kv, ld), (ab, inverse), b, (to, n));
         for j in (0..if windowed { to } else { n }).rev() {
             let col = j * ld + kv;
-            b[j] /= self.ab[col];
+            b[j] *= self.pivot_inverse[j];
             let bj = b[j];
             let top = j.saturating_sub(self.u_width);
             subtract_multiple(&mut b[top..j], &self.ab[col + top - j..col], bj);

@@ -4,7 +4,7 @@
 //!
 //! Column by column, the forward solve `b ← L⁻¹ b` subtracts `lᵢⱼ bⱼ` from
 //! the `kl` entries below `bⱼ`, and the backward solve `b ← U⁻¹ b` divides
-//! `bⱼ` by its pivot and subtracts `uᵢⱼ bⱼ` from the `ku` entries above it.
+//! `bⱼ` by its pivot (multiplies by its inverse) and subtracts `uᵢⱼ bⱼ` from the `ku` entries above it.
 //! Done in memory, every column waits for the entry the previous column
 //! has just stored (a store forwarded to a load, about five cycles) before
 //! its own chain of a product and a difference; here the `kl` (or `ku + 1`)
@@ -59,16 +59,17 @@ fn forward_fixed<const KL: usize>(
 /// The backward solve's columns `to..from`, last first, with `ku` entries
 /// above the diagonal each (`to ≥ ku`) and no interchange, for `ku` ∈
 /// {11, 12, 17}; `false` (and nothing done) for other bandwidths.
+/// `inverse`: the pivots' inverses.
 pub(crate) fn backward_window(
     (ku, kv, ld): (usize, usize, usize),
-    ab: &[f64],
+    factors: (&[f64], &[f64]),
     b: &mut [f64],
     (to, from): (usize, usize),
 ) -> bool {
     match ku {
-        11 => backward_fixed::<11, 12>((kv, ld), ab, b, (to, from)),
-        12 => backward_fixed::<12, 13>((kv, ld), ab, b, (to, from)),
-        17 => backward_fixed::<17, 18>((kv, ld), ab, b, (to, from)),
+        11 => backward_fixed::<11, 12>((kv, ld), factors, b, (to, from)),
+        12 => backward_fixed::<12, 13>((kv, ld), factors, b, (to, from)),
+        17 => backward_fixed::<17, 18>((kv, ld), factors, b, (to, from)),
         _ => return false,
     }
     true
@@ -79,7 +80,7 @@ pub(crate) fn backward_window(
 #[inline(always)]
 fn backward_fixed<const KU: usize, const W: usize>(
     (kv, ld): (usize, usize),
-    ab: &[f64],
+    (ab, inverse): (&[f64], &[f64]),
     b: &mut [f64],
     (to, from): (usize, usize),
 ) {
@@ -90,7 +91,7 @@ fn backward_fixed<const KU: usize, const W: usize>(
     let mut w: [f64; W] = std::array::from_fn(|i| b[top + i]);
     for j in (to..from).rev() {
         let col = j * ld + kv;
-        let bj = w[KU] / ab[col];
+        let bj = w[KU] * inverse[j];
         b[j] = bj;
         let u: &[f64; KU] = ab[col - KU..col].try_into().expect("KU entries");
         for k in (1..=KU).rev() {
@@ -121,9 +122,13 @@ mod tests {
         }
     }
 
-    fn backward_in_memory((ku, kv, ld): (usize, usize, usize), ab: &[f64], b: &mut [f64]) {
+    fn backward_in_memory(
+        (ku, kv, ld): (usize, usize, usize),
+        (ab, inverse): (&[f64], &[f64]),
+        b: &mut [f64],
+    ) {
         for j in (ku..b.len()).rev() {
-            b[j] /= ab[j * ld + kv];
+            b[j] *= inverse[j];
             let bj = b[j];
             for i in 1..=ku {
                 b[j - i] -= ab[j * ld + kv - i] * bj;
@@ -147,11 +152,17 @@ mod tests {
             ));
             forward_in_memory((width, kv, ld), &ab, &mut slow);
             assert_eq!(fast, slow, "forward, width {width}");
-            assert!(backward_window((width, kv, ld), &ab, &mut fast, (width, n)));
-            backward_in_memory((width, kv, ld), &ab, &mut slow);
+            let inverse: Vec<f64> = (0..n).map(|j| 1.0 / ab[j * ld + kv]).collect();
+            assert!(backward_window(
+                (width, kv, ld),
+                (&ab, &inverse),
+                &mut fast,
+                (width, n)
+            ));
+            backward_in_memory((width, kv, ld), (&ab, &inverse), &mut slow);
             assert_eq!(fast, slow, "backward, width {width}");
         }
         assert!(!forward_window((10, 20, 31), &[], &mut [], (0, 0)));
-        assert!(!backward_window((10, 20, 31), &[], &mut [], (0, 0)));
+        assert!(!backward_window((10, 20, 31), (&[], &[]), &mut [], (0, 0)));
     }
 }
