@@ -1,6 +1,8 @@
 //! The configuration of a mesh: nodal positions and nodal rotations.
 
-use crate::rotation::{exp, matrix_from_quaternion, quaternion_from_matrix};
+use crate::rotation::{
+    exp_quaternion, matrix_from_quaternion, quaternion_from_matrix, quaternion_product,
+};
 use nalgebra::{Matrix3, Vector3, Vector4};
 
 /// Positions `xᵢ` and rotations `Rᵢ` (from the initial configuration) of every node.
@@ -51,7 +53,9 @@ impl Configuration {
 }
 
 /// [`Configuration::increment`] of one node's pose `(x, rot)`: `x ← x + u`,
-/// `R ← exp(φ̂) R`, re-orthonormalised through its unit quaternion.
+/// `R ← exp(φ̂) R`, composed as unit quaternions, `q(exp φ̂) ⊗ q(R)`, and
+/// normalised (re-orthonormalising `R`): no matrix exponential and no
+/// matrix product.
 pub fn increment_pose(
     x: &mut Vector3<f64>,
     rot: &mut Matrix3<f64>,
@@ -59,6 +63,6 @@ pub fn increment_pose(
     phi: &Vector3<f64>,
 ) {
     *x += u;
-    let r = exp(phi) * *rot;
-    *rot = matrix_from_quaternion(&quaternion_from_matrix(&r).normalize());
+    let q = quaternion_product(&exp_quaternion(phi), &quaternion_from_matrix(rot));
+    *rot = matrix_from_quaternion(&q.normalize());
 }
