@@ -174,31 +174,19 @@ fn symmetric_adjacency(pattern: &SymbolicSparseColMat<usize>) -> (Vec<usize>, Ve
     }
     let mut ptr = Vec::with_capacity(n + 1);
     let mut adj = Vec::with_capacity(2 * row_idx.len());
+    let mut neighbours = Vec::new();
     ptr.push(0);
     for v in 0..n {
-        let start = adj.len();
         let column = &row_idx[col_ptr[v]..col_ptr[v + 1]];
         let row = &t_idx[t_ptr[v]..t_ptr[v + 1]];
-        adj.extend(column.iter().chain(row).copied().filter(|&w| w != v));
-        adj[start..].sort_unstable();
-        let unique = dedup_in_place(&mut adj[start..]);
-        adj.truncate(start + unique);
+        neighbours.clear();
+        neighbours.extend(column.iter().chain(row).copied().filter(|&w| w != v));
+        neighbours.sort_unstable();
+        neighbours.dedup();
+        adj.extend_from_slice(&neighbours);
         ptr.push(adj.len());
     }
     (ptr, adj)
-}
-
-/// Moves the distinct values of the sorted `v` to its front; returns their
-/// count.
-fn dedup_in_place(v: &mut [usize]) -> usize {
-    let mut k = 0;
-    for i in 0..v.len() {
-        if i == 0 || v[i] != v[k - 1] {
-            v[k] = v[i];
-            k += 1;
-        }
-    }
-    k
 }
 
 /// A band LU factorisation bound to one pattern.
