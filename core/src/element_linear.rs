@@ -120,13 +120,13 @@ impl BeamElement<2> {
         let ad = exp_transpose_first(&(phi * 0.5));
         let (am, da) = (ad.value, ad.d1);
         let (g0, k0) = self.initial_strains()[0];
-        let (cn, cm) = (
-            Matrix3::from_diagonal(&self.section.c_n),
-            Matrix3::from_diagonal(&self.section.c_m),
-        );
-        let n = cn * (am * a / l - g0);
-        let m = cm * (phi / l - k0);
+        // The section's diagonal stiffnesses as products by entries (a
+        // product by the diagonal matrix adds only zeros to the same ones).
+        let (cn, cm) = (self.section.c_n, self.section.c_m);
+        let n = (am * a / l - g0).component_mul(&cn);
+        let m = (phi / l - k0).component_mul(&cm);
         let aa: [Vector3<f64>; 3] = std::array::from_fn(|i| da[i] * a);
+        let cn_aa: [Vector3<f64>; 3] = std::array::from_fn(|i| aa[i].component_mul(&cn));
         // N·∂ᵢⱼA a, the only use of A's second derivatives.
         let n_dda = ad.bilinear_hessian(&n, &a);
         // e = ∂E/∂z and the blocks of ∂²E/∂z² in z = (φ, a).
@@ -136,14 +136,15 @@ impl BeamElement<2> {
         for i in 0..3 {
             e_phi[i] = 0.5 * n.dot(&aa[i]) + m[i];
             for j in 0..3 {
-                h_pp[(i, j)] =
-                    0.25 * (aa[j].dot(&(cn * aa[i])) / l + n_dda[(i, j)]) + cm[(i, j)] / l;
+                h_pp[(i, j)] = 0.25 * (aa[j].dot(&cn_aa[i]) / l + n_dda[(i, j)]);
             }
-            let phi_a = (da[i].transpose() * n + am.transpose() * (cn * aa[i]) / l) * 0.5;
+            h_pp[(i, i)] += cm[i] / l;
+            let phi_a = (da[i].transpose() * n + am.transpose() * cn_aa[i] / l) * 0.5;
             h_pa.set_row(i, &phi_a.transpose());
         }
         let ea = am.transpose() * n;
-        let h_aa = am.transpose() * cn * am / l;
+        // (Aᵀ C_N) A: Aᵀ with its columns scaled, times A.
+        let h_aa = Matrix3::from_fn(|r, c| am[(c, r)] * cn[c]) * am / l;
         // J = ∂z/∂(η₁, ε₁, η₂, ε₂) has the column blocks
         // c₁ = −P, c₂ = −Q + P d̂, c₃ = P, c₄ = Q with P = (0; Λ₁ᵀ),
         // Q = (S; 0): Jᵀ(∂²E/∂z²)J from the four products of P and Q
