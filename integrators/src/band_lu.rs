@@ -317,25 +317,23 @@ impl BandLu {
         let inverse = &mut self.pivot_inverse;
         let mut farthest = 0usize;
         let (mut smallest, mut largest_pivot) = (f64::INFINITY, 0.0f64);
+        let entries = Entries {
+            slot: &self.slot,
+            columns: &self.columns,
+            sources: self.sources.as_deref(),
+            values,
+        };
+        for c in 0..LOAD_AHEAD.min(n) {
+            entries.load(c, &mut ab[c * ld..(c + 1) * ld], from);
+        }
         for c in 0..n {
             // Row r of column c at kv + r − c of its storage.
             let (done, rest) = ab.split_at_mut(c * ld);
-            let column = &mut rest[..ld];
-            column[from..].iter_mut().for_each(|v| *v = 0.0);
-            let entries = self.columns[c].clone();
-            let slots = &self.slot[entries.clone()];
-            match &self.sources {
-                None => {
-                    for (&row, &v) in slots.iter().zip(&values[entries]) {
-                        column[row as usize] = v;
-                    }
-                }
-                Some(src) => {
-                    for (&row, &k) in slots.iter().zip(&src[entries]) {
-                        column[row as usize] = values[k];
-                    }
-                }
+            if c + LOAD_AHEAD < n {
+                let ahead = (c + LOAD_AHEAD) * ld - c * ld;
+                entries.load(c + LOAD_AHEAD, &mut rest[ahead..ahead + ld], from);
             }
+            let column = &mut rest[..ld];
             // The earlier steps that reach this column, in order: each
             // step's interchange, then its multipliers times the entry of
             // its pivot row. Rows above c − ku are reached only through
@@ -507,6 +505,41 @@ impl BandLu {
     /// The renumbering and bandwidths the factorisation works in.
     pub(crate) fn structure(&self) -> &BandStructure {
         &self.band
+    }
+}
+
+/// Columns a factorisation loads ahead of the one it eliminates: each
+/// column's entries are stored one by one and then read by the update in
+/// pairs, which waits where the stores are still in flight.
+const LOAD_AHEAD: usize = 4;
+
+/// The pattern's values as the band storage's columns take them.
+struct Entries<'a> {
+    slot: &'a [u32],
+    columns: &'a [std::ops::Range<usize>],
+    sources: Option<&'a [usize]>,
+    values: &'a [f64],
+}
+
+impl Entries<'_> {
+    /// Column `c` of the band storage (`column`, zero from row `from`) with
+    /// its entries.
+    fn load(&self, c: usize, column: &mut [f64], from: usize) {
+        column[from..].iter_mut().for_each(|v| *v = 0.0);
+        let entries = self.columns[c].clone();
+        let slots = &self.slot[entries.clone()];
+        match self.sources {
+            None => {
+                for (&row, &v) in slots.iter().zip(&self.values[entries]) {
+                    column[row as usize] = v;
+                }
+            }
+            Some(src) => {
+                for (&row, &k) in slots.iter().zip(&src[entries]) {
+                    column[row as usize] = self.values[k];
+                }
+            }
+        }
     }
 }
 
