@@ -1568,3 +1568,23 @@ fn lock_result(path: &Path) -> Result<Option<(std::fs::File, PathBuf)>, ResultEr
         Err(std::fs::TryLockError::Error(source)) => Err(ResultError::Lock { lock, source }),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A written dataset has no chunk cache: through one, HDF5 allocates and
+    /// zeroes every chunk a write covers before copying the rows in.
+    #[test]
+    fn written_datasets_have_no_chunk_cache() {
+        let name = format!("flexmech-writer-cache-{}.h5", std::process::id());
+        let path = std::env::temp_dir().join(name);
+        let file = File::create(&path).expect("a scratch file");
+        let series = Series::create::<f64>(&file, &path, "s", 0, &[3], &[16, 3], "a series")
+            .expect("the series");
+        let dapl = series.ds.access_plist().expect("its access list");
+        assert_eq!(dapl.chunk_cache().nbytes, 0);
+        drop((series, file));
+        std::fs::remove_file(&path).expect("the scratch file removed");
+    }
+}
