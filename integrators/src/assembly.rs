@@ -12,6 +12,7 @@
 //! threads.
 
 use crate::dofs::DofMap;
+use crate::sparsity::symmetric_pattern;
 use faer::sparse::SymbolicSparseColMat;
 use flexmech_core::{Configuration, Element, Inertia, Mesh};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector6};
@@ -48,21 +49,16 @@ fn direct_pairs(el: &Element, dofs: &DofMap, eqs: &[usize]) -> Option<Vec<(usize
     let mut pairs = Vec::with_capacity(eqs.len());
     for (a, &nd) in el.nodes().iter().enumerate() {
         let map = &dofs.nodes[nd];
-        for (eq, d) in map.eqs.iter().zip(map.own_dofs()?) {
-            pairs.push((6 * a + d, eqs.binary_search(eq).ok()?));
+        for (eq, &d) in map.eqs.iter().zip(dofs.own_dofs(nd)?) {
+            pairs.push((6 * a + usize::from(d), eqs.binary_search(eq).ok()?));
         }
     }
     (pairs.len() == eqs.len()).then_some(pairs)
 }
 
 /// Every element's slots (its sorted, unique equations; positions still to
-/// be found) and its direct pairs ([`direct_pairs`]), with its equation
-/// pairs added to the pattern's columns `cols`.
-fn element_slots(
-    mesh: &Mesh,
-    dofs: &DofMap,
-    cols: &mut [Vec<usize>],
-) -> (Vec<Slots>, Vec<DirectPairs>) {
+/// be found) and its direct pairs ([`direct_pairs`]).
+fn element_slots(mesh: &Mesh, dofs: &DofMap) -> (Vec<Slots>, Vec<DirectPairs>) {
     let mut slots = Vec::with_capacity(mesh.elements.len());
     let mut direct = Vec::with_capacity(mesh.elements.len());
     for el in &mesh.elements {
@@ -73,9 +69,6 @@ fn element_slots(
             .collect();
         eqs.sort_unstable();
         eqs.dedup();
-        for &j in &eqs {
-            cols[j].extend(eqs.iter().copied());
-        }
         direct.push(direct_pairs(el, dofs, &eqs));
         slots.push(Slots {
             eqs,
@@ -87,35 +80,16 @@ fn element_slots(
 }
 
 /// The slots of the extra dense blocks over the equation lists `blocks`
-/// (positions still to be found), with their pairs added to `cols`.
-fn block_slots(blocks: &[Vec<usize>], cols: &mut [Vec<usize>]) -> Vec<Slots> {
-    let mut extra: Vec<Slots> = Vec::with_capacity(blocks.len());
-    for eqs in blocks {
-        for &j in eqs {
-            cols[j].extend(eqs.iter().copied());
-        }
-        extra.push(Slots {
+/// (positions still to be found).
+fn block_slots(blocks: &[Vec<usize>]) -> Vec<Slots> {
+    blocks
+        .iter()
+        .map(|eqs| Slots {
             eqs: eqs.clone(),
             pos: Vec::new(),
             direct: None,
-        });
-    }
-    extra
-}
-
-/// The compressed columns `(col_ptr, row_idx)` of the pattern whose
-/// column `j` holds the rows `cols[j]` (sorted and made unique in place).
-fn compressed_columns(cols: &mut [Vec<usize>]) -> (Vec<usize>, Vec<usize>) {
-    let mut col_ptr = Vec::with_capacity(cols.len() + 1);
-    let mut row_idx = Vec::new();
-    col_ptr.push(0);
-    for c in cols {
-        c.sort_unstable();
-        c.dedup();
-        row_idx.extend(c.iter().copied());
-        col_ptr.push(row_idx.len());
-    }
-    (col_ptr, row_idx)
+        })
+        .collect()
 }
 
 /// The positions in the CSC value array of the pattern `(col_ptr, row_idx)`
@@ -231,13 +205,10 @@ impl Assembler {
     /// [`Assembler::add_block`]).
     pub fn new(mesh: &Mesh, dofs: &DofMap, blocks: &[Vec<usize>]) -> Self {
         let n = dofs.n_eq;
-        let mut cols: Vec<Vec<usize>> = vec![Vec::new(); n];
-        for (e, c) in cols.iter_mut().enumerate() {
-            c.push(e);
-        }
-        let (mut slots, direct) = element_slots(mesh, dofs, &mut cols);
-        let mut extra = block_slots(blocks, &mut cols);
-        let (col_ptr, row_idx) = compressed_columns(&mut cols);
+        let (mut slots, direct) = element_slots(mesh, dofs);
+        let mut extra = block_slots(blocks);
+        let lists: Vec<&[usize]> = slots.iter().chain(&extra).map(|s| &s.eqs[..]).collect();
+        let (col_ptr, row_idx) = symmetric_pattern(n, &lists);
         for s in slots.iter_mut().chain(extra.iter_mut()) {
             s.pos = value_positions(&s.eqs, &col_ptr, &row_idx);
         }
@@ -516,14 +487,14 @@ impl Assembler {
         (j, cj): (usize, usize),
     ) -> Option<Vec<(usize, usize, usize)>> {
         let (mi, mj) = (&dofs.nodes[i], &dofs.nodes[j]);
-        let (di, dj) = (mi.own_dofs()?, mj.own_dofs()?);
+        let (di, dj) = (dofs.own_dofs(i)?, dofs.own_dofs(j)?);
         let (cp, ri_idx) = (self.pattern.col_ptr(), self.pattern.row_idx());
         let mut out = Vec::new();
-        for (ei, &a) in mi.eqs.iter().zip(&di) {
+        for (ei, a) in mi.eqs.iter().zip(di.iter().map(|&a| usize::from(a))) {
             if !(ri..ri + 3).contains(&a) {
                 continue;
             }
-            for (ej, &b) in mj.eqs.iter().zip(&dj) {
+            for (ej, b) in mj.eqs.iter().zip(dj.iter().map(|&b| usize::from(b))) {
                 if !(cj..cj + 3).contains(&b) {
                     continue;
                 }
@@ -533,6 +504,33 @@ impl Assembler {
             }
         }
         Some(out)
+    }
+
+    /// The diagonal of [`Self::node_block_slots`]' translational block
+    /// (`ri = cj = 0`): the positions of the triples with `a = b`, in the
+    /// same order, found without the others (a mass block is `m I`). `None`
+    /// under the same conditions.
+    pub fn node_block_diagonal(
+        &self,
+        dofs: &DofMap,
+        i: usize,
+        j: usize,
+    ) -> Option<([usize; 3], usize)> {
+        let (mi, mj) = (&dofs.nodes[i], &dofs.nodes[j]);
+        let (di, dj) = (dofs.own_dofs(i)?, dofs.own_dofs(j)?);
+        let (cp, ri_idx) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        let (mut out, mut len) = ([0; 3], 0);
+        for (ei, &a) in mi.eqs.iter().zip(di) {
+            if a >= 3 {
+                continue;
+            }
+            for (ej, _) in mj.eqs.iter().zip(dj).filter(|&(_, &b)| b == a) {
+                let rows = &ri_idx[cp[*ej]..cp[*ej + 1]];
+                out[len] = cp[*ej] + rows.binary_search(ei).ok()?;
+                len += 1;
+            }
+        }
+        Some((out, len))
     }
 
     /// Adds the node block `k` at the positions of
@@ -810,5 +808,75 @@ mod tests {
         map_rows(&t, rows.iter().copied(), &mut out);
         let expected = dense(&rows).transpose() * &k * dense(&cols);
         assert!((out - expected).amax() < 1e-9);
+    }
+    /// A beam of 2-node elements and one of 3-node elements, with some
+    /// DOFs held.
+    fn two_beams() -> (Mesh, DofMap) {
+        let section =
+            flexmech_core::Section::new([1e4, 5e3, 5e3], [10.0, 20.0, 30.0], 1.0, [0.1; 3]);
+        let mut mesh = Mesh::default();
+        let (o, e2) = (nalgebra::Vector3::zeros(), nalgebra::Vector3::y());
+        mesh.add_straight_beam(o, nalgebra::Vector3::x(), e2, 3, 2, section)
+            .unwrap();
+        mesh.add_straight_beam(
+            o,
+            nalgebra::Vector3::z(),
+            nalgebra::Vector3::x(),
+            2,
+            3,
+            section,
+        )
+        .unwrap();
+        let mut fixed = vec![[false; 6]; mesh.node_count()];
+        fixed[1] = [true, false, true, false, false, true];
+        fixed[5] = [false, true, false, true, true, false];
+        (mesh, DofMap::independent(&fixed))
+    }
+
+    #[test]
+    fn the_counted_pattern_is_the_one_of_sorted_lists() {
+        let (mesh, dofs) = two_beams();
+        let blocks = vec![vec![2, 7, 30], vec![0, 31]];
+        let asm = Assembler::new(&mesh, &dofs, &blocks);
+        let n = dofs.n_eq;
+        let mut cols: Vec<Vec<usize>> = (0..n).map(|j| vec![j]).collect();
+        let lists = mesh.elements.iter().map(|el| {
+            el.nodes()
+                .iter()
+                .flat_map(|&nd| dofs.nodes[nd].eqs.clone())
+                .collect::<Vec<_>>()
+        });
+        for eqs in lists.chain(blocks) {
+            for &j in &eqs {
+                cols[j].extend(&eqs);
+            }
+        }
+        let (col_ptr, row_idx) = (asm.pattern().col_ptr(), asm.pattern().row_idx());
+        for (j, c) in cols.iter_mut().enumerate() {
+            c.sort_unstable();
+            c.dedup();
+            assert_eq!(&row_idx[col_ptr[j]..col_ptr[j + 1]], &c[..], "column {j}");
+        }
+    }
+
+    #[test]
+    fn the_mass_diagonal_is_the_node_blocks_diagonal() {
+        let (mesh, dofs) = two_beams();
+        let asm = Assembler::new(&mesh, &dofs, &[]);
+        let mut checked = 0;
+        for el in &mesh.elements {
+            for &i in el.nodes() {
+                for &j in el.nodes() {
+                    let full = asm.node_block_slots(&dofs, (i, 0), (j, 0)).unwrap();
+                    let diagonal: Vec<usize> =
+                        full.iter().filter(|s| s.1 == s.2).map(|s| s.0).collect();
+                    let (at, len) = asm.node_block_diagonal(&dofs, i, j).unwrap();
+                    assert_eq!(&at[..len], &diagonal[..], "nodes {i}, {j}");
+                    checked += usize::from(len < 3);
+                }
+            }
+        }
+        // Blocks of the nodes with held DOFs were among them.
+        assert!(checked > 0);
     }
 }

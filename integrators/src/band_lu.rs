@@ -90,7 +90,9 @@ impl BandStructure {
         let mut order = Vec::with_capacity(n);
         let mut seen = vec![false; n];
         let mut by_degree: Vec<usize> = (0..n).collect();
-        by_degree.sort_by_key(|&i| (degree[i], i));
+        // The keys are unique (ties go by index): the unstable sort gives
+        // the stable one's order.
+        by_degree.sort_unstable_by_key(|&i| (degree[i], i));
         let mut next = Vec::new();
         for &root in &by_degree {
             if seen[root] {
@@ -102,7 +104,7 @@ impl BandStructure {
                 order.push(v);
                 next.clear();
                 next.extend(neighbours(v).iter().copied().filter(|&w| !seen[w]));
-                next.sort_by_key(|&w| (degree[w], w));
+                next.sort_unstable_by_key(|&w| (degree[w], w));
                 for &w in &next {
                     seen[w] = true;
                     queue.push_back(w);
@@ -174,19 +176,65 @@ fn symmetric_adjacency(pattern: &SymbolicSparseColMat<usize>) -> (Vec<usize>, Ve
     }
     let mut ptr = Vec::with_capacity(n + 1);
     let mut adj = Vec::with_capacity(2 * row_idx.len());
-    let mut neighbours = Vec::new();
     ptr.push(0);
     for v in 0..n {
         let column = &row_idx[col_ptr[v]..col_ptr[v + 1]];
         let row = &t_idx[t_ptr[v]..t_ptr[v + 1]];
-        neighbours.clear();
-        neighbours.extend(column.iter().chain(row).copied().filter(|&w| w != v));
-        neighbours.sort_unstable();
-        neighbours.dedup();
-        adj.extend_from_slice(&neighbours);
+        if column.windows(2).all(|w| w[0] < w[1]) {
+            // Then the rows of A are sorted and unique too (gathered
+            // column by column).
+            merge_without(column, row, v, &mut adj);
+        } else {
+            let from = adj.len();
+            adj.extend(column.iter().chain(row).copied().filter(|&w| w != v));
+            adj[from..].sort_unstable();
+            let unique = from + dedup_sorted(&mut adj[from..]);
+            adj.truncate(unique);
+        }
         ptr.push(adj.len());
     }
     (ptr, adj)
+}
+
+/// Moves the distinct values of the sorted `list` to its front; returns
+/// how many there are.
+fn dedup_sorted(list: &mut [usize]) -> usize {
+    let mut kept = 0;
+    for k in 0..list.len() {
+        if kept == 0 || list[k] != list[kept - 1] {
+            list[kept] = list[k];
+            kept += 1;
+        }
+    }
+    kept
+}
+
+/// Appends to `out` the union of the sorted, duplicate-free lists `a` and
+/// `b` without `v`, in ascending order (a column's rows and a row's
+/// columns of a CSC pattern are both sorted).
+fn merge_without(a: &[usize], b: &[usize], v: usize, out: &mut Vec<usize>) {
+    let (mut i, mut j) = (0, 0);
+    loop {
+        let next = match (a.get(i), b.get(j)) {
+            (Some(&x), Some(&y)) => {
+                i += usize::from(x <= y);
+                j += usize::from(y <= x);
+                x.min(y)
+            }
+            (Some(&x), None) => {
+                i += 1;
+                x
+            }
+            (None, Some(&y)) => {
+                j += 1;
+                y
+            }
+            (None, None) => return,
+        };
+        if next != v {
+            out.push(next);
+        }
+    }
 }
 
 /// A band LU factorisation bound to one pattern.
@@ -703,9 +751,16 @@ pub(crate) mod tests {
             row_idx.extend_from_slice(c);
             col_ptr.push(row_idx.len());
         }
-        let mut patterns = vec![SymbolicSparseColMat::new_checked(
-            6, 6, col_ptr, None, row_idx,
-        )];
+        // The same columns with their rows out of order (merged only when
+        // sorted).
+        let unsorted: Vec<usize> = columns
+            .iter()
+            .flat_map(|c| c.iter().rev().copied())
+            .collect();
+        let mut patterns = vec![
+            SymbolicSparseColMat::new_unsorted_checked(6, 6, col_ptr.clone(), None, unsorted),
+            SymbolicSparseColMat::new_checked(6, 6, col_ptr, None, row_idx),
+        ];
         patterns.extend([(40, 3, 1), (61, 6, 2)].map(|(n, w, seed)| scrambled(n, w, seed).0));
         for pattern in &patterns {
             let (ptr, adj) = symmetric_adjacency(pattern);

@@ -110,6 +110,13 @@ impl DofMap {
         Self::new(n_eq, nodes)
     }
 
+    /// [`NodeMap::own_dofs`] of node `n`, found once when the map was made:
+    /// the nodal DOF (0..6) of each of its equations where the node is
+    /// independent, `None` otherwise.
+    pub fn own_dofs(&self, n: usize) -> Option<&[u8]> {
+        self.own[n].as_ref().map(|o| &o.dofs[..o.len as usize])
+    }
+
     /// Nodal increment of node `n` for the global increment `dq`.
     pub fn node_increment(&self, n: usize, dq: &[f64]) -> Vector6<f64> {
         let m = &self.nodes[n];

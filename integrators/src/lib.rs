@@ -28,6 +28,7 @@ pub mod newton;
 pub mod record;
 pub mod rotation_guard;
 pub mod sensitivity;
+mod sparsity;
 pub mod stability;
 mod start_shift;
 pub mod statics;

@@ -27,13 +27,8 @@ impl MassSlots {
         let mut translational = Vec::new();
         let mut through_maps = Vec::new();
         for (k, &(i, j, m)) in inertia.mass.iter().enumerate() {
-            match asm.node_block_slots(dofs, (i, 0), (j, 0)) {
-                Some(slots) => translational.extend(
-                    slots
-                        .into_iter()
-                        .filter(|&(_, a, b)| a == b)
-                        .map(|(p, _, _)| (p, m)),
-                ),
+            match asm.node_block_diagonal(dofs, i, j) {
+                Some((at, len)) => translational.extend(at[..len].iter().map(|&p| (p, m))),
                 None => through_maps.push(k),
             }
         }

@@ -237,7 +237,8 @@ impl NewmarkTerms {
         let slots = MassSlots::new(asm, &topo.dofs, &inertia);
         let mut fext = vec![0.0; 6 * nodes];
         mech.external_forces(0.0, &mut fext);
-        asm.assemble(&mech.mesh, &topo.dofs, &state.config);
+        // The forces only: the tangent's values are the mass's next.
+        asm.assemble_residual(&mech.mesh, &state.config);
         let residual: Vec<f64> = asm.nodal.iter().zip(&fext).map(|(a, b)| a - b).collect();
         let (v, w) = slave_velocities(mech, topo, state, initial);
         let (a, alpha, _) =
