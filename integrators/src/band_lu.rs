@@ -34,6 +34,7 @@ use faer::sparse::SymbolicSparseColMat;
 use std::collections::VecDeque;
 
 use crate::band_solve::{backward_window, forward_window};
+use crate::sparsity::transposed;
 use crate::tolerances::TOLERANCES;
 
 /// A column keeps its diagonal pivot while `|bⱼⱼ| ≥ τ maxᵢ |bᵢⱼ|` on the
@@ -159,21 +160,7 @@ fn symmetric_adjacency(pattern: &SymbolicSparseColMat<usize>) -> (Vec<usize>, Ve
     let n = pattern.nrows();
     let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
     // Aᵀ by columns: the columns of each row of A.
-    let mut t_ptr = vec![0usize; n + 1];
-    for &i in row_idx {
-        t_ptr[i + 1] += 1;
-    }
-    for v in 0..n {
-        t_ptr[v + 1] += t_ptr[v];
-    }
-    let mut fill = t_ptr.clone();
-    let mut t_idx = vec![0usize; row_idx.len()];
-    for j in 0..n {
-        for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
-            t_idx[fill[i]] = j;
-            fill[i] += 1;
-        }
-    }
+    let (t_ptr, t_idx) = transposed(col_ptr, row_idx);
     let mut ptr = Vec::with_capacity(n + 1);
     let mut adj = Vec::with_capacity(2 * row_idx.len());
     ptr.push(0);
@@ -185,28 +172,19 @@ fn symmetric_adjacency(pattern: &SymbolicSparseColMat<usize>) -> (Vec<usize>, Ve
             // column by column).
             merge_without(column, row, v, &mut adj);
         } else {
-            let from = adj.len();
-            adj.extend(column.iter().chain(row).copied().filter(|&w| w != v));
-            adj[from..].sort_unstable();
-            let unique = from + dedup_sorted(&mut adj[from..]);
-            adj.truncate(unique);
+            let mut neighbours: Vec<usize> = column
+                .iter()
+                .chain(row)
+                .copied()
+                .filter(|&w| w != v)
+                .collect();
+            neighbours.sort_unstable();
+            neighbours.dedup();
+            adj.extend_from_slice(&neighbours);
         }
         ptr.push(adj.len());
     }
     (ptr, adj)
-}
-
-/// Moves the distinct values of the sorted `list` to its front; returns
-/// how many there are.
-fn dedup_sorted(list: &mut [usize]) -> usize {
-    let mut kept = 0;
-    for k in 0..list.len() {
-        if kept == 0 || list[k] != list[kept - 1] {
-            list[kept] = list[k];
-            kept += 1;
-        }
-    }
-    kept
 }
 
 /// Appends to `out` the union of the sorted, duplicate-free lists `a` and

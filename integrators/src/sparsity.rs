@@ -47,7 +47,7 @@ pub(crate) fn symmetric_pattern(n: usize, lists: &[&[usize]]) -> (Vec<usize>, Ve
 
 /// The transpose `(col_ptr, row_idx)` of the square CSC pattern `(ptr,
 /// rows)`, each column's rows in ascending order.
-fn transposed(ptr: &[usize], rows: &[usize]) -> (Vec<usize>, Vec<usize>) {
+pub(crate) fn transposed(ptr: &[usize], rows: &[usize]) -> (Vec<usize>, Vec<usize>) {
     let n = ptr.len() - 1;
     let mut col_ptr = vec![0; n + 1];
     for &r in rows {
