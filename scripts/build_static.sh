@@ -10,7 +10,8 @@
 # instructions and goes to target/static-<cpu>/release/flexmech; it will not
 # start on a processor without them. Rust never fuses a product and a sum
 # into one rounding, so the results are bitwise those of the portable build
-# (checked on every model of data/paper and data/benchmarks).
+# (scripts/same_results.sh checks it on every model of data/paper and
+# data/benchmarks).
 # CMake >= 3.26 is taken from PATH or the environment's CMAKE, else installed
 # from PyPI into target/cmake-venv. The first build compiles HDF5 (a few
 # minutes); later ones only what changed.

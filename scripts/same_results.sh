@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Whether two flexmech executables give the same results, bit for bit: runs
+# every model of data/paper and data/benchmarks (and any MODEL given) with
+# each, one thread, and compares the result files dataset by dataset.
+#
+#   scripts/same_results.sh A_BINARY B_BINARY [MODEL ...]
+#
+# For builds that should not change the arithmetic: the build with HDF5
+# linked in, or one for a newer processor (`FLEXMECH_TARGET_CPU` of
+# scripts/build_static.sh), against the usual one. Prints each model's
+# differing datasets (the largest difference and the largest value) and
+# exits non-zero if any differ. Needs Python with h5py and numpy.
+set -euo pipefail
+[ $# -ge 2 ] || { sed -n '2,11p' "$0"; exit 2; }
+a="$1"; b="$2"; shift 2
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+out="$(mktemp -d)"
+trap 'rm -rf "$out"' EXIT
+status=0
+for model in "$root"/data/paper/*.toml "$root"/data/benchmarks/*.toml "$@"; do
+    name="$(basename "$model" .toml)"
+    for side in a b; do
+        bin="$a"; [ "$side" = b ] && bin="$b"
+        RAYON_NUM_THREADS=1 "$bin" run "$model" --out "$out/$side/$name" >/dev/null 2>&1 || true
+    done
+    python3 - "$out/a/$name" "$out/b/$name" "$name" <<'PY' || status=1
+import pathlib, sys
+import h5py, numpy as np
+
+a_dir, b_dir, name = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2]), sys.argv[3]
+files = sorted(p.name for p in a_dir.glob("*.h5"))
+if files != sorted(p.name for p in b_dir.glob("*.h5")) or not files:
+    print(f"{name}: the result files differ or are missing: {files}")
+    sys.exit(1)
+differ = []
+for f in files:
+    with h5py.File(a_dir / f) as x, h5py.File(b_dir / f) as y:
+        def visit(path, obj):
+            if not isinstance(obj, h5py.Dataset):
+                return
+            if path not in y:
+                differ.append(f"{f}:{path} (missing)")
+                return
+            u, v = obj[()], y[path][()]
+            same = u.shape == v.shape and (
+                np.array_equal(u, v, equal_nan=True) if u.dtype.kind in "fc" else np.array_equal(u, v))
+            if not same:
+                if u.shape == v.shape and u.dtype.kind in "fc" and u.size:
+                    detail = f"largest difference {np.nanmax(np.abs(u - v)):.3e} of {np.nanmax(np.abs(u)):.3e}"
+                else:
+                    detail = "not comparable"
+                differ.append(f"{f}:{path} ({detail})")
+        x.visititems(visit)
+print(f"{name}: " + ("bitwise the same" if not differ else "differs: " + "; ".join(differ)))
+sys.exit(1 if differ else 0)
+PY
+done
+exit "$status"
