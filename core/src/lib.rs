@@ -25,6 +25,7 @@ pub use element::BeamElement;
 pub use inertia::{Inertia, MassKind};
 pub use section::Section;
 pub mod mesh;
+pub mod pose_pair;
 pub mod prestress;
 pub mod state;
 pub mod step_start;

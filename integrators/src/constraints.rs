@@ -9,9 +9,8 @@ use crate::error::SolveError;
 use crate::mechanism::Mechanism;
 use crate::record::JointRecord;
 use crate::step_maps::StepMaps;
-use crate::threads::for_each_pose;
+use crate::threads::increment_poses;
 use flexmech_core::rotation::{exp, log};
-use flexmech_core::state::increment_pose;
 use flexmech_core::Configuration;
 use flexmech_joints::{JointStep, ReleasedState, SeededStep, StepLanes, LOCAL, MAX_RELEASED};
 use nalgebra::{DMatrix, Matrix3, SMatrix, SVector, Vector3, Vector6};
@@ -518,17 +517,14 @@ impl Topology {
         // Each node on its own: on two threads for a large mesh, the same
         // numbers either way.
         let config = &mut state.config;
-        for_each_pose(&mut config.x, &mut config.rot, |n, x, rot| {
-            if self.slave_of[n].is_none() {
-                let p = self.dofs.node_increment(n, dq);
-                if p != Vector6::zeros() {
-                    let (u, phi) = (
-                        p.fixed_rows::<3>(0).into_owned(),
-                        p.fixed_rows::<3>(3).into_owned(),
-                    );
-                    increment_pose(x, rot, &u, &phi);
-                }
-            }
+        increment_poses(&mut config.x, &mut config.rot, |n| {
+            let p = self.dofs.node_increment(n, dq);
+            (self.slave_of[n].is_none() && p != Vector6::zeros()).then(|| {
+                (
+                    p.fixed_rows::<3>(0).into_owned(),
+                    p.fixed_rows::<3>(3).into_owned(),
+                )
+            })
         });
         for &j in &self.order {
             let eqs = &self.released_eqs[j];

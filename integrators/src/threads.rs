@@ -205,12 +205,23 @@ pub fn for_each_pose(
     rot: &mut [nalgebra::Matrix3<f64>],
     f: impl Fn(usize, &mut nalgebra::Vector3<f64>, &mut nalgebra::Matrix3<f64>) + Sync + Send,
 ) {
+    for_each_pose_chunk(x, rot, |first, xs, rs| {
+        for (k, (x, r)) in xs.iter_mut().zip(rs.iter_mut()).enumerate() {
+            f(first + k, x, r);
+        }
+    });
+}
+
+/// `f(first, xs, rs)` on consecutive chunks of the nodes' poses, `first`
+/// the chunk's first node — on two threads where [`split_nodes`] (one
+/// chunk otherwise); each node in one chunk.
+pub fn for_each_pose_chunk(
+    x: &mut [nalgebra::Vector3<f64>],
+    rot: &mut [nalgebra::Matrix3<f64>],
+    f: impl Fn(usize, &mut [nalgebra::Vector3<f64>], &mut [nalgebra::Matrix3<f64>]) + Sync + Send,
+) {
     if !split_nodes(x.len()) {
-        x.iter_mut()
-            .zip(rot.iter_mut())
-            .enumerate()
-            .for_each(|(i, (x, r))| f(i, x, r));
-        return;
+        return f(0, x, rot);
     }
     let mut items = Vec::new();
     let (mut x, mut rot) = (x, rot);
@@ -220,10 +231,21 @@ pub fn for_each_pose(
         items.push((range.start, xs, rs));
         (x, rot) = (x_rest, rot_rest);
     }
-    for_each_item(items, |_, (first, xs, rs)| {
-        for (k, (x, r)) in xs.iter_mut().zip(rs.iter_mut()).enumerate() {
-            f(first + k, x, r);
-        }
+    for_each_item(items, |_, (first, xs, rs)| f(first, xs, rs));
+}
+
+/// The increments `inc(i)` of the nodes' poses (translation, spatial
+/// rotation vector; `None`: node `i` stays), applied as
+/// [`flexmech_core::state::increment_pose`] would — two nodes at a time
+/// ([`flexmech_core::pose_pair::increment_poses`]), on two threads where
+/// [`split_nodes`]; each node on its own, so the same bits either way.
+pub fn increment_poses(
+    x: &mut [nalgebra::Vector3<f64>],
+    rot: &mut [nalgebra::Matrix3<f64>],
+    inc: impl Fn(usize) -> Option<(nalgebra::Vector3<f64>, nalgebra::Vector3<f64>)> + Sync + Send,
+) {
+    for_each_pose_chunk(x, rot, |first, xs, rs| {
+        flexmech_core::pose_pair::increment_poses(first, xs, rs, &inc)
     });
 }
 

@@ -41,7 +41,6 @@ use crate::sensitivity::Parameter;
 use crate::step_control::StepControl;
 use crate::system::ReducedSystem;
 use crate::tolerances::TOLERANCES;
-use flexmech_core::state::increment_pose;
 use flexmech_core::{Configuration, Element};
 use nalgebra::Vector3;
 
@@ -371,11 +370,9 @@ impl<'m, S: TimeScheme> Stepper<'m, S> {
         let (v, w) = sys.terms.predictor_velocities();
         let (topo, start_rot) = (&sys.topo, &sys.start.config.rot);
         let end = &mut sys.end.config;
-        crate::threads::for_each_pose(&mut end.x, &mut end.rot, |i, x, rot| {
-            if !mech.fixed[i].iter().any(|&h| h) && topo.slave_of[i].is_none() {
-                let spin = start_rot[i] * w[i] * dt;
-                increment_pose(x, rot, &(v[i] * dt), &spin);
-            }
+        crate::threads::increment_poses(&mut end.x, &mut end.rot, |i| {
+            (!mech.fixed[i].iter().any(|&h| h) && topo.slave_of[i].is_none())
+                .then(|| (v[i] * dt, start_rot[i] * w[i] * dt))
         });
         for (j, rates) in sys.terms.joint_rates().iter().enumerate() {
             let delta: Vec<f64> = rates.iter().map(|r| r * dt).collect();
