@@ -7,7 +7,7 @@
 //! maps (a large increment, a rotation whose quaternion is not read from its
 //! trace) each goes its own way through [`increment_pose`].
 
-use crate::rotation::SERIES_LIMIT;
+use crate::rotation::{rotation_entries, SERIES_LIMIT};
 use crate::state::increment_pose;
 use nalgebra::{Matrix3, Vector3};
 use wide::f64x2;
@@ -48,7 +48,7 @@ pub fn increment_pose_pair(
     let e = exp_series(&vector(phi), pair(t2[0], t2[1]));
     let q = from_trace_quaternion([r0, r1]);
     let p = normalize(product(&e, &q));
-    let m = matrix(&p);
+    let m = rotation_entries(p, f64x2::splat(1.0), f64x2::splat(2.0));
     for (k, r) in [r0, r1].into_iter().enumerate() {
         *r = Matrix3::from_fn(|i, j| m[3 * i + j].to_array()[k]);
     }
@@ -146,23 +146,6 @@ fn product(a: &[f64x2; 4], b: &[f64x2; 4]) -> [f64x2; 4] {
 fn normalize(q: [f64x2; 4]) -> [f64x2; 4] {
     let n = ((q[0] * q[0] + q[2] * q[2]) + (q[1] * q[1] + q[3] * q[3])).sqrt();
     q.map(|c| c / n)
-}
-
-/// `matrix_from_quaternion`, row by row.
-fn matrix(q: &[f64x2; 4]) -> [f64x2; 9] {
-    let (w, x, y, z) = (q[0], q[1], q[2], q[3]);
-    let (one, two) = (f64x2::splat(1.0), f64x2::splat(2.0));
-    [
-        one - two * (y * y + z * z),
-        two * (x * y - w * z),
-        two * (x * z + w * y),
-        two * (x * y + w * z),
-        one - two * (x * x + z * z),
-        two * (y * z - w * x),
-        two * (x * z - w * y),
-        two * (y * z + w * x),
-        one - two * (x * x + y * y),
-    ]
 }
 
 #[cfg(test)]

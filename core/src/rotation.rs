@@ -219,10 +219,19 @@ pub fn quaternion_from_matrix<T: Scalar>(r: &Matrix3<T>) -> Vector4<T> {
 
 /// Rotation matrix of a unit quaternion `(w, x, y, z)`.
 pub fn matrix_from_quaternion<T: Scalar>(q: &Vector4<T>) -> Matrix3<T> {
-    let (w, x, y, z) = (q.x, q.y, q.z, q.w);
-    let two = cst::<T>(2.0);
-    let one = T::one();
-    Matrix3::new(
+    let [r00, r01, r02, r10, r11, r12, r20, r21, r22] =
+        rotation_entries([q.x, q.y, q.z, q.w], T::one(), cst::<T>(2.0));
+    Matrix3::new(r00, r01, r02, r10, r11, r12, r20, r21, r22)
+}
+
+/// The entries, row by row, of the rotation matrix of the unit quaternion
+/// `(w, x, y, z)` — [`matrix_from_quaternion`]'s, for any numbers with the
+/// four operations (also pairs of nodes' at once, `pose_pair`).
+pub(crate) fn rotation_entries<T>([w, x, y, z]: [T; 4], one: T, two: T) -> [T; 9]
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T> + std::ops::Mul<Output = T>,
+{
+    [
         one - two * (y * y + z * z),
         two * (x * y - w * z),
         two * (x * z + w * y),
@@ -232,7 +241,7 @@ pub fn matrix_from_quaternion<T: Scalar>(q: &Vector4<T>) -> Matrix3<T> {
         two * (x * z - w * y),
         two * (y * z + w * x),
         one - two * (x * x + y * y),
-    )
+    ]
 }
 
 /// Rotation vector of a unit quaternion `(w, x, y, z)`, `|ψ| ≤ π`:
