@@ -7,6 +7,7 @@
 pub mod expr;
 pub mod rotation;
 pub mod rotation_derivatives;
+pub mod rotation_pair;
 pub mod scalar;
 
 pub use scalar::{cst, Scalar};

@@ -8,20 +8,10 @@
 //! trace) each goes its own way through [`increment_pose`].
 
 use crate::rotation::{rotation_entries, SERIES_LIMIT};
+use crate::rotation_pair::{cross, from_trace, matrices, pair, quaternion_from_trace, vectors, V2};
 use crate::state::increment_pose;
 use nalgebra::{Matrix3, Vector3};
 use wide::f64x2;
-
-/// A 3-vector of pairs: lane `k` is node `k`'s.
-type V = [f64x2; 3];
-
-fn pair(a: f64, b: f64) -> f64x2 {
-    f64x2::new([a, b])
-}
-
-fn vector(v: [&Vector3<f64>; 2]) -> V {
-    std::array::from_fn(|i| pair(v[0][i], v[1][i]))
-}
 
 /// `increment_pose(x[k], rot[k], u[k], phi[k])` for `k = 0, 1`.
 pub fn increment_pose_pair(
@@ -31,10 +21,6 @@ pub fn increment_pose_pair(
     phi: [&Vector3<f64>; 2],
 ) {
     let t2: [f64; 2] = std::array::from_fn(|k| phi[k].norm_squared());
-    let from_trace = |r: &Matrix3<f64>| {
-        let tr = r[(0, 0)] + r[(1, 1)] + r[(2, 2)];
-        tr >= r[(0, 0)] && tr >= r[(1, 1)] && tr >= r[(2, 2)]
-    };
     let lanes = t2.iter().all(|&t| t < SERIES_LIMIT) && from_trace(rot[0]) && from_trace(rot[1]);
     let [x0, x1] = x;
     let [r0, r1] = rot;
@@ -45,8 +31,8 @@ pub fn increment_pose_pair(
     }
     *x0 += u[0];
     *x1 += u[1];
-    let e = exp_series(&vector(phi), pair(t2[0], t2[1]));
-    let q = from_trace_quaternion([r0, r1]);
+    let e = exp_series(&vectors(phi), pair(t2[0], t2[1]));
+    let q = quaternion_from_trace(&matrices([r0, r1]));
     let p = normalize(product(&e, &q));
     let m = rotation_entries(p, f64x2::splat(1.0), f64x2::splat(2.0));
     for (k, r) in [r0, r1].into_iter().enumerate() {
@@ -87,7 +73,7 @@ pub fn increment_poses(
 }
 
 /// `exp_quaternion` by its series (`|ψ|² = t2 <` [`SERIES_LIMIT`]).
-fn exp_series(psi: &V, t2: f64x2) -> [f64x2; 4] {
+fn exp_series(psi: &V2, t2: f64x2) -> [f64x2; 4] {
     let x = t2 * f64x2::splat(0.25);
     let w = horner(x, &[1.0, -0.5, 1.0 / 24.0, -1.0 / 720.0, 1.0 / 40320.0]);
     let f = horner(
@@ -112,31 +98,12 @@ fn horner(x: f64x2, c: &[f64]) -> f64x2 {
     acc
 }
 
-/// `quaternion_from_matrix` where the trace is the largest diagonal term
-/// (then `w > 0`).
-fn from_trace_quaternion(r: [&Matrix3<f64>; 2]) -> [f64x2; 4] {
-    let at = |i: usize, j: usize| pair(r[0][(i, j)], r[1][(i, j)]);
-    let tr = at(0, 0) + at(1, 1) + at(2, 2);
-    let w = (f64x2::splat(1.0) + tr).sqrt() * f64x2::splat(0.5);
-    let f = f64x2::splat(0.25) / w;
-    [
-        w,
-        (at(2, 1) - at(1, 2)) * f,
-        (at(0, 2) - at(2, 0)) * f,
-        (at(1, 0) - at(0, 1)) * f,
-    ]
-}
-
 /// The Hamilton product `a ⊗ b`, as `quaternion_product`.
 fn product(a: &[f64x2; 4], b: &[f64x2; 4]) -> [f64x2; 4] {
     let (aw, av) = (a[0], [a[1], a[2], a[3]]);
     let (bw, bv) = (b[0], [b[1], b[2], b[3]]);
-    let cross = [
-        av[1] * bv[2] - av[2] * bv[1],
-        av[2] * bv[0] - av[0] * bv[2],
-        av[0] * bv[1] - av[1] * bv[0],
-    ];
-    let v: V = std::array::from_fn(|i| bv[i] * aw + av[i] * bw + cross[i]);
+    let cross = cross(&av, &bv);
+    let v: V2 = std::array::from_fn(|i| bv[i] * aw + av[i] * bw + cross[i]);
     let dot = av[0] * bv[0] + av[1] * bv[1] + av[2] * bv[2];
     [aw * bw - dot, v[0], v[1], v[2]]
 }

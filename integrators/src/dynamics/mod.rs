@@ -33,6 +33,7 @@ mod midpoint_predictor;
 mod midpoint_sensitivity;
 pub mod momentum;
 pub mod newmark;
+mod newmark_pair;
 pub mod newmark_sensitivity;
 mod newmark_terms;
 pub mod simulation;

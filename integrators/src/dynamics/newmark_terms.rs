@@ -6,6 +6,7 @@
 
 use super::checkpoint::{CheckpointMismatch, Tape};
 use super::mass_slots::MassSlots;
+use super::newmark_pair::inertial_moments;
 use super::newmark_sensitivity::NewmarkSensitivities;
 use super::slave_velocities;
 use super::time_scheme::{SchemeSensitivities, TimeScheme};
@@ -146,7 +147,7 @@ fn acceleration_of_increment<T: flexmech_core::Scalar>(
 
 /// Inertial moment `Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁)` of node `i` for the end
 /// rotation `r1`, `Ȧ` the body angular acceleration (generic, for AD).
-fn inertial_moment<T: flexmech_core::Scalar>(
+pub(super) fn inertial_moment<T: flexmech_core::Scalar>(
     k: &Coefficients,
     j0: &Matrix3<f64>,
     r_n: &Matrix3<f64>,
@@ -337,7 +338,15 @@ impl StepTerms for NewmarkTerms {
         // Translational inertia M q̈ₙ₊₁ from the pseudo-acceleration
         // aₙ₊₁ = (u − Δt vₙ − Δt²(½−β)aₙ)/(βΔt²); rotational
         // Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), its tangent in closed form in a spin of
-        // Rₙ₊₁ ([`inertial_moment_tangent`]).
+        // Rₙ₊₁ ([`inertial_moment_tangent`]). Without the tangent, the
+        // moments two nodes at a time ([`inertial_moments`], the same bits).
+        let moments = tangent.is_none().then(|| {
+            let rotations = (&start.rot[..], &end.rot[..]);
+            inertial_moments(k, &self.inertia.rotational, rotations, prev, dt, |i| {
+                let j0 = &self.inertia.rotational[i];
+                inertial_moment(k, j0, &start.rot[i], &end.rot[i], prev, i, dt)
+            })
+        });
         self.slots.add_inertia(
             &self.inertia,
             g,
@@ -349,10 +358,12 @@ impl StepTerms for NewmarkTerms {
             },
             |m, a| a.map(|a| m * a),
             k.stiffness(dt),
-            |i, j0, tangent| {
-                if tangent {
+            |i, j0, tangent| match (tangent, &moments) {
+                (true, _) => {
                     inertial_moment_tangent(k, j0, &start.rot[i], &end.rot[i], prev, i, dt)
-                } else {
+                }
+                (false, Some(m)) => (m[i], Matrix3::zeros()),
+                (false, None) => {
                     let m = inertial_moment(k, j0, &start.rot[i], &end.rot[i], prev, i, dt);
                     (m, Matrix3::zeros())
                 }
