@@ -346,7 +346,7 @@ pub fn cayley<T: Scalar>(theta: &Vector3<T>) -> Matrix3<T> {
 
 /// Below this `1 + tr Λ` (rotations beyond 120°) [`cayley_inverse`] goes
 /// through the quaternion, whose largest component is then not `w`.
-const CAYLEY_DIRECT: f64 = 1.0;
+pub(crate) const CAYLEY_DIRECT: f64 = 1.0;
 
 /// Inverse Cayley transform: the tangent-scaled vector `θ` with `cay(θ) = Λ`
 /// (undefined for half turns). From `cay(θ) = I + f(θ̂ + ½θ̂²)`,

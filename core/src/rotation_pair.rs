@@ -5,7 +5,7 @@
 //! lane holds the bits the one-node map gives. Where the lanes would take
 //! different branches, each lane goes through the one-node map.
 
-use crate::rotation::log;
+use crate::rotation::{log, CAYLEY_DIRECT};
 use nalgebra::{Matrix3, Vector3};
 use wide::f64x2;
 
@@ -85,6 +85,18 @@ pub fn quaternion_from_trace(r: &M2) -> [f64x2; 4] {
     let w = (f64x2::splat(1.0) + tr).sqrt() * f64x2::splat(0.5);
     let f = f64x2::splat(0.25) / w;
     [w, (r[7] - r[5]) * f, (r[2] - r[6]) * f, (r[3] - r[1]) * f]
+}
+
+/// [`crate::rotation::cayley_inverse`] of two rotations given as pairs,
+/// where both take its direct branch (`1 + tr ≥ 1`; `None` otherwise):
+/// `θ = 2 vee(Λ − Λᵀ)/(1 + tr Λ)`.
+pub fn cayley_inverse_pair(r: &M2) -> Option<V2> {
+    let tr1 = f64x2::splat(1.0) + r[0] + r[4] + r[8];
+    if !tr1.to_array().iter().all(|&t| t >= CAYLEY_DIRECT) {
+        return None;
+    }
+    let f = f64x2::splat(2.0) / tr1;
+    Some([(r[7] - r[5]) * f, (r[2] - r[6]) * f, (r[3] - r[1]) * f])
 }
 
 /// [`log`] of two rotations, `r` also given as pairs (`packed`).

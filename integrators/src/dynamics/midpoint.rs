@@ -24,6 +24,7 @@
 
 use super::bordered::{self, Bordered};
 use super::checkpoint::{CheckpointMismatch, Tape};
+use super::inertia_pairs::{midpoint_moment_pair, moments_in_pairs};
 use super::mass_slots::MassSlots;
 use super::midpoint_kernels::{
     correction_size, element_force, element_kernel, start_of, started_force, started_kernel,
@@ -104,7 +105,7 @@ fn inertial_moment(
 
 /// `(πₙ₊₁ − πₙ)/Δt` for the end rotation `r1` (generic, for AD), with
 /// `Wₙ₊₁ = 2 Rₙᵀ cay⁻¹(Rₙ₊₁Rₙᵀ)/Δt − Wₙ`.
-fn inertial_moment_at<T: flexmech_core::Scalar>(
+pub(super) fn inertial_moment_at<T: flexmech_core::Scalar>(
     j0: &Matrix3<f64>,
     r_n: &Matrix3<f64>,
     r1: &Matrix3<T>,
@@ -229,7 +230,17 @@ impl StepTerms for MidpointTerms {
     ) {
         let dt = self.dt;
         // Translational inertia: Σⱼ m_ij (vⱼ,ₙ₊₁ − vⱼ,ₙ)/Δt, vₙ₊₁ = 2(xₙ₊₁ − xₙ)/Δt − vₙ;
-        // rotational (πₙ₊₁ − πₙ)/Δt, node by node.
+        // rotational (πₙ₊₁ − πₙ)/Δt, node by node — without the tangent two
+        // nodes at a time ([`moments_in_pairs`], the same bits).
+        let (j0, w_n) = (&self.inertia.rotational, &self.w_n);
+        let moments = tangent.is_none().then(|| {
+            let pi_n = |i: usize| start.rot[i] * (j0[i] * w_n[i]);
+            moments_in_pairs(
+                j0,
+                |i| inertial_moment_at(&j0[i], &start.rot[i], &end.rot[i], &w_n[i], dt),
+                |i| midpoint_moment_pair((j0, &start.rot, &end.rot), (w_n, pi_n), i, dt),
+            )
+        });
         self.slots.add_inertia(
             &self.inertia,
             g,
@@ -238,8 +249,9 @@ impl StepTerms for MidpointTerms {
             |j| (end.x[j] - start.x[j]) * (2.0 / dt) - self.v_n[j] * 2.0,
             |m, dv| dv.map(|d| m * d / dt),
             2.0 / (dt * dt),
-            |i, j0, tangent| {
-                inertial_moment(j0, &start.rot[i], &end.rot[i], &self.w_n[i], dt, tangent)
+            |i, j0, tangent| match (tangent, &moments) {
+                (false, Some(m)) => (m[i], Matrix3::zeros()),
+                _ => inertial_moment(j0, &start.rot[i], &end.rot[i], &w_n[i], dt, tangent),
             },
         );
     }

@@ -5,8 +5,8 @@
 //! the trapezoidal rule bit for bit when `α_m = α_f = 0`.
 
 use super::checkpoint::{CheckpointMismatch, Tape};
+use super::inertia_pairs::{moments_in_pairs, newmark_moment_pair};
 use super::mass_slots::MassSlots;
-use super::newmark_pair::inertial_moments;
 use super::newmark_sensitivity::NewmarkSensitivities;
 use super::slave_velocities;
 use super::time_scheme::{SchemeSensitivities, TimeScheme};
@@ -340,12 +340,21 @@ impl StepTerms for NewmarkTerms {
         // Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), its tangent in closed form in a spin of
         // Rₙ₊₁ ([`inertial_moment_tangent`]). Without the tangent, the
         // moments two nodes at a time ([`inertial_moments`], the same bits).
+        let j0 = &self.inertia.rotational;
         let moments = tangent.is_none().then(|| {
-            let rotations = (&start.rot[..], &end.rot[..]);
-            inertial_moments(k, &self.inertia.rotational, rotations, prev, dt, |i| {
-                let j0 = &self.inertia.rotational[i];
-                inertial_moment(k, j0, &start.rot[i], &end.rot[i], prev, i, dt)
-            })
+            moments_in_pairs(
+                j0,
+                |i| inertial_moment(k, &j0[i], &start.rot[i], &end.rot[i], prev, i, dt),
+                |i| {
+                    Some(newmark_moment_pair(
+                        k,
+                        (j0, &start.rot, &end.rot),
+                        prev,
+                        i,
+                        dt,
+                    ))
+                },
+            )
         });
         self.slots.add_inertia(
             &self.inertia,
