@@ -3,12 +3,15 @@
 //! quaternions — one node in each lane of a pair of doubles: the same
 //! operations in the same order (no fused products), so the same bits,
 //! with the square roots and divisions of both nodes issued together (a
-//! node's chain of them is what its update waits on). Where the two nodes take different branches of the rotation
-//! maps (a large increment, a rotation whose quaternion is not read from its
-//! trace) each goes its own way through [`increment_pose`].
+//! node's chain of them is what its update waits on). Where the two nodes
+//! take different branches of the rotation maps (a large increment, a
+//! rotation whose quaternion is not read from its trace) each goes its own
+//! way through [`increment_pose`].
 
 use crate::rotation::{rotation_entries, SERIES_LIMIT};
-use crate::rotation_pair::{cross, from_trace, matrices, pair, quaternion_from_trace, vectors, V2};
+use crate::rotation_pair::{
+    cross, from_trace, matrices, pair, quaternion_from_trace, unpack, vectors, V2,
+};
 use crate::state::increment_pose;
 use nalgebra::{Matrix3, Vector3};
 use wide::f64x2;
@@ -36,7 +39,7 @@ pub fn increment_pose_pair(
     let p = normalize(product(&e, &q));
     let m = rotation_entries(p, f64x2::splat(1.0), f64x2::splat(2.0));
     for (k, r) in [r0, r1].into_iter().enumerate() {
-        *r = Matrix3::from_fn(|i, j| m[3 * i + j].to_array()[k]);
+        *r = unpack(&m, k);
     }
 }
 

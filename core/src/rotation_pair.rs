@@ -32,6 +32,12 @@ pub fn matrices(m: [&Matrix3<f64>; 2]) -> M2 {
     std::array::from_fn(|e| pair(m[0][(e / 3, e % 3)], m[1][(e / 3, e % 3)]))
 }
 
+/// Lane `k` of a matrix of pairs (the inverse of [`matrices`]).
+#[inline]
+pub fn unpack(m: &M2, k: usize) -> Matrix3<f64> {
+    Matrix3::from_fn(|i, j| m[3 * i + j].to_array()[k])
+}
+
 /// Lane `k` of a vector of pairs.
 #[inline]
 pub fn lane(v: &V2, k: usize) -> Vector3<f64> {
@@ -99,10 +105,11 @@ pub fn cayley_inverse_pair(r: &M2) -> Option<V2> {
     Some([(r[7] - r[5]) * f, (r[2] - r[6]) * f, (r[3] - r[1]) * f])
 }
 
-/// [`log`] of two rotations, `r` also given as pairs (`packed`).
-pub fn log_pair(r: [&Matrix3<f64>; 2], packed: &M2) -> V2 {
-    if !(from_trace(r[0]) && from_trace(r[1])) {
-        let [a, b] = r.map(log);
+/// [`log`] of two rotations given as pairs.
+pub fn log_pair(packed: &M2) -> V2 {
+    let r = [0, 1].map(|k| unpack(packed, k));
+    if !(from_trace(&r[0]) && from_trace(&r[1])) {
+        let [a, b] = r.map(|r| log(&r));
         return vectors([&a, &b]);
     }
     let [w, x, y, z] = quaternion_from_trace(packed);
@@ -161,7 +168,7 @@ mod tests {
             scale in prop::array::uniform2(-4.0..0.5f64),
         ) {
             let r = [0, 1].map(|k| exp(&(Vector3::from(dir[k]) * 10f64.powf(scale[k]))));
-            let l = log_pair([&r[0], &r[1]], &matrices([&r[0], &r[1]]));
+            let l = log_pair(&matrices([&r[0], &r[1]]));
             for (k, r) in r.iter().enumerate() {
                 let one = log(r);
                 prop_assert!(one.iter().zip(lane(&l, k).iter()).all(|(a, b)| a.to_bits() == b.to_bits()));

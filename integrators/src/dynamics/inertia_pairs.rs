@@ -62,9 +62,7 @@ pub(super) fn newmark_moment_pair(
     let v = |x: &[Vector3<f64>]| vectors([&x[i[0]], &x[i[1]]]);
     let s = f64x2::splat;
     // ω = log(Rₙ₊₁Rₙᵀ), the body increment Rₙᵀω and the pseudo-acceleration.
-    let rel = mat_mat_t(&r1p, &rn);
-    let rel_m = [0, 1].map(|l| Matrix3::from_fn(|a, b| rel[3 * a + b].to_array()[l]));
-    let omega = log_pair([&rel_m[0], &rel_m[1]], &rel);
+    let omega = log_pair(&mat_mat_t(&r1p, &rn));
     let big = mat_t_vec(&rn, &omega);
     let (w_n, a_n) = (v(&prev.w), v(&prev.alpha));
     let (c_a, c_div) = (dt * dt * (0.5 - k.beta), k.beta * dt * dt);
