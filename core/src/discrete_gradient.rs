@@ -70,6 +70,7 @@ use crate::rotation::{
     quaternion_product, skew, tangent, tangent_inverse,
 };
 use crate::scalar::{cst, Scalar};
+use crate::secant_pair::{secant_operators_both, EndView};
 use nalgebra::{Matrix3, SVector, Vector3, Vector4};
 
 /// Width `ε` of the rank-one corrections' regularisation, relative to
@@ -173,6 +174,45 @@ pub(crate) fn secant_operators_at<T: Scalar>(
 
 /// The discrete gradient's [`Step`] between two poses' [`Frames`].
 pub(crate) fn dg_step_of<T: Scalar>(s: &Frames<T>, e: &Frames<T>) -> Step<T> {
+    dg_step_with(s, e, |s, e, g, theta| {
+        [
+            secant_operators_at(&s.lam[0], &s.rel, &s.half, g, theta),
+            secant_operators_at(&e.lam[0], &e.rel, &e.half, &(-g), &theta.map(|t| -t)),
+        ]
+    })
+}
+
+/// [`dg_step_of`] with the operators of both ends computed two at once
+/// ([`crate::secant_pair`]): the same bits.
+pub(crate) fn dg_step_in_pairs(s: &Frames<f64>, e: &Frames<f64>) -> Step<f64> {
+    dg_step_with(s, e, |s, e, g, theta| {
+        secant_operators_both([
+            EndView {
+                lam1: &s.lam[0],
+                rel0: &s.rel,
+                half0: &s.half,
+                g: *g,
+                th: *theta,
+            },
+            EndView {
+                lam1: &e.lam[0],
+                rel0: &e.rel,
+                half0: &e.half,
+                g: -g,
+                th: theta.map(|t| -t),
+            },
+        ])
+    })
+}
+
+/// The discrete gradient's [`Step`] with the secant operators `(B, T)` of
+/// the step seen from its start and from its end, `[start, end]`, from
+/// `both` of the two poses' [`Frames`], the reference rotation's relative
+/// increment `g` and the nodes' increments `θᵢ`.
+fn dg_step_with<T: Scalar, F>(s: &Frames<T>, e: &Frames<T>, both: F) -> Step<T>
+where
+    F: Fn(&Frames<T>, &Frames<T>, &Vector3<T>, &[Vector3<T>; 2]) -> [(Matrix3<T>, Matrix3<T>); 2],
+{
     let half = cst::<T>(0.5);
     let theta = [0, 1].map(|i| cayley_inverse(&mmt(&e.lam[i], &s.lam[i])));
     let dtheta = theta[1] - theta[0];
@@ -181,8 +221,7 @@ pub(crate) fn dg_step_of<T: Scalar>(s: &Frames<T>, e: &Frames<T>) -> Step<T> {
     // time, hence consistent at second order; seen from the end, the
     // reference rotation's relative increment is the start's reversed.
     let g = relative_cayley(&e.half, &s.half);
-    let (bf, tf) = secant_operators_at(&s.lam[0], &s.rel, &s.half, &g, &theta);
-    let (bb, tb) = secant_operators_at(&e.lam[0], &e.rel, &e.half, &(-g), &theta.map(|t| -t));
+    let [(bf, tf), (bb, tb)] = both(s, e, &g, &theta);
     let (b, t) = ((bf + bb) * half, (tf + tb) * half);
     let eps = (T::one() + theta[0].norm_squared() + theta[1].norm_squared()) * cst::<T>(RIGID_STEP);
     Step {

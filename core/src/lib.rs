@@ -9,6 +9,7 @@ pub mod rotation;
 pub mod rotation_derivatives;
 pub mod rotation_pair;
 pub mod scalar;
+mod secant_pair;
 
 pub use scalar::{cst, Scalar};
 pub mod conserving;

@@ -121,7 +121,7 @@ pub fn log_pair(packed: &M2) -> V2 {
 /// `log_quaternion`'s factor `2 atan(s/w)/s` of the vector part (`w > 0`,
 /// `s² = s2`): by its series where `s² < 10⁻⁶ w²`, else through `atan2`,
 /// called lane by lane.
-fn log_factor(w: f64x2, s2: f64x2) -> f64x2 {
+pub(crate) fn log_factor(w: f64x2, s2: f64x2) -> f64x2 {
     let (wa, sa) = (w.to_array(), s2.to_array());
     let series = [0, 1].map(|k| sa[k] < 1e-6 * wa[k] * wa[k]);
     let two = f64x2::splat(2.0);

@@ -7,7 +7,7 @@
 //! recomputed: the same arithmetic, so the same results to the bit (tested).
 
 use crate::conserving::{Frames, Pose};
-use crate::discrete_gradient::{dg_step_of, step_force};
+use crate::discrete_gradient::{dg_step_in_pairs, step_force};
 use crate::element::BeamElement;
 use nalgebra::{SMatrix, SVector};
 
@@ -44,7 +44,7 @@ impl BeamElement<2> {
     ) -> (SVector<f64, 12>, SVector<f64, 12>) {
         let (s, e) = (&start.frames, &self.frames(end));
         let (nbar, mbar) = self.averaged_resultants(s, e);
-        step_force(&dg_step_of(s, e), &nbar, &mbar)
+        step_force(&dg_step_in_pairs(s, e), &nbar, &mbar)
     }
 
     /// [`Self::energy_momentum_force_cheap_tangent`] from a step's start.
@@ -55,7 +55,7 @@ impl BeamElement<2> {
     ) -> (SVector<f64, 12>, SMatrix<f64, 12, 12>) {
         let (s0, s1) = (&start.frames, &self.frames(end));
         let (nbar, mbar) = self.averaged_resultants(s0, s1);
-        let q = step_force(&dg_step_of(s0, s1), &nbar, &mbar).0;
+        let q = step_force(&dg_step_in_pairs(s0, s1), &nbar, &mbar).0;
         (q, self.momentum_tangent_of(s0, s1).1)
     }
 }
