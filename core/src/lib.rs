@@ -18,6 +18,7 @@ pub mod discrete_gradient;
 pub mod discrete_gradient_quadratic;
 pub mod element;
 pub mod element_linear;
+pub mod element_pair;
 pub mod element_quadratic;
 pub mod inertia;
 pub mod section;

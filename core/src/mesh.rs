@@ -394,6 +394,16 @@ pub struct RelativeRotations {
     len: usize,
 }
 
+impl RelativeRotations {
+    /// A 2-node element's relative rotation.
+    pub(crate) fn one(phi: Vector3<f64>) -> Self {
+        Self {
+            values: [phi, Vector3::zeros()],
+            len: 1,
+        }
+    }
+}
+
 impl std::ops::Deref for RelativeRotations {
     type Target = [Vector3<f64>];
 

@@ -5,7 +5,7 @@
 //! lane holds the bits the one-node map gives. Where the lanes would take
 //! different branches, each lane goes through the one-node map.
 
-use crate::rotation::{log, CAYLEY_DIRECT};
+use crate::rotation::{log, rodrigues_coefficients, tangent_inverse_coefficient, CAYLEY_DIRECT};
 use nalgebra::{Matrix3, Vector3};
 use wide::f64x2;
 
@@ -63,6 +63,111 @@ pub fn mat_mat_t(a: &M2, b: &M2) -> M2 {
         let (i, j) = (e / 3, e % 3);
         a[3 * i] * b[3 * j] + a[3 * i + 1] * b[3 * j + 1] + a[3 * i + 2] * b[3 * j + 2]
     })
+}
+
+/// `(v, v)`.
+#[inline]
+pub fn splat(v: f64) -> f64x2 {
+    f64x2::splat(v)
+}
+
+/// A scalar function of one lane applied lane by lane.
+#[inline]
+pub fn by_lane(x: f64x2, f: impl Fn(f64) -> f64) -> f64x2 {
+    let a = x.to_array();
+    pair(f(a[0]), f(a[1]))
+}
+
+/// `a·b`, summed `(a₀b₀ + a₁b₁) + a₂b₂` as nalgebra sums a 3-vector's.
+#[inline]
+pub fn dot(a: &V2, b: &V2) -> f64x2 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// `s v`.
+#[inline]
+pub fn scale(v: &V2, s: f64x2) -> V2 {
+    v.map(|x| x * s)
+}
+
+/// `â`, row by row (as [`crate::rotation::skew`]).
+#[inline]
+pub fn skew(a: &V2) -> M2 {
+    let z = splat(0.0);
+    [z, -a[2], a[1], a[2], z, -a[0], -a[1], a[0], z]
+}
+
+/// `a aᵀ − |a|² I` (as [`crate::rotation::skew_squared`]).
+#[inline]
+pub fn skew_squared(a: &V2) -> M2 {
+    let n = dot(a, a);
+    std::array::from_fn(|e| {
+        let (i, j) = (e / 3, e % 3);
+        if i == j {
+            a[i] * a[i] - n
+        } else {
+            a[i] * a[j]
+        }
+    })
+}
+
+/// The identity's entry `e` (row by row).
+#[inline]
+pub fn id(e: usize) -> f64x2 {
+    splat(if e.is_multiple_of(4) { 1.0 } else { 0.0 })
+}
+
+/// `s m`.
+#[inline]
+pub fn mat_scale(m: &M2, s: f64x2) -> M2 {
+    m.map(|x| x * s)
+}
+
+/// `a b`, each entry summed left to right (as [`crate::rotation::mm`] and
+/// nalgebra's product).
+#[inline]
+pub fn mat_mat(a: &M2, b: &M2) -> M2 {
+    std::array::from_fn(|e| {
+        let (i, j) = (e / 3, e % 3);
+        a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j]
+    })
+}
+
+/// `aᵀ b`, each entry summed left to right (as [`crate::rotation::mtm`]).
+#[inline]
+pub fn mat_t_mat(a: &M2, b: &M2) -> M2 {
+    std::array::from_fn(|e| {
+        let (i, j) = (e / 3, e % 3);
+        a[i] * b[j] + a[3 + i] * b[3 + j] + a[6 + i] * b[6 + j]
+    })
+}
+
+/// [`crate::rotation::exp`].
+#[inline]
+pub fn exp(psi: &V2) -> M2 {
+    let t2 = dot(psi, psi).to_array();
+    let [(a0, b0, _), (a1, b1, _)] = t2.map(rodrigues_coefficients::<f64>);
+    let (a, b) = (pair(a0, a1), pair(b0, b1));
+    let (sk, sq) = (skew(psi), skew_squared(psi));
+    std::array::from_fn(|e| id(e) + sk[e] * a + sq[e] * b)
+}
+
+/// [`crate::rotation::tangent`].
+#[inline]
+pub fn tangent(psi: &V2) -> M2 {
+    let t2 = dot(psi, psi).to_array();
+    let [(_, b0, c0), (_, b1, c1)] = t2.map(rodrigues_coefficients::<f64>);
+    let (b, c) = (pair(b0, b1), pair(c0, c1));
+    let (sk, sq) = (skew(psi), skew_squared(psi));
+    std::array::from_fn(|e| id(e) + sk[e] * b + sq[e] * c)
+}
+
+/// [`crate::rotation::tangent_inverse`].
+#[inline]
+pub fn tangent_inverse(psi: &V2) -> M2 {
+    let d = by_lane(dot(psi, psi), tangent_inverse_coefficient::<f64>);
+    let (sk, sq) = (skew(psi), skew_squared(psi));
+    std::array::from_fn(|e| id(e) - sk[e] * splat(0.5) + sq[e] * d)
 }
 
 /// `a × b`, as nalgebra's `cross`.

@@ -9,8 +9,10 @@
 //! the one-end functions called lane by lane, so each lane holds the bits
 //! the one-end operators give (tested on every branch).
 
-use crate::rotation::{rodrigues_coefficients, tangent_inverse_coefficient};
-use crate::rotation_pair::{log_factor, mat_vec, pair, unpack, M2, V2};
+use crate::rotation_pair::{
+    cross, dot, id, log_factor, mat_mat, mat_scale, mat_t_mat, mat_vec, pair, scale, skew, splat,
+    tangent, tangent_inverse, unpack, M2, V2,
+};
 use nalgebra::{Matrix3, Vector3, Vector4};
 use wide::f64x2;
 
@@ -29,11 +31,6 @@ pub(crate) struct EndView<'a> {
 }
 
 #[inline]
-fn splat(v: f64) -> f64x2 {
-    f64x2::splat(v)
-}
-
-#[inline]
 fn vec2(a: &Vector3<f64>, b: &Vector3<f64>) -> V2 {
     std::array::from_fn(|i| pair(a[i], b[i]))
 }
@@ -46,84 +43,6 @@ fn mat2(a: &Matrix3<f64>, b: &Matrix3<f64>) -> M2 {
 #[inline]
 fn quat2(a: &Vector4<f64>, b: &Vector4<f64>) -> Q2 {
     std::array::from_fn(|i| pair(a[i], b[i]))
-}
-
-/// A scalar function of one lane applied lane by lane.
-#[inline]
-fn by_lane(x: f64x2, f: impl Fn(f64) -> f64) -> f64x2 {
-    let a = x.to_array();
-    pair(f(a[0]), f(a[1]))
-}
-
-/// `a·b`, summed `(a₀b₀ + a₁b₁) + a₂b₂` as nalgebra sums a 3-vector's.
-#[inline]
-fn dot(a: &V2, b: &V2) -> f64x2 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline]
-fn scale(v: &V2, s: f64x2) -> V2 {
-    v.map(|x| x * s)
-}
-
-/// `â`, row by row (as [`crate::rotation::skew`]).
-#[inline]
-fn skew(a: &V2) -> M2 {
-    let z = splat(0.0);
-    [z, -a[2], a[1], a[2], z, -a[0], -a[1], a[0], z]
-}
-
-/// `a aᵀ − |a|² I` (as [`crate::rotation::skew_squared`]).
-#[inline]
-fn skew_squared(a: &V2) -> M2 {
-    let n = dot(a, a);
-    std::array::from_fn(|e| {
-        let (i, j) = (e / 3, e % 3);
-        if i == j {
-            a[i] * a[i] - n
-        } else {
-            a[i] * a[j]
-        }
-    })
-}
-
-/// The identity's entry `e` (row by row).
-#[inline]
-fn id(e: usize) -> f64x2 {
-    splat(if e.is_multiple_of(4) { 1.0 } else { 0.0 })
-}
-
-#[inline]
-fn mat_scale(m: &M2, s: f64x2) -> M2 {
-    m.map(|x| x * s)
-}
-
-/// `a b`, each entry summed left to right (as [`crate::rotation::mm`]).
-#[inline]
-fn mat_mat(a: &M2, b: &M2) -> M2 {
-    std::array::from_fn(|e| {
-        let (i, j) = (e / 3, e % 3);
-        a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j]
-    })
-}
-
-/// `aᵀ b`, each entry summed left to right (as [`crate::rotation::mtm`]).
-#[inline]
-fn mat_t_mat(a: &M2, b: &M2) -> M2 {
-    std::array::from_fn(|e| {
-        let (i, j) = (e / 3, e % 3);
-        a[i] * b[j] + a[3 + i] * b[3 + j] + a[6 + i] * b[6 + j]
-    })
-}
-
-/// `a × b` (as nalgebra's `cross`).
-#[inline]
-fn cross(a: &V2, b: &V2) -> V2 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// [`crate::rotation::quaternion_product`].
@@ -165,24 +84,6 @@ fn relative_cayley_of_half(q: &Q2, half0: &Q2) -> V2 {
     let h = [w1 * f, q[1] * f, q[2] * f, q[3] * f];
     let p = product(&h, &[half0[0], -half0[1], -half0[2], -half0[3]]);
     scale(&[p[1], p[2], p[3]], splat(2.0) / p[0])
-}
-
-/// [`crate::rotation::tangent_inverse`].
-#[inline]
-fn tangent_inverse(psi: &V2) -> M2 {
-    let d = by_lane(dot(psi, psi), tangent_inverse_coefficient::<f64>);
-    let (sk, sq) = (skew(psi), skew_squared(psi));
-    std::array::from_fn(|e| id(e) - sk[e] * splat(0.5) + sq[e] * d)
-}
-
-/// [`crate::rotation::tangent`].
-#[inline]
-fn tangent(psi: &V2) -> M2 {
-    let t2 = dot(psi, psi).to_array();
-    let [(_, b0, c0), (_, b1, c1)] = t2.map(rodrigues_coefficients::<f64>);
-    let (b, c) = (pair(b0, b1), pair(c0, c1));
-    let (sk, sq) = (skew(psi), skew_squared(psi));
-    std::array::from_fn(|e| id(e) + sk[e] * b + sq[e] * c)
 }
 
 /// The Cayley map's spatial tangent `Q(c)` (as the one-end kernel's).

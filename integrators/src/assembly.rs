@@ -14,6 +14,7 @@
 use crate::dofs::DofMap;
 use crate::sparsity::symmetric_pattern;
 use faer::sparse::SymbolicSparseColMat;
+use flexmech_core::element_pair::for_each_internal_force;
 use flexmech_core::{Configuration, Element, Inertia, Mesh};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector6};
 
@@ -278,7 +279,7 @@ impl Assembler {
                     None => &mut self.work[index],
                 };
                 element(w, index, el, s);
-                add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
+                add_forces(&mut self.nodal, &mut self.nodal_abs, el, w.r.as_slice());
                 add_tangent(&mut self.values, w, s);
             }
             if let Some(start) = start {
@@ -401,10 +402,24 @@ impl Assembler {
     /// The internal nodal forces only ([`Self::nodal`], [`Self::nodal_abs`];
     /// the tangent values are left as they were): for a residual check that
     /// no factorisation follows.
+    /// On one thread, the 2-node elements' forces are computed two at a
+    /// time ([`for_each_internal_force`]): the same bits.
     pub fn assemble_residual(&mut self, mesh: &Mesh, config: &Configuration) {
-        self.assemble_residual_with(mesh, |el, _, r| {
-            el.internal_force_into(&config.x, &config.rot, r)
+        let n = mesh.elements.len();
+        if self.residual_cost.split(n) {
+            return self.assemble_residual_with(mesh, |el, _, r| {
+                el.internal_force_into(&config.x, &config.rot, r)
+            });
+        }
+        let start = self.residual_cost.probing(n).then(Instant::now);
+        self.clear_forces();
+        let (nodal, nodal_abs) = (&mut self.nodal, &mut self.nodal_abs);
+        for_each_internal_force(&mesh.elements, &config.x, &config.rot, |_, el, r| {
+            add_forces(nodal, nodal_abs, el, r)
         });
+        if let Some(start) = start {
+            self.residual_cost.record(start.elapsed(), n);
+        }
     }
 
     /// [`Self::assemble_residual`] with the element forces of `kernel`
@@ -420,7 +435,7 @@ impl Assembler {
             for (index, el) in mesh.elements.iter().enumerate() {
                 let w = scratch_for(&mut self.scratch, el.dofs());
                 kernel(el, index, w.r.as_mut_slice());
-                add_forces(&mut self.nodal, &mut self.nodal_abs, el, &w.r);
+                add_forces(&mut self.nodal, &mut self.nodal_abs, el, w.r.as_slice());
             }
             if let Some(start) = start {
                 self.residual_cost.record(start.elapsed(), n);
@@ -617,14 +632,11 @@ fn map_rows<'a>(
 
 /// An element's forces `r` (6 per node, ordered as its nodes) as
 /// `(node, its six forces)`.
-fn force_blocks<'a>(
-    el: &'a Element,
-    r: &'a DVector<f64>,
-) -> impl Iterator<Item = (usize, &'a [f64])> {
+fn force_blocks<'a>(el: &'a Element, r: &'a [f64]) -> impl Iterator<Item = (usize, &'a [f64])> {
     el.nodes()
         .iter()
         .enumerate()
-        .map(move |(a, &nd)| (nd, &r.as_slice()[6 * a..6 * a + 6]))
+        .map(move |(a, &nd)| (nd, &r[6 * a..6 * a + 6]))
 }
 
 /// Adds a node's six forces to its nodal forces and their absolute values
@@ -637,7 +649,7 @@ fn add_force_block(nodal: &mut [f64], nodal_abs: &mut [f64], f: &[f64]) {
 }
 
 /// Adds an element's forces `r` to the nodal forces and scale.
-fn add_forces(nodal: &mut [f64], nodal_abs: &mut [f64], el: &Element, r: &DVector<f64>) {
+fn add_forces(nodal: &mut [f64], nodal_abs: &mut [f64], el: &Element, r: &[f64]) {
     for (nd, f) in force_blocks(el, r) {
         add_force_block(
             &mut nodal[6 * nd..6 * nd + 6],
@@ -714,7 +726,7 @@ impl<'a> Sinks<'a> {
         s: Option<&Slots>,
         only: Option<(&Split, usize, bool)>,
     ) {
-        for (nd, f) in force_blocks(el, &w.r) {
+        for (nd, f) in force_blocks(el, w.r.as_slice()) {
             if only.is_none_or(|(split, c, owned)| split.owns_node(c, nd) == owned) {
                 // SAFETY: by the caller's contract.
                 unsafe {

@@ -17,6 +17,7 @@
 use crate::constraints::MechanismState;
 use crate::error::{NewtonFailure, SolveError};
 use crate::mechanism::Mechanism;
+use flexmech_core::element_pair::relative_rotations_of;
 use flexmech_core::mesh::RelativeRotations;
 use flexmech_core::{Configuration, Element};
 
@@ -107,6 +108,9 @@ impl RotationGuard {
 
 fn rotations(mech: &Mechanism, config: &Configuration) -> Vec<RelativeRotations> {
     let elements = &mech.mesh.elements;
+    if !crate::threads::split_nodes(elements.len()) {
+        return relative_rotations_of(elements, &config.rot);
+    }
     // Each element's on its own: on two threads for a large mesh.
     crate::threads::map_nodes(elements.len(), |e| {
         elements[e].relative_rotations(&config.rot)
