@@ -9,8 +9,8 @@
 
 use super::newmark_terms::{Coefficients, Kinematics};
 use flexmech_core::rotation_pair::{
-    cayley_inverse_pair, cross, lane, log_pair, mat_mat_t, mat_t_vec, mat_vec, matrices, vectors,
-    V2,
+    cayley_inverse_pair, cross, lane, log_pair, mat_mat, mat_mat_t, mat_t_mat, mat_t_vec, mat_vec,
+    matrices, skew, tangent_inverse, unpack, vectors, M2, V2,
 };
 use nalgebra::{Matrix3, Vector3};
 use wide::f64x2;
@@ -21,18 +21,29 @@ type Rotary<'a> = (&'a [Matrix3<f64>], &'a [Matrix3<f64>], &'a [Matrix3<f64>]);
 
 /// Every node's moment (zero where the node has no rotary inertia `j0`),
 /// two nodes at a time by `pair` (`None`: where its lanes part, each node
-/// by `single`) — on two threads for a large mesh, each pair on its own,
-/// so the same either way. A last odd node, and a pair with a node without
-/// rotary inertia, go by `single`.
+/// by `single`): [`in_node_pairs`] of moments.
 pub(super) fn moments_in_pairs(
     j0: &[Matrix3<f64>],
     single: impl Fn(usize) -> Vector3<f64> + Sync,
     pair: impl Fn([usize; 2]) -> Option<V2> + Sync,
 ) -> Vec<Vector3<f64>> {
+    in_node_pairs(j0, single, |i| pair(i).map(|m| [lane(&m, 0), lane(&m, 1)]))
+}
+
+/// Every node's value (the default where the node has no rotary inertia
+/// `j0`), two nodes at a time by `pair` (`None`: each node by `single`) —
+/// on two threads for a large mesh, each pair on its own, so the same
+/// either way. A last odd node, and a pair with a node without rotary
+/// inertia, go by `single`.
+pub(super) fn in_node_pairs<T: Copy + Default + Send>(
+    j0: &[Matrix3<f64>],
+    single: impl Fn(usize) -> T + Sync,
+    pair: impl Fn([usize; 2]) -> Option<[T; 2]> + Sync,
+) -> Vec<T> {
     let n = j0.len();
-    let moment = |i: usize| {
+    let one = |i: usize| {
         if i >= n || j0[i] == Matrix3::zeros() {
-            Vector3::zeros()
+            T::default()
         } else {
             single(i)
         }
@@ -40,29 +51,39 @@ pub(super) fn moments_in_pairs(
     let pairs = crate::threads::map_nodes(n.div_ceil(2), |p| {
         let i = [2 * p, 2 * p + 1];
         let both = i[1] < n && j0[i[0]] != Matrix3::zeros() && j0[i[1]] != Matrix3::zeros();
-        match both.then(|| pair(i)).flatten() {
-            Some(m) => [lane(&m, 0), lane(&m, 1)],
-            None => i.map(moment),
-        }
+        both.then(|| pair(i))
+            .flatten()
+            .unwrap_or_else(|| i.map(one))
     });
     pairs.into_iter().flatten().take(n).collect()
 }
 
-/// The Newmark family's `inertial_moment` of nodes `i` (rotary inertias
-/// `j0`, start rotations `r_n`, end rotations `r1`).
-pub(super) fn newmark_moment_pair(
+/// The Newmark family's kinematics of a pair of nodes at the step's end:
+/// `ω = log(Rₙ₊₁Rₙᵀ)`, `Wₙ₊₁`, `Ȧₙ₊₁` and the nodes' `J₀`, `Rₙ`, `Rₙ₊₁`.
+struct NodePair {
+    omega: V2,
+    w1: V2,
+    acc1: V2,
+    j0: M2,
+    rn: M2,
+    r1: M2,
+}
+
+/// [`NodePair`] of nodes `i` (rotary inertias `j0`, start rotations `r_n`,
+/// end rotations `r1`), as the one-node kernels compute it.
+fn newmark_node_pair(
     k: &Coefficients,
     (j0, r_n, r1): Rotary<'_>,
     prev: &Kinematics,
     i: [usize; 2],
     dt: f64,
-) -> V2 {
+) -> NodePair {
     let at = |m: &[Matrix3<f64>]| matrices([&m[i[0]], &m[i[1]]]);
-    let (j0, rn, r1p) = (at(j0), at(r_n), at(r1));
+    let (j0, rn, r1) = (at(j0), at(r_n), at(r1));
     let v = |x: &[Vector3<f64>]| vectors([&x[i[0]], &x[i[1]]]);
     let s = f64x2::splat;
     // ω = log(Rₙ₊₁Rₙᵀ), the body increment Rₙᵀω and the pseudo-acceleration.
-    let omega = log_pair(&mat_mat_t(&r1p, &rn));
+    let omega = log_pair(&mat_mat_t(&r1, &rn));
     let big = mat_t_vec(&rn, &omega);
     let (w_n, a_n) = (v(&prev.w), v(&prev.alpha));
     let (c_a, c_div) = (dt * dt * (0.5 - k.beta), k.beta * dt * dt);
@@ -75,8 +96,64 @@ pub(super) fn newmark_moment_pair(
         let history = a_n[c] * s(k.alpha_m) - acc_n[c] * s(k.alpha_f);
         (a1[c] * s(1.0 - k.alpha_m) + history) / s(1.0 - k.alpha_f)
     });
-    let (j_acc, gyro) = (mat_vec(&j0, &acc1), cross(&w1, &mat_vec(&j0, &w1)));
-    mat_vec(&r1p, &std::array::from_fn(|c| j_acc[c] + gyro[c]))
+    NodePair {
+        omega,
+        w1,
+        acc1,
+        j0,
+        rn,
+        r1,
+    }
+}
+
+impl NodePair {
+    /// `J₀W` and the moment `Rₙ₊₁(J₀Ȧ + W × J₀W)`.
+    fn moment(&self) -> (V2, V2) {
+        let jw = mat_vec(&self.j0, &self.w1);
+        let (j_acc, gyro) = (mat_vec(&self.j0, &self.acc1), cross(&self.w1, &jw));
+        (
+            jw,
+            mat_vec(&self.r1, &std::array::from_fn(|c| j_acc[c] + gyro[c])),
+        )
+    }
+}
+
+/// The Newmark family's `inertial_moment` of nodes `i` (rotary inertias
+/// `j0`, start rotations `r_n`, end rotations `r1`).
+pub(super) fn newmark_moment_pair(
+    k: &Coefficients,
+    rotary: Rotary<'_>,
+    prev: &Kinematics,
+    i: [usize; 2],
+    dt: f64,
+) -> V2 {
+    newmark_node_pair(k, rotary, prev, i, dt).moment().1
+}
+
+/// The Newmark family's `inertial_moment_tangent` of nodes `i`: the moment
+/// and its derivative under a spatial spin of the end rotation,
+/// `−m̂ + Rₙ₊₁ dv/dȦ RₙᵀH⁻¹(ω)/(βΔt²)` with
+/// `dv/dȦ = (1 − α_m)/(1 − α_f) J₀ + γΔt (ŴJ₀ − (J₀W)^)`.
+pub(super) fn newmark_tangent_pair(
+    k: &Coefficients,
+    rotary: Rotary<'_>,
+    prev: &Kinematics,
+    i: [usize; 2],
+    dt: f64,
+) -> [(Vector3<f64>, Matrix3<f64>); 2] {
+    let node = newmark_node_pair(k, rotary, prev, i, dt);
+    let (jw, m) = node.moment();
+    let s = f64x2::splat;
+    let (c_j, c_g) = ((1.0 - k.alpha_m) / (1.0 - k.alpha_f), k.gamma * dt);
+    let wj = mat_mat(&skew(&node.w1), &node.j0);
+    let jw_hat = skew(&jw);
+    let dv_da: M2 = std::array::from_fn(|e| node.j0[e] * s(c_j) + (wj[e] - jw_hat[e]) * s(c_g));
+    let da_deta =
+        mat_t_mat(&node.rn, &tangent_inverse(&node.omega)).map(|x| x / s(k.beta * dt * dt));
+    let spin = mat_mat(&mat_mat(&node.r1, &dv_da), &da_deta);
+    let m_hat = skew(&m);
+    let t: M2 = std::array::from_fn(|e| -m_hat[e] + spin[e]);
+    [0, 1].map(|l| (lane(&m, l), unpack(&t, l)))
 }
 
 /// The midpoint schemes' `inertial_moment_at` of nodes `i`,
@@ -102,10 +179,15 @@ pub(super) fn midpoint_moment_pair(
 
 #[cfg(test)]
 mod tests {
-    use super::{midpoint_moment_pair, moments_in_pairs, newmark_moment_pair};
+    use super::{
+        in_node_pairs, midpoint_moment_pair, moments_in_pairs, newmark_moment_pair,
+        newmark_tangent_pair,
+    };
     use crate::dynamics::mass_slots::inertia_oracle::inertia;
     use crate::dynamics::midpoint::inertial_moment_at;
-    use crate::dynamics::newmark_terms::{inertial_moment, Coefficients, Kinematics};
+    use crate::dynamics::newmark_terms::{
+        inertial_moment, inertial_moment_tangent, Coefficients, Kinematics,
+    };
     use flexmech_core::rotation::exp;
     use nalgebra::{Matrix3, Vector3};
     use proptest::prelude::*;
@@ -156,6 +238,14 @@ mod tests {
                 for (i, got) in pairs.iter().enumerate() {
                     let expected = if i == bare { Vector3::zeros() } else { one(i) };
                     prop_assert!(expected.iter().zip(got.iter()).all(|(a, b)| a.to_bits() == b.to_bits()), "node {}", i);
+                }
+                let one = |i: usize| inertial_moment_tangent(&k, &j0[i], &r_n[i], &r1[i], &prev, i, dt);
+                let pair = |i| Some(newmark_tangent_pair(&k, (&j0, &r_n, &r1), &prev, i, dt));
+                for (i, got) in in_node_pairs(&j0, one, pair).iter().enumerate() {
+                    let expected = if i == bare { Default::default() } else { one(i) };
+                    let same = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+                    prop_assert!(same(expected.0.as_slice(), got.0.as_slice()), "moment of node {}", i);
+                    prop_assert!(same(expected.1.as_slice(), got.1.as_slice()), "tangent of node {}", i);
                 }
             }
             // The midpoint schemes' moments, on both branches of the Cayley

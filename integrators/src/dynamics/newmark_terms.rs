@@ -5,7 +5,9 @@
 //! the trapezoidal rule bit for bit when `α_m = α_f = 0`.
 
 use super::checkpoint::{CheckpointMismatch, Tape};
-use super::inertia_pairs::{moments_in_pairs, newmark_moment_pair};
+use super::inertia_pairs::{
+    in_node_pairs, moments_in_pairs, newmark_moment_pair, newmark_tangent_pair,
+};
 use super::mass_slots::MassSlots;
 use super::newmark_sensitivity::NewmarkSensitivities;
 use super::slave_velocities;
@@ -174,7 +176,7 @@ pub(super) fn inertial_moment<T: flexmech_core::Scalar>(
 /// ```
 ///
 /// equal to forward AD of [`inertial_moment`] to round-off (tested).
-fn inertial_moment_tangent(
+pub(super) fn inertial_moment_tangent(
     k: &Coefficients,
     j0: &Matrix3<f64>,
     r_n: &Matrix3<f64>,
@@ -338,8 +340,8 @@ impl StepTerms for NewmarkTerms {
         // Translational inertia M q̈ₙ₊₁ from the pseudo-acceleration
         // aₙ₊₁ = (u − Δt vₙ − Δt²(½−β)aₙ)/(βΔt²); rotational
         // Rₙ₊₁(J₀Ȧₙ₊₁ + Wₙ₊₁ × J₀Wₙ₊₁), its tangent in closed form in a spin of
-        // Rₙ₊₁ ([`inertial_moment_tangent`]). Without the tangent, the
-        // moments two nodes at a time ([`inertial_moments`], the same bits).
+        // Rₙ₊₁ ([`inertial_moment_tangent`]). Both two nodes at a time
+        // (`inertia_pairs`, the same bits).
         let j0 = &self.inertia.rotational;
         let moments = tangent.is_none().then(|| {
             moments_in_pairs(
@@ -356,6 +358,16 @@ impl StepTerms for NewmarkTerms {
                 },
             )
         });
+        let tangents = tangent.is_some().then(|| {
+            in_node_pairs(
+                j0,
+                |i| inertial_moment_tangent(k, &j0[i], &start.rot[i], &end.rot[i], prev, i, dt),
+                |i| {
+                    let rotary = (&j0[..], &start.rot[..], &end.rot[..]);
+                    Some(newmark_tangent_pair(k, rotary, prev, i, dt))
+                },
+            )
+        });
         self.slots.add_inertia(
             &self.inertia,
             g,
@@ -368,9 +380,10 @@ impl StepTerms for NewmarkTerms {
             |m, a| a.map(|a| m * a),
             k.stiffness(dt),
             |i, j0, tangent| match (tangent, &moments) {
-                (true, _) => {
-                    inertial_moment_tangent(k, j0, &start.rot[i], &end.rot[i], prev, i, dt)
-                }
+                (true, _) => match &tangents {
+                    Some(t) => t[i],
+                    None => inertial_moment_tangent(k, j0, &start.rot[i], &end.rot[i], prev, i, dt),
+                },
                 (false, Some(m)) => (m[i], Matrix3::zeros()),
                 (false, None) => {
                     let m = inertial_moment(k, j0, &start.rot[i], &end.rot[i], prev, i, dt);
