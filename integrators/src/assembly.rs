@@ -407,9 +407,7 @@ impl Assembler {
     pub fn assemble_residual(&mut self, mesh: &Mesh, config: &Configuration) {
         let n = mesh.elements.len();
         if self.residual_cost.split(n) {
-            return self.assemble_residual_with(mesh, |el, _, r| {
-                el.internal_force_into(&config.x, &config.rot, r)
-            });
+            return self.residual_in_halves(mesh, config);
         }
         let start = self.residual_cost.probing(n).then(Instant::now);
         self.clear_forces();
@@ -419,6 +417,27 @@ impl Assembler {
         });
         if let Some(start) = start {
             self.residual_cost.record(start.elapsed(), n);
+        }
+    }
+
+    /// [`Self::assemble_residual`] on two threads: each half of the
+    /// elements (cut at an even element) computes its forces two elements
+    /// at a time into the elements' own buffers, then they are summed in
+    /// element order, as on one thread — the same bits.
+    fn residual_in_halves(&mut self, mesh: &Mesh, config: &Configuration) {
+        self.own_work(mesh);
+        self.clear_forces();
+        let els = &mesh.elements;
+        let mid = (els.len() / 2) & !1;
+        let (first, second) = self.work.split_at_mut(mid);
+        let halves = vec![(&els[..mid], first), (&els[mid..], second)];
+        crate::threads::for_each_item(halves, |_, (els, work)| {
+            for_each_internal_force(els, &config.x, &config.rot, |i, _, r| {
+                work[i].r.as_mut_slice().copy_from_slice(r)
+            });
+        });
+        for (el, w) in els.iter().zip(&self.work) {
+            add_forces(&mut self.nodal, &mut self.nodal_abs, el, w.r.as_slice());
         }
     }
 

@@ -111,8 +111,15 @@ fn rotations(mech: &Mechanism, config: &Configuration) -> Vec<RelativeRotations>
     if !crate::threads::split_nodes(elements.len()) {
         return relative_rotations_of(elements, &config.rot);
     }
-    // Each element's on its own: on two threads for a large mesh.
-    crate::threads::map_nodes(elements.len(), |e| {
-        elements[e].relative_rotations(&config.rot)
-    })
+    // On two threads for a large mesh, half the elements each (cut at an
+    // even element), each element's on its own: the same either way.
+    let mid = (elements.len() / 2) & !1;
+    let halves = [&elements[..mid], &elements[mid..]];
+    let outs = halves.map(|_| std::sync::Mutex::new(Vec::new()));
+    crate::threads::for_each_item(vec![0, 1], |_, h| {
+        let rotations = relative_rotations_of(halves[h], &config.rot);
+        *outs[h].lock().unwrap_or_else(|e| e.into_inner()) = rotations;
+    });
+    let [first, second] = outs.map(|o| o.into_inner().unwrap_or_else(|e| e.into_inner()));
+    [first, second].concat()
 }
