@@ -145,21 +145,24 @@ pub fn mat_t_mat(a: &M2, b: &M2) -> M2 {
 /// [`crate::rotation::exp`].
 #[inline]
 pub fn exp(psi: &V2) -> M2 {
-    let t2 = dot(psi, psi).to_array();
-    let [(a0, b0, _), (a1, b1, _)] = t2.map(rodrigues_coefficients::<f64>);
-    let (a, b) = (pair(a0, a1), pair(b0, b1));
-    let (sk, sq) = (skew(psi), skew_squared(psi));
-    std::array::from_fn(|e| id(e) + sk[e] * a + sq[e] * b)
+    rodrigues_sum(psi, |(a, b, _)| (a, b))
 }
 
 /// [`crate::rotation::tangent`].
 #[inline]
 pub fn tangent(psi: &V2) -> M2 {
+    rodrigues_sum(psi, |(_, b, c)| (b, c))
+}
+
+/// `I + a ψ̂ + b ψ̂²`, `(a, b)` picked from the Rodrigues coefficients of
+/// each lane.
+#[inline]
+fn rodrigues_sum(psi: &V2, pick: impl Fn((f64, f64, f64)) -> (f64, f64)) -> M2 {
     let t2 = dot(psi, psi).to_array();
-    let [(_, b0, c0), (_, b1, c1)] = t2.map(rodrigues_coefficients::<f64>);
-    let (b, c) = (pair(b0, b1), pair(c0, c1));
+    let [(a0, b0), (a1, b1)] = t2.map(|t| pick(rodrigues_coefficients::<f64>(t)));
+    let (a, b) = (pair(a0, a1), pair(b0, b1));
     let (sk, sq) = (skew(psi), skew_squared(psi));
-    std::array::from_fn(|e| id(e) + sk[e] * b + sq[e] * c)
+    std::array::from_fn(|e| id(e) + sk[e] * a + sq[e] * b)
 }
 
 /// [`crate::rotation::tangent_inverse`].
