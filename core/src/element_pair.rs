@@ -8,8 +8,8 @@
 use crate::element::BeamElement;
 use crate::mesh::{gather, Element, RelativeRotations};
 use crate::rotation_pair::{
-    cross, exp, lane, log_pair, mat_mat, mat_t_mat, mat_t_vec, mat_vec, pair, scale, splat,
-    tangent, tangent_inverse, vectors, M2, V2,
+    cross, exp, lane, log_pair, mat_mat, mat_t_mat, mat_t_vec, mat_vec, matrices, pair, scale,
+    splat, tangent, tangent_inverse, vectors, M2, V2,
 };
 use nalgebra::{Matrix3, SVector, Vector3};
 use wide::f64x2;
@@ -20,13 +20,9 @@ const MOST_DOFS: usize = 18;
 /// Two elements' nodal triads `Λᵢ = Rᵢ Λ₀ᵢ` as pairs, node by node.
 fn triads(e: [&BeamElement<2>; 2], rot: &[[Matrix3<f64>; 2]; 2]) -> [M2; 2] {
     [0, 1].map(|i| {
-        let r = mat2(&rot[0][i], &rot[1][i]);
-        mat_mat(&r, &mat2(&e[0].lambda0[i], &e[1].lambda0[i]))
+        let r = matrices([&rot[0][i], &rot[1][i]]);
+        mat_mat(&r, &matrices([&e[0].lambda0[i], &e[1].lambda0[i]]))
     })
-}
-
-fn mat2(a: &Matrix3<f64>, b: &Matrix3<f64>) -> M2 {
-    crate::rotation_pair::matrices([a, b])
 }
 
 fn component_mul(v: &V2, w: [&Vector3<f64>; 2]) -> V2 {

@@ -10,8 +10,8 @@
 //! the one-end operators give (tested on every branch).
 
 use crate::rotation_pair::{
-    cross, dot, id, log_factor, mat_mat, mat_scale, mat_t_mat, mat_vec, pair, scale, skew, splat,
-    tangent, tangent_inverse, unpack, M2, V2,
+    cross, dot, id, log_factor, mat_mat, mat_scale, mat_t_mat, mat_vec, matrices, pair, scale,
+    skew, splat, tangent, tangent_inverse, unpack, vectors, M2, V2,
 };
 use nalgebra::{Matrix3, Vector3, Vector4};
 use wide::f64x2;
@@ -28,16 +28,6 @@ pub(crate) struct EndView<'a> {
     pub(crate) half0: &'a Vector4<f64>,
     pub(crate) g: Vector3<f64>,
     pub(crate) th: [Vector3<f64>; 2],
-}
-
-#[inline]
-fn vec2(a: &Vector3<f64>, b: &Vector3<f64>) -> V2 {
-    std::array::from_fn(|i| pair(a[i], b[i]))
-}
-
-#[inline]
-fn mat2(a: &Matrix3<f64>, b: &Matrix3<f64>) -> M2 {
-    std::array::from_fn(|e| pair(a[(e / 3, e % 3)], b[(e / 3, e % 3)]))
 }
 
 #[inline]
@@ -110,8 +100,8 @@ fn cayley_tangent_inverse(theta: &V2) -> M2 {
 pub(crate) fn secant_operators_both(ends: [EndView<'_>; 2]) -> [(Matrix3<f64>, Matrix3<f64>); 2] {
     let [a, b] = &ends;
     let (half, quarter) = (splat(0.5), splat(0.25));
-    let lam1 = mat2(a.lam1, b.lam1);
-    let th = [vec2(&a.th[0], &b.th[0]), vec2(&a.th[1], &b.th[1])];
+    let lam1 = matrices([a.lam1, b.lam1]);
+    let th = [0, 1].map(|n| vectors([&a.th[n], &b.th[n]]));
     let dtheta: V2 = std::array::from_fn(|i| th[1][i] - th[0][i]);
     let tbar: V2 = std::array::from_fn(|i| (th[0][i] + th[1][i]) * half);
     let sk = skew(&tbar);
@@ -131,7 +121,7 @@ pub(crate) fn secant_operators_both(ends: [EndView<'_>; 2]) -> [(Matrix3<f64>, M
         &mat_mat(&tangent_inverse(&phi_h), &cayley_tangent(&c_half)),
         &to_rel,
     );
-    let bv = mat_vec(&lam1, &vec2(&a.g, &b.g));
+    let bv = mat_vec(&lam1, &vectors([&a.g, &b.g]));
     let sk0 = skew(&th[0]);
     let e_sum: M2 = std::array::from_fn(|e| {
         let (i, j) = (e / 3, e % 3);
