@@ -20,6 +20,7 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector6};
 
 use crate::element_split::{Shared, Split};
 use crate::threads::LoopCost;
+use std::ops::Range;
 use std::time::Instant;
 
 struct Slots {
@@ -35,9 +36,20 @@ struct Slots {
     /// that the tangent is summed into the values straight from the kernel's
     /// buffer, a run at a time (a chain's element has one run of 12 per
     /// column), one addition per position as through `pos` (so the sums are
-    /// bitwise the same).
-    direct: Option<Vec<(usize, usize, usize)>>,
+    /// bitwise the same). The fourth member is whether the element writes
+    /// the run's positions first ([`Slots::first`], the same for the whole
+    /// run).
+    direct: Option<Vec<DirectRun>>,
+    /// Whether this element is the first, in element order, to add to each
+    /// position of `pos`: it stores its value there instead of adding it
+    /// to a zero (the same bits but for the sign of a zero), so the values
+    /// need no zeroing before an assembly ([`Assembler::untouched`]).
+    first: Vec<bool>,
 }
+
+/// A run of [`Slots::direct`]: `(first entry of the element tangent, first
+/// position in the values, length, written first)`.
+type DirectRun = (usize, usize, usize, bool);
 
 /// An element's `(element dof, local index)` pairs, or `None` where a joint
 /// touches it (see [`direct_pairs`]).
@@ -75,6 +87,7 @@ fn element_slots(mesh: &Mesh, dofs: &DofMap) -> (Vec<Slots>, Vec<DirectPairs>) {
             eqs,
             pos: Vec::new(),
             direct: None,
+            first: Vec::new(),
         });
     }
     (slots, direct)
@@ -89,6 +102,7 @@ fn block_slots(blocks: &[Vec<usize>]) -> Vec<Slots> {
             eqs: eqs.clone(),
             pos: Vec::new(),
             direct: None,
+            first: Vec::new(),
         })
         .collect()
 }
@@ -119,20 +133,44 @@ fn value_positions(eqs: &[usize], col_ptr: &[usize], row_idx: &[usize]) -> Vec<u
 }
 
 /// The runs of [`Slots::direct`] for an element of `d` unknowns whose nodes
-/// are all independent, from its direct `pairs` and positions `s.pos`.
-fn direct_runs(pairs: &[(usize, usize)], d: usize, s: &Slots) -> Vec<(usize, usize, usize)> {
+/// are all independent, from its direct `pairs`, positions `s.pos` and
+/// first writes `s.first`.
+fn direct_runs(pairs: &[(usize, usize)], d: usize, s: &Slots) -> Vec<DirectRun> {
     let m = s.eqs.len();
-    let mut runs: Vec<(usize, usize, usize)> = Vec::new();
+    let mut runs: Vec<DirectRun> = Vec::new();
     for &(ec, lc) in pairs {
         for &(er, lr) in pairs {
-            let (e, p) = (ec * d + er, s.pos[lc * m + lr]);
+            let (e, p, first) = (ec * d + er, s.pos[lc * m + lr], s.first[lc * m + lr]);
             match runs.last_mut() {
-                Some((e0, p0, len)) if *e0 + *len == e && *p0 + *len == p => *len += 1,
-                _ => runs.push((e, p, 1)),
+                Some((e0, p0, len, f0)) if *e0 + *len == e && *p0 + *len == p && *f0 == first => {
+                    *len += 1
+                }
+                _ => runs.push((e, p, 1, first)),
             }
         }
     }
     runs
+}
+
+/// Marks each element's first writes ([`Slots::first`]), in element order,
+/// and returns the ranges of the `n` values no element writes.
+fn first_writes(slots: &mut [Slots], n: usize) -> Vec<Range<usize>> {
+    let mut written = vec![false; n];
+    for s in slots.iter_mut() {
+        s.first = s
+            .pos
+            .iter()
+            .map(|&p| !std::mem::replace(&mut written[p], true))
+            .collect();
+    }
+    let mut untouched: Vec<Range<usize>> = Vec::new();
+    for (p, _) in written.iter().enumerate().filter(|(_, &w)| !w) {
+        match untouched.last_mut() {
+            Some(r) if r.end == p => r.end += 1,
+            _ => untouched.push(p..p + 1),
+        }
+    }
+    untouched
 }
 
 /// One scratch buffer per element kind (number of unknowns) of `mesh`, for
@@ -185,12 +223,19 @@ pub struct Assembler {
     scratch: Vec<Work>,
     /// The split of the element loop over threads, made when first needed.
     split: Option<Split>,
+    /// The split of the residual-only loop into two halves
+    /// ([`Self::residual_in_halves`]; nodes only), made when first needed.
+    halves: Option<Split>,
     /// One set of [`Self::scratch`] buffers per chunk of `split`.
     chunk_scratch: Vec<Vec<Work>>,
     /// Whether the residual-and-tangent loop is worth splitting.
     tangent_cost: LoopCost,
     /// Whether the residual-only loop is worth splitting.
     residual_cost: LoopCost,
+    /// The ranges of [`Self::values`] no element writes, zeroed before an
+    /// assembly (the others take their first element's value as it is,
+    /// [`Slots::first`]).
+    untouched: Vec<Range<usize>>,
     /// CSC values of the reduced tangent after [`Assembler::assemble`].
     pub values: Vec<f64>,
     /// Internal nodal forces, 6 per node (force, spatial moment).
@@ -213,6 +258,7 @@ impl Assembler {
         for s in slots.iter_mut().chain(extra.iter_mut()) {
             s.pos = value_positions(&s.eqs, &col_ptr, &row_idx);
         }
+        let untouched = first_writes(&mut slots, row_idx.len());
         for ((s, el), pairs) in slots.iter_mut().zip(&mesh.elements).zip(&direct) {
             if let Some(pairs) = pairs {
                 s.direct = Some(direct_runs(pairs, el.dofs(), s));
@@ -228,9 +274,11 @@ impl Assembler {
             any_reduced: direct.iter().any(Option::is_none),
             scratch: kind_scratch(mesh),
             split: None,
+            halves: None,
             chunk_scratch: Vec::new(),
             tangent_cost: LoopCost::default(),
             residual_cost: LoopCost::default(),
+            untouched,
             values: vec![0.0; nnz],
             nodal: vec![0.0; 6 * mesh.node_count()],
             nodal_abs: vec![0.0; 6 * mesh.node_count()],
@@ -387,9 +435,12 @@ impl Assembler {
         self.split = Some(split);
     }
 
-    /// Zeroes the tangent values and the nodal forces.
+    /// Zeroes the tangent values no element writes and the nodal forces
+    /// (the elements' first writes store, [`Slots::first`]).
     fn clear(&mut self) {
-        self.values.iter_mut().for_each(|v| *v = 0.0);
+        for r in &self.untouched {
+            self.values[r.clone()].fill(0.0);
+        }
         self.clear_forces();
     }
 
@@ -422,22 +473,39 @@ impl Assembler {
 
     /// [`Self::assemble_residual`] on two threads: each half of the
     /// elements (cut at an even element) computes its forces two elements
-    /// at a time into the elements' own buffers, then they are summed in
-    /// element order, as on one thread — the same bits.
+    /// at a time and adds them to the nodes it owns as [`Split`] says (a
+    /// late element keeps its forces in its own buffer for the nodes the
+    /// first half owns, added afterwards): every sum in element order, as
+    /// on one thread — the same bits.
     fn residual_in_halves(&mut self, mesh: &Mesh, config: &Configuration) {
         self.own_work(mesh);
         self.clear_forces();
         let els = &mesh.elements;
         let mid = (els.len() / 2) & !1;
+        let halves = self.halves.get_or_insert_with(|| {
+            let nodes = els.iter().map(|el| (&[][..], el.nodes()));
+            let chunks = vec![0..mid, mid..els.len()];
+            Split::with_chunks(chunks, 2, 0, mesh.node_count(), nodes)
+        });
         let (first, second) = self.work.split_at_mut(mid);
-        let halves = vec![(&els[..mid], first), (&els[mid..], second)];
-        crate::threads::for_each_item(halves, |_, (els, work)| {
-            for_each_internal_force(els, &config.x, &config.rot, |i, _, r| {
-                work[i].r.as_mut_slice().copy_from_slice(r)
+        let sinks = Sinks::new(&mut [], &mut self.nodal, &mut self.nodal_abs);
+        let items = vec![(&els[..mid], first), (&els[mid..], second)];
+        crate::threads::for_each_item(items, |c, (part, work)| {
+            let offset = halves.chunks[c].start;
+            for_each_internal_force(part, &config.x, &config.rot, |i, el, r| {
+                let late = halves.is_late(offset + i);
+                if late {
+                    work[i].r.as_mut_slice().copy_from_slice(r);
+                }
+                // SAFETY: half `c` adds only what it owns (all of it for an
+                // element that is not late).
+                unsafe { sinks.add_forces(el, r, late.then_some((&*halves, c, true))) };
             });
         });
-        for (el, w) in els.iter().zip(&self.work) {
-            add_forces(&mut self.nodal, &mut self.nodal_abs, el, w.r.as_slice());
+        for &index in &halves.late {
+            let only = Some((&*halves, halves.chunk_of(index), false));
+            // SAFETY: the parallel phase is over.
+            unsafe { sinks.add_forces(&els[index], self.work[index].r.as_slice(), only) };
         }
     }
 
@@ -678,17 +746,17 @@ fn add_forces(nodal: &mut [f64], nodal_abs: &mut [f64], el: &Element, r: &[f64])
     }
 }
 
-/// An element's tangent as runs `(first position, values)`: straight from
-/// the kernel's buffer along the direct runs, or its reduced tangent
-/// through `pos`, one entry a run.
-fn tangent_runs<'a>(w: &'a Work, s: &'a Slots) -> impl Iterator<Item = (usize, &'a [f64])> {
+/// An element's tangent as runs `(first position, values, written first)`:
+/// straight from the kernel's buffer along the direct runs, or its reduced
+/// tangent through `pos`, one entry a run.
+fn tangent_runs<'a>(w: &'a Work, s: &'a Slots) -> impl Iterator<Item = (usize, &'a [f64], bool)> {
     let k = w.k.as_slice();
     let k_red = w.k_red.as_slice();
     let direct = s
         .direct
         .iter()
         .flatten()
-        .map(move |&(e, p, len)| (p, &k[e..e + len]));
+        .map(move |&(e, p, len, first)| (p, &k[e..e + len], first));
     let reduced = if s.direct.is_some() {
         &[][..]
     } else {
@@ -696,22 +764,27 @@ fn tangent_runs<'a>(w: &'a Work, s: &'a Slots) -> impl Iterator<Item = (usize, &
     };
     let reduced = reduced
         .iter()
+        .zip(&s.first)
         .enumerate()
-        .map(move |(i, &p)| (p, &k_red[i..i + 1]));
+        .map(move |(i, (&p, &first))| (p, &k_red[i..i + 1], first));
     direct.chain(reduced)
 }
 
-/// Adds `src` to `target` entry by entry.
-fn add_run(target: &mut [f64], src: &[f64]) {
-    for (t, v) in target.iter_mut().zip(src) {
-        *t += v;
+/// Stores (`first`) or adds `src` into `target` entry by entry.
+fn add_run(target: &mut [f64], src: &[f64], first: bool) {
+    if first {
+        target.copy_from_slice(src);
+    } else {
+        for (t, v) in target.iter_mut().zip(src) {
+            *t += v;
+        }
     }
 }
 
-/// Adds an element's tangent to the values.
+/// Adds an element's tangent to the values (stores its first writes).
 fn add_tangent(values: &mut [f64], w: &Work, s: &Slots) {
-    for (p, run) in tangent_runs(w, s) {
-        add_run(&mut values[p..p + run.len()], run);
+    for (p, run, first) in tangent_runs(w, s) {
+        add_run(&mut values[p..p + run.len()], run, first);
     }
 }
 
@@ -745,27 +818,37 @@ impl<'a> Sinks<'a> {
         s: Option<&Slots>,
         only: Option<(&Split, usize, bool)>,
     ) {
-        for (nd, f) in force_blocks(el, w.r.as_slice()) {
+        // SAFETY: by the caller's contract.
+        unsafe { self.add_forces(el, w.r.as_slice(), only) };
+        let Some(s) = s else { return };
+        for (p, run, first) in tangent_runs(w, s) {
+            match only {
+                // SAFETY: by the caller's contract.
+                None => unsafe { self.values.add_or_store(p, run, first) },
+                Some((split, c, owned)) => {
+                    for (i, v) in run.iter().enumerate() {
+                        if split.owns_value(c, p + i) == owned {
+                            // SAFETY: by the caller's contract.
+                            unsafe { self.values.add_or_store(p + i, &[*v], first) };
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds element `el`'s forces `r` to the nodes (all, or as
+    /// [`Sinks::add`] says with `only`).
+    ///
+    /// # Safety
+    /// As for [`Sinks::add`].
+    unsafe fn add_forces(&self, el: &Element, r: &[f64], only: Option<(&Split, usize, bool)>) {
+        for (nd, f) in force_blocks(el, r) {
             if only.is_none_or(|(split, c, owned)| split.owns_node(c, nd) == owned) {
                 // SAFETY: by the caller's contract.
                 unsafe {
                     self.nodal.add(6 * nd, f, |v| v);
                     self.nodal_abs.add(6 * nd, f, f64::abs);
-                }
-            }
-        }
-        let Some(s) = s else { return };
-        for (p, run) in tangent_runs(w, s) {
-            match only {
-                // SAFETY: by the caller's contract.
-                None => unsafe { self.values.add(p, run, |v| v) },
-                Some((split, c, owned)) => {
-                    for (i, v) in run.iter().enumerate() {
-                        if split.owns_value(c, p + i) == owned {
-                            // SAFETY: by the caller's contract.
-                            unsafe { self.values.add(p + i, &[*v], |v| v) };
-                        }
-                    }
                 }
             }
         }
@@ -888,6 +971,60 @@ mod tests {
             c.dedup();
             assert_eq!(&row_idx[col_ptr[j]..col_ptr[j + 1]], &c[..], "column {j}");
         }
+    }
+
+    #[test]
+    fn an_assembly_leaves_nothing_of_the_last_one_in_the_values() {
+        // Each element's first writes store, so the values need no zeroing:
+        // stale values (NaN) must leave no trace. The reference sums every
+        // element's tangent into zeros, in element order, entry by entry.
+        let (mesh, dofs) = two_beams();
+        let blocks = vec![vec![2, 7, 30], vec![0, 31]];
+        let mut asm = Assembler::new(&mesh, &dofs, &blocks);
+        let mut config = flexmech_core::Configuration::initial(&mesh.positions);
+        for (i, x) in config.x.iter_mut().enumerate() {
+            // A bent, twisted state: tangents with no zero pattern of their own.
+            let phi = nalgebra::Vector3::new(0.3, -0.2, 0.1) * i as f64;
+            *x += phi * 0.05;
+            config.rot[i] = flexmech_core::rotation::exp(&phi);
+        }
+        let n = dofs.n_eq;
+        let mut dense = vec![0.0; n * n];
+        for el in &mesh.elements {
+            let d = el.dofs();
+            let (mut r, mut k) = (vec![0.0; d], vec![0.0; d * d]);
+            el.residual_tangent(&config.x, &config.rot, &mut r, &mut k);
+            let eqs: Vec<(usize, usize)> = el
+                .nodes()
+                .iter()
+                .enumerate()
+                .flat_map(|(a, &nd)| {
+                    let own = dofs.own_dofs(nd).unwrap();
+                    dofs.nodes[nd]
+                        .eqs
+                        .iter()
+                        .zip(own)
+                        .map(move |(&eq, &o)| (6 * a + usize::from(o), eq))
+                })
+                .collect();
+            for &(b, col) in &eqs {
+                for &(a, row) in &eqs {
+                    dense[col * n + row] += k[b * d + a];
+                }
+            }
+        }
+        asm.values.fill(f64::NAN);
+        asm.assemble(&mesh, &dofs, &config);
+        let (col_ptr, row_idx) = (asm.pattern().col_ptr(), asm.pattern().row_idx());
+        for j in 0..n {
+            for p in col_ptr[j]..col_ptr[j + 1] {
+                let i = row_idx[p];
+                // Bitwise, but for the sign of a zero.
+                assert!(asm.values[p] == dense[j * n + i], "entry ({i}, {j})");
+            }
+        }
+        // Block 0's entry (2, 30) is no element's: zeroed.
+        assert!(!asm.untouched.is_empty());
     }
 
     #[test]

@@ -72,6 +72,20 @@ impl Split {
         let chunks: Vec<Range<usize>> = (0..count)
             .map(|c| c * n_elements / count..(c + 1) * n_elements / count)
             .collect();
+        Self::with_chunks(chunks, threads, n_values, n_nodes, elements)
+    }
+
+    /// The split into the given contiguous `chunks` (in element order,
+    /// covering every element) made for `threads` threads, given each
+    /// element's tangent value positions and nodes.
+    pub fn with_chunks<'a>(
+        chunks: Vec<Range<usize>>,
+        threads: usize,
+        n_values: usize,
+        n_nodes: usize,
+        elements: impl Iterator<Item = (&'a [usize], &'a [usize])>,
+    ) -> Self {
+        let n_elements = chunks.last().map_or(0, |r| r.end);
         let chunk_of = |e: usize| chunks.partition_point(|r| r.end <= e) as u32;
         let mut value_owner = vec![NO_OWNER; n_values];
         let mut node_owner = vec![NO_OWNER; n_nodes];
@@ -171,6 +185,21 @@ impl<'a> Shared<'a> {
             // SAFETY: in bounds (asserted); exclusive by the caller's contract.
             unsafe { *self.ptr.add(p + i) += f(v) };
         }
+    }
+
+    /// Stores (`store`) or adds `src[i]` at `values[p + i]` for every `i`.
+    ///
+    /// # Safety
+    /// As for [`Shared::add`].
+    pub unsafe fn add_or_store(&self, p: usize, src: &[f64], store: bool) {
+        if !store {
+            // SAFETY: by the caller's contract.
+            return unsafe { self.add(p, src, |v| v) };
+        }
+        assert!(p + src.len() <= self.len, "shared range within the array");
+        // SAFETY: in bounds (asserted); exclusive by the caller's contract.
+        let target = unsafe { std::slice::from_raw_parts_mut(self.ptr.add(p), src.len()) };
+        target.copy_from_slice(src);
     }
 }
 
