@@ -1017,10 +1017,10 @@ mod tests {
         asm.assemble(&mesh, &dofs, &config);
         let (col_ptr, row_idx) = (asm.pattern().col_ptr(), asm.pattern().row_idx());
         for j in 0..n {
-            for p in col_ptr[j]..col_ptr[j + 1] {
-                let i = row_idx[p];
+            let (rows, values) = (col_ptr[j]..col_ptr[j + 1], col_ptr[j]..col_ptr[j + 1]);
+            for (&i, &v) in row_idx[rows].iter().zip(&asm.values[values]) {
                 // Bitwise, but for the sign of a zero.
-                assert!(asm.values[p] == dense[j * n + i], "entry ({i}, {j})");
+                assert!(v == dense[j * n + i], "entry ({i}, {j})");
             }
         }
         // Block 0's entry (2, 30) is no element's: zeroed.
