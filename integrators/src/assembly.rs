@@ -242,6 +242,8 @@ pub struct Assembler {
     pub nodal: Vec<f64>,
     /// Sum of the absolute element contributions per nodal DOF — the scale of
     /// the internal forces, used to measure the residual relative to round-off.
+    /// Every assembly zeroes it first, so a caller may take it (swap it out)
+    /// after one.
     pub nodal_abs: Vec<f64>,
 }
 

@@ -237,7 +237,9 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
         {
             *g = fi - fe;
         }
-        self.abs.copy_from_slice(&self.asm.nodal_abs);
+        // The assembler's scale, taken as it is: the next assembly zeroes
+        // what is left in its place.
+        std::mem::swap(&mut self.abs, &mut self.asm.nodal_abs);
         let blocks = tangent.then_some((&mut self.asm, &self.topo.dofs));
         self.terms
             .inertia(start, end, &mut self.nodal, &mut self.abs, blocks);
