@@ -18,7 +18,7 @@ use wide::f64x2;
 const MOST_DOFS: usize = 18;
 
 /// Two elements' nodal triads `Λᵢ = Rᵢ Λ₀ᵢ` as pairs, node by node.
-fn triads(e: [&BeamElement<2>; 2], rot: &[[Matrix3<f64>; 2]; 2]) -> [M2; 2] {
+pub(crate) fn triads(e: [&BeamElement<2>; 2], rot: &[[Matrix3<f64>; 2]; 2]) -> [M2; 2] {
     [0, 1].map(|i| {
         let r = matrices([&rot[0][i], &rot[1][i]]);
         mat_mat(&r, &matrices([&e[0].lambda0[i], &e[1].lambda0[i]]))

@@ -20,6 +20,7 @@ pub mod element;
 pub mod element_linear;
 pub mod element_pair;
 pub mod element_quadratic;
+pub mod frames_pair;
 pub mod inertia;
 pub mod section;
 pub mod shape;

@@ -25,6 +25,11 @@ impl StepStart {
     pub fn is_of(&self, pose: &Pose<f64>) -> bool {
         self.pose == *pose
     }
+
+    /// The start pose's rotation pieces.
+    pub(crate) fn frames(&self) -> &Frames<f64> {
+        &self.frames
+    }
 }
 
 impl BeamElement<2> {

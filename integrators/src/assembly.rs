@@ -21,6 +21,9 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector6};
 use crate::element_split::{Shared, Split};
 use crate::threads::LoopCost;
 use std::ops::Range;
+
+/// The most unknowns of an element (a 3-node element's).
+const MOST_DOFS: usize = 18;
 use std::time::Instant;
 
 struct Slots {
@@ -517,23 +520,49 @@ impl Assembler {
     where
         F: Fn(&Element, usize, &mut [f64]) + Sync,
     {
+        self.assemble_residual_paired(mesh, |_, _, _| false, kernel);
+    }
+
+    /// [`Self::assemble_residual_with`] with a kernel for two neighbouring
+    /// elements at once: `pair(index, [a, b], [ra, rb])` writes the forces
+    /// of elements `index` and `index + 1` and returns `true`, or returns
+    /// `false` (then `kernel` takes element `index` alone). On one thread
+    /// only (a split loop takes `kernel`); the forces are summed in element
+    /// order either way.
+    pub fn assemble_residual_paired<P, F>(&mut self, mesh: &Mesh, pair: P, kernel: F)
+    where
+        P: Fn(usize, [&Element; 2], [&mut [f64]; 2]) -> bool,
+        F: Fn(&Element, usize, &mut [f64]) + Sync,
+    {
         let n = mesh.elements.len();
-        if !self.residual_cost.split(n) {
-            let start = self.residual_cost.probing(n).then(Instant::now);
-            self.clear_forces();
-            for (index, el) in mesh.elements.iter().enumerate() {
-                let w = scratch_for(&mut self.scratch, el.dofs());
-                kernel(el, index, w.r.as_mut_slice());
-                add_forces(&mut self.nodal, &mut self.nodal_abs, el, w.r.as_slice());
-            }
-            if let Some(start) = start {
-                self.residual_cost.record(start.elapsed(), n);
-            }
-            return;
+        if self.residual_cost.split(n) {
+            return self.split_loop(mesh, false, |w, index, el, _| {
+                kernel(el, index, w.r.as_mut_slice())
+            });
         }
-        self.split_loop(mesh, false, |w, index, el, _| {
-            kernel(el, index, w.r.as_mut_slice())
-        });
+        let start = self.residual_cost.probing(n).then(Instant::now);
+        self.clear_forces();
+        let (els, nodal, abs) = (&mesh.elements, &mut self.nodal, &mut self.nodal_abs);
+        let (mut a, mut b) = ([0.0; MOST_DOFS], [0.0; MOST_DOFS]);
+        let mut i = 0;
+        while i < n {
+            let ra = &mut a[..els[i].dofs()];
+            if let Some(next) = els.get(i + 1) {
+                let rb = &mut b[..next.dofs()];
+                if pair(i, [&els[i], next], [&mut *ra, &mut *rb]) {
+                    add_forces(nodal, abs, &els[i], ra);
+                    add_forces(nodal, abs, next, rb);
+                    i += 2;
+                    continue;
+                }
+            }
+            kernel(&els[i], i, ra);
+            add_forces(nodal, abs, &els[i], ra);
+            i += 1;
+        }
+        if let Some(start) = start {
+            self.residual_cost.record(start.elapsed(), n);
+        }
     }
 
     /// Adds the dense matrix `m` (column-major over block `b`'s equations) to

@@ -27,8 +27,8 @@ use super::checkpoint::{CheckpointMismatch, Tape};
 use super::inertia_pairs::{midpoint_moment_pair, moments_in_pairs};
 use super::mass_slots::MassSlots;
 use super::midpoint_kernels::{
-    correction_size, element_force, element_kernel, start_of, started_force, started_kernel,
-    step_starts, CorrectionTally,
+    correction_size, element_force, element_kernel, start_of, started_force, started_force_pair,
+    started_kernel, step_starts, CorrectionTally,
 };
 use super::midpoint_sensitivity::MidpointSensitivities;
 use super::time_scheme::{SchemeSensitivities, TimeScheme};
@@ -211,12 +211,23 @@ impl StepTerms for MidpointTerms {
                 }
             });
         } else {
-            asm.assemble_residual_with(&mech.mesh, |el, i, re| {
-                match start_of(starts, el, i, start) {
+            asm.assemble_residual_paired(
+                &mech.mesh,
+                |i, [a, b], forces| match (
+                    start_of(starts, a, i, start),
+                    start_of(starts, b, i + 1, start),
+                ) {
+                    (Some(from_a), Some(from_b)) => {
+                        started_force_pair([from_a, from_b], end, tally, forces);
+                        true
+                    }
+                    _ => false,
+                },
+                |el, i, re| match start_of(starts, el, i, start) {
                     Some(from) => started_force(from, end, tally, re),
                     None => element_force(el, start, end, scheme, beta, tally, re),
-                }
-            });
+                },
+            );
         }
     }
 

@@ -7,6 +7,7 @@ use super::Scheme;
 use crate::mechanism::Mechanism;
 use crate::threads;
 use flexmech_core::conserving::{MidRotation, Pose, Pose3};
+use flexmech_core::frames_pair::energy_momentum_force_parts_pair;
 use flexmech_core::rotation::exp;
 use flexmech_core::step_start::StepStart;
 use flexmech_core::{cst, BeamElement, Configuration, Element, Scalar};
@@ -231,6 +232,23 @@ pub(crate) fn started_force(
     let (q, c) = e.energy_momentum_force_parts_from(s, &pose_of(e, end));
     tally.add(c.norm(), q.norm());
     r.copy_from_slice(q.as_slice());
+}
+
+/// [`started_force`] of two neighbouring elements, their end poses' pieces
+/// two at a time ([`energy_momentum_force_parts_pair`]): the same bits.
+pub(crate) fn started_force_pair(
+    starts: [(&BeamElement<2>, &StepStart); 2],
+    end: &Configuration,
+    tally: &CorrectionTally,
+    forces: [&mut [f64]; 2],
+) {
+    let [(ea, sa), (eb, sb)] = starts;
+    let poses = [pose_of(ea, end), pose_of(eb, end)];
+    let parts = energy_momentum_force_parts_pair([ea, eb], [sa, sb], [&poses[0], &poses[1]]);
+    for ((q, c), r) in parts.iter().zip(forces) {
+        tally.add(c.norm(), q.norm());
+        r.copy_from_slice(q.as_slice());
+    }
 }
 
 /// Element kernel for 3-node elements, in both conserving schemes: the

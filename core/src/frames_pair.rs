@@ -1,0 +1,166 @@
+//! The rotation pieces ([`Frames`]) of two 2-node element poses at once, one
+//! element in each lane of a pair of doubles ([`crate::rotation_pair`]): the
+//! arithmetic of [`BeamElement::frames`] in the same order, so each lane
+//! holds the bits of the one-element pieces (tested). The energy–momentum
+//! scheme's residual-only evaluations take the end pose's pieces of two
+//! neighbouring elements this way ([`energy_momentum_force_parts_pair`]).
+
+use crate::conserving::{Frames, Pose};
+use crate::discrete_gradient::{dg_step_in_pairs, step_force};
+use crate::element::BeamElement;
+use crate::element_pair::triads;
+use crate::rotation_pair::{
+    exp, from_trace, lane, log_factor, mat_mat, mat_t_mat, quaternion_from_trace, scale, splat,
+    unpack, M2,
+};
+use crate::step_start::StepStart;
+use nalgebra::{SVector, Vector4};
+use wide::f64x2;
+
+/// [`BeamElement::frames`] of two elements' poses, or `None` where a
+/// relative rotation's quaternion is not read from its trace (a relative
+/// rotation beyond a half turn's neighbourhood: the one-element path
+/// handles it).
+pub(crate) fn frames_pair(
+    e: [&BeamElement<2>; 2],
+    poses: [&Pose<f64>; 2],
+) -> Option<[Frames<f64>; 2]> {
+    let lam = triads(e, &[poses[0].1, poses[1].1]);
+    let rel = mat_t_mat(&lam[0], &lam[1]);
+    if !(0..2).all(|k| from_trace(&unpack(&rel, k))) {
+        return None;
+    }
+    // `log_quaternion`: `w ≥ 0` from the trace, no sign flip.
+    let [w, x, y, z] = quaternion_from_trace(&rel);
+    let s2 = x * x + y * y + z * z;
+    let factor = log_factor(w, s2);
+    let phi = [x * factor, y * factor, z * factor];
+    // `quaternion_half`: `(1 + w, v)/√(2(1 + w))`.
+    let w1 = splat(1.0) + w;
+    let f = splat(1.0) / (w1 * splat(2.0)).sqrt();
+    let half = [w1 * f, x * f, y * f, z * f];
+    let lam_r = mat_mat(&lam[0], &exp(&scale(&phi, splat(0.5))));
+    let quaternion = |q: &[f64x2; 4], k: usize| Vector4::from_fn(|i, _| q[i].to_array()[k]);
+    let of = |m: &M2, k| unpack(m, k);
+    Some([0, 1].map(|k| Frames {
+        lam: [of(&lam[0], k), of(&lam[1], k)],
+        rel: quaternion(&[w, x, y, z], k),
+        phi: lane(&phi, k),
+        half: quaternion(&half, k),
+        lam_r: of(&lam_r, k),
+        d: poses[k].0[1] - poses[k].0[0],
+    }))
+}
+
+/// [`BeamElement::energy_momentum_force_parts_from`] of two elements from
+/// their step starts to their end poses, the end poses' pieces two at a
+/// time ([`frames_pair`]): the same bits.
+pub fn energy_momentum_force_parts_pair(
+    e: [&BeamElement<2>; 2],
+    start: [&StepStart; 2],
+    end: [&Pose<f64>; 2],
+) -> [(SVector<f64, 12>, SVector<f64, 12>); 2] {
+    let ends = frames_pair(e, end).unwrap_or_else(|| [0, 1].map(|k| e[k].frames(end[k])));
+    [0, 1].map(|k| {
+        let (s, f) = (start[k].frames(), &ends[k]);
+        let (nbar, mbar) = e[k].averaged_resultants(s, f);
+        step_force(&dg_step_in_pairs(s, f), &nbar, &mbar)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rotation::exp as exp1;
+    use crate::Section;
+    use nalgebra::{Matrix3, Vector3};
+    use proptest::prelude::*;
+
+    /// An element whose initial triads differ by `kink` about z.
+    fn element(kink: f64) -> BeamElement<2> {
+        let section = Section::new([2e4, 1e4, 1e4], [30.0, 20.0, 10.0], 1.0, [0.1; 3]);
+        let x0 = [Vector3::zeros(), Vector3::new(0.5, 0.0, 0.0)];
+        let l0 = [Matrix3::identity(), exp1(&(Vector3::z() * kink))];
+        BeamElement::new([0, 1], section, 0.5, &x0, l0)
+    }
+
+    fn pose(x: [f64; 6], psi: [f64; 6]) -> Pose<f64> {
+        (
+            [
+                Vector3::new(x[0], x[1], x[2]),
+                Vector3::new(x[3], x[4], x[5]),
+            ],
+            [
+                exp1(&Vector3::new(psi[0], psi[1], psi[2])),
+                exp1(&Vector3::new(psi[3], psi[4], psi[5])),
+            ],
+        )
+    }
+
+    fn bits(f: &Frames<f64>) -> Vec<u64> {
+        let m = f.lam[0].iter().chain(f.lam[1].iter()).chain(f.lam_r.iter());
+        let v = f
+            .rel
+            .iter()
+            .chain(f.phi.iter())
+            .chain(f.half.iter())
+            .chain(f.d.iter());
+        m.chain(v).map(|v| v.to_bits()).collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(512))]
+        /// Every lane is the one-element pieces to the bit, on every branch:
+        /// relative rotations from the identity (the logarithm's series) to
+        /// beyond a half turn (the one-element path).
+        #[test]
+        fn a_pair_gives_the_bits_of_one_element_at_a_time(
+            x in proptest::array::uniform12(-1.0f64..1.0),
+            psi in proptest::array::uniform12(-2.0f64..2.0),
+            small in proptest::array::uniform2(0u8..3),
+            kink in -0.3f64..0.3,
+        ) {
+            let es = [element(kink), element(0.1 - kink)];
+            let poses: [Pose<f64>; 2] = [0, 1].map(|k| {
+                let mut p: [f64; 6] = std::array::from_fn(|i| psi[6 * k + i]);
+                // Nearly equal nodal rotations: the logarithm's series.
+                let near = [1.0, 1e-4, 1e-9][usize::from(small[k])];
+                for i in 3..6 {
+                    p[i] = p[i - 3] + near * p[i];
+                }
+                pose(std::array::from_fn(|i| x[6 * k + i]), p)
+            });
+            let one = [0, 1].map(|k| es[k].frames(&poses[k]));
+            match frames_pair([&es[0], &es[1]], [&poses[0], &poses[1]]) {
+                Some(two) => for k in 0..2 {
+                    prop_assert_eq!(bits(&two[k]), bits(&one[k]), "lane {}", k);
+                },
+                None => prop_assert!((0..2).any(|k| !from_trace(
+                    &(one[k].lam[0].transpose() * one[k].lam[1])
+                ))),
+            }
+            let starts = [0, 1].map(|k| es[k].step_start(&pose([0.0; 6], [0.01 * k as f64; 6])));
+            let pair = energy_momentum_force_parts_pair(
+                [&es[0], &es[1]],
+                [&starts[0], &starts[1]],
+                [&poses[0], &poses[1]],
+            );
+            for k in 0..2 {
+                let single = es[k].energy_momentum_force_parts_from(&starts[k], &poses[k]);
+                let b = |v: &SVector<f64, 12>| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                prop_assert_eq!(b(&pair[k].0), b(&single.0));
+                prop_assert_eq!(b(&pair[k].1), b(&single.1));
+            }
+        }
+    }
+
+    #[test]
+    fn relative_rotations_beyond_the_trace_branch_go_one_element_at_a_time() {
+        let e = element(0.0);
+        let p = pose(
+            [0.0, 0.0, 0.0, 0.5, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 3.0, 0.0, 0.0],
+        );
+        assert!(frames_pair([&e, &e], [&p, &p]).is_none());
+    }
+}
