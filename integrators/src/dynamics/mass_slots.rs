@@ -20,6 +20,39 @@ pub(crate) struct MassSlots {
     /// Mass entries (indices into [`Inertia::mass`]) that involve a slave.
     through_maps: Vec<usize>,
     rotational: Vec<Option<Vec<(usize, usize, usize)>>>,
+    /// Where no node is a slave: each node's translational mass entries
+    /// (`by_node[i]` into `entries`, in the order of [`Inertia::mass`]),
+    /// so that a node's translational forces and tangent diagonal are added
+    /// with its rotational terms, by the thread that takes the node.
+    own: Option<NodeMass>,
+}
+
+/// The translational mass entries `(i, j, m)` of every node `i`, with the
+/// positions of their blocks' diagonals in the tangent values.
+struct NodeMass {
+    by_node: Vec<std::ops::Range<usize>>,
+    /// `(j, m, diagonal positions, how many)`.
+    entries: Vec<(usize, f64, [usize; 3], usize)>,
+}
+
+impl NodeMass {
+    /// Every entry's node `i` and diagonal, or `None` where one involves a
+    /// slave.
+    fn new(asm: &Assembler, dofs: &DofMap, inertia: &Inertia) -> Option<Self> {
+        let nodes = inertia.rotational.len();
+        let mut rows: Vec<Vec<(usize, f64, [usize; 3], usize)>> = vec![Vec::new(); nodes];
+        for &(i, j, m) in &inertia.mass {
+            let (at, len) = asm.node_block_diagonal(dofs, i, j)?;
+            rows.get_mut(i)?.push((j, m, at, len));
+        }
+        let mut by_node = Vec::with_capacity(nodes);
+        let mut entries = Vec::with_capacity(inertia.mass.len());
+        for row in rows {
+            by_node.push(entries.len()..entries.len() + row.len());
+            entries.extend(row);
+        }
+        Some(Self { by_node, entries })
+    }
 }
 
 impl MassSlots {
@@ -33,12 +66,19 @@ impl MassSlots {
             }
         }
         translational.sort_by_key(|&(p, _)| p);
+        let rotational: Vec<_> = (0..inertia.rotational.len())
+            .map(|i| asm.node_block_slots(dofs, (i, 3), (i, 3)))
+            .collect();
+        let own = rotational
+            .iter()
+            .all(Option::is_some)
+            .then(|| NodeMass::new(asm, dofs, inertia))
+            .flatten();
         Self {
             translational,
             through_maps,
-            rotational: (0..inertia.rotational.len())
-                .map(|i| asm.node_block_slots(dofs, (i, 3), (i, 3)))
-                .collect(),
+            rotational,
+            own,
         }
     }
 
@@ -86,11 +126,16 @@ impl MassSlots {
         abs: &mut [f64],
         mut tangent: Option<(&mut Assembler, &DofMap)>,
         node_term: impl Fn(usize) -> Vector3<f64> + Sync + Send,
-        force: impl Fn(f64, &Vector3<f64>) -> Vector3<f64>,
+        force: impl Fn(f64, &Vector3<f64>) -> Vector3<f64> + Sync,
         coefficient: f64,
         moment: impl Fn(usize, &Matrix3<f64>, bool) -> (Vector3<f64>, Matrix3<f64>) + Sync,
     ) {
         let terms = crate::threads::map_nodes(g.len() / 6, node_term);
+        if let Some(own) = &self.own {
+            let values = tangent.map(|(asm, _)| &mut asm.values[..]);
+            let translational: Translational<'_> = (own, &terms[..], &force, coefficient);
+            return self.add_rotational_own(inertia, g, abs, values, &moment, Some(translational));
+        }
         for &(i, j, m) in &inertia.mass {
             let f = force(m, &terms[j]);
             for c in 0..3 {
@@ -103,7 +148,7 @@ impl MassSlots {
         }
         if self.rotational.iter().all(Option::is_some) {
             let values = tangent.map(|(asm, _)| &mut asm.values[..]);
-            return self.add_rotational_own(inertia, g, abs, values, &moment);
+            return self.add_rotational_own(inertia, g, abs, values, &moment, None);
         }
         let moments = rotational_moments(inertia, tangent.is_some(), &moment);
         for (i, (m, k)) in moments.into_iter().enumerate() {
@@ -125,9 +170,12 @@ impl MassSlots {
     /// on the team's threads for a large mesh
     /// ([`crate::threads::for_each_node`]): each node's moment, and its
     /// tangent block into `values` (given a tangent), is added by the thread
-    /// that computes it. The entries of `g`, `abs` and the values each node
-    /// adds to are its own, and each receives one term here, so the sums do
-    /// not depend on the thread count.
+    /// that computes it; so are, given `translational`, its translational
+    /// forces and tangent diagonal ([`Self::own`]: the forces of node `i`'s
+    /// mass entries in their order, then `c m` along their diagonals). The
+    /// entries of `g`, `abs` and the values each node adds to are its own,
+    /// and each receives its terms in the order of the one-thread loops, so
+    /// the sums do not depend on the thread count.
     fn add_rotational_own(
         &self,
         inertia: &Inertia,
@@ -135,11 +183,33 @@ impl MassSlots {
         abs: &mut [f64],
         values: Option<&mut [f64]>,
         moment: &(impl Fn(usize, &Matrix3<f64>, bool) -> (Vector3<f64>, Matrix3<f64>) + Sync),
+        translational: Option<Translational<'_>>,
     ) {
         let tangent = values.is_some();
         let (g, abs) = (Shared::new(g), Shared::new(abs));
         let values = values.map(Shared::new);
         crate::threads::for_each_node(inertia.rotational.len(), |i| {
+            if let Some((own, terms, force, c)) = translational {
+                let entries = &own.entries[own.by_node[i].clone()];
+                for &(j, m, _, _) in entries {
+                    let f = force(m, &terms[j]);
+                    // SAFETY: node `i`'s translational entries of `g` and
+                    // `abs` are touched by this node only.
+                    unsafe {
+                        g.add(6 * i, f.as_slice(), |v| v);
+                        abs.add(6 * i, f.as_slice(), f64::abs);
+                    }
+                }
+                if let Some(values) = values.as_ref().filter(|_| c != 0.0) {
+                    for &(_, m, at, len) in entries {
+                        for &p in &at[..len] {
+                            // SAFETY: the diagonals of node `i`'s row blocks
+                            // are touched by this node only.
+                            unsafe { values.add(p, &[c * m], |v| v) };
+                        }
+                    }
+                }
+            }
             let j0 = &inertia.rotational[i];
             if *j0 == Matrix3::zeros() {
                 return;
@@ -165,6 +235,16 @@ impl MassSlots {
         });
     }
 }
+
+/// The translational part of [`MassSlots::add_rotational_own`]: every
+/// node's mass entries, the nodes' terms, the force of an entry and the
+/// tangent's coefficient.
+type Translational<'a> = (
+    &'a NodeMass,
+    &'a [Vector3<f64>],
+    &'a (dyn Fn(f64, &Vector3<f64>) -> Vector3<f64> + Sync),
+    f64,
+);
 
 /// Every node's inertial moment and its tangent (zero for nodes without
 /// rotary inertia), on two threads for a large mesh
