@@ -31,16 +31,19 @@ pub(crate) struct MassSlots {
 /// positions of their blocks' diagonals in the tangent values.
 struct NodeMass {
     by_node: Vec<std::ops::Range<usize>>,
-    /// `(j, m, diagonal positions, how many)`.
-    entries: Vec<(usize, f64, [usize; 3], usize)>,
+    entries: Vec<MassEntry>,
 }
+
+/// A translational mass entry `(i, j, m)` of node `i`: `(j, m, positions of
+/// its block's diagonal, how many)`.
+type MassEntry = (usize, f64, [usize; 3], usize);
 
 impl NodeMass {
     /// Every entry's node `i` and diagonal, or `None` where one involves a
     /// slave.
     fn new(asm: &Assembler, dofs: &DofMap, inertia: &Inertia) -> Option<Self> {
         let nodes = inertia.rotational.len();
-        let mut rows: Vec<Vec<(usize, f64, [usize; 3], usize)>> = vec![Vec::new(); nodes];
+        let mut rows: Vec<Vec<MassEntry>> = vec![Vec::new(); nodes];
         for &(i, j, m) in &inertia.mass {
             let (at, len) = asm.node_block_diagonal(dofs, i, j)?;
             rows.get_mut(i)?.push((j, m, at, len));
