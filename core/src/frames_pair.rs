@@ -1,6 +1,6 @@
-//! The rotation pieces ([`Frames`]) of two 2-node element poses at once, one
+//! The rotation pieces (`Frames`) of two 2-node element poses at once, one
 //! element in each lane of a pair of doubles ([`crate::rotation_pair`]): the
-//! arithmetic of [`BeamElement::frames`] in the same order, so each lane
+//! arithmetic of `BeamElement::frames` in the same order, so each lane
 //! holds the bits of the one-element pieces (tested). The energy–momentum
 //! scheme's residual-only evaluations take the end pose's pieces of two
 //! neighbouring elements this way ([`energy_momentum_force_parts_pair`]).
@@ -54,7 +54,7 @@ pub(crate) fn frames_pair(
 
 /// [`BeamElement::energy_momentum_force_parts_from`] of two elements from
 /// their step starts to their end poses, the end poses' pieces two at a
-/// time ([`frames_pair`]): the same bits.
+/// time (`frames_pair`): the same bits.
 pub fn energy_momentum_force_parts_pair(
     e: [&BeamElement<2>; 2],
     start: [&StepStart; 2],
