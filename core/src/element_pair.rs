@@ -14,8 +14,9 @@ use crate::rotation_pair::{
 use nalgebra::{Matrix3, SVector, Vector3};
 use wide::f64x2;
 
-/// The largest element force (a 3-node element's).
-const MOST_DOFS: usize = 18;
+/// The most unknowns of an element, the length of the largest element
+/// force (a 3-node element's).
+pub const MOST_DOFS: usize = 18;
 
 /// Two elements' nodal triads `Λᵢ = Rᵢ Λ₀ᵢ` as pairs, node by node.
 pub(crate) fn triads(e: [&BeamElement<2>; 2], rot: &[[Matrix3<f64>; 2]; 2]) -> [M2; 2] {

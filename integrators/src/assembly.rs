@@ -14,16 +14,13 @@
 use crate::dofs::DofMap;
 use crate::sparsity::symmetric_pattern;
 use faer::sparse::SymbolicSparseColMat;
-use flexmech_core::element_pair::for_each_internal_force;
+use flexmech_core::element_pair::{for_each_internal_force, MOST_DOFS};
 use flexmech_core::{Configuration, Element, Inertia, Mesh};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector6};
 
 use crate::element_split::{Shared, Split};
 use crate::threads::LoopCost;
 use std::ops::Range;
-
-/// The most unknowns of an element (a 3-node element's).
-const MOST_DOFS: usize = 18;
 use std::time::Instant;
 
 struct Slots {
