@@ -801,7 +801,7 @@ fn tangent_runs<'a>(w: &'a Work, s: &'a Slots) -> impl Iterator<Item = (usize, &
 /// Stores (`first`) or adds `src` into `target` entry by entry.
 fn add_run(target: &mut [f64], src: &[f64], first: bool) {
     if first {
-        target.copy_from_slice(src);
+        crate::element_split::store_run(target, src);
     } else {
         for (t, v) in target.iter_mut().zip(src) {
             *t += v;

@@ -241,6 +241,14 @@ pub struct BandLu {
     sources: Option<Vec<usize>>,
     /// Position in the CSC values of each unknown's diagonal entry.
     diagonal: Vec<Option<usize>>,
+    /// For each column of the band storage, its first row that is not zero
+    /// in the pattern (the diagonal at the latest): without interchanges,
+    /// the rows above it stay zero in `U` (`u(i, c) = a(i, c) − Σ_{k<i} l(i, k) u(k, c)`, zero for every `i` above
+    /// the top by induction), so
+    /// the steps before it change nothing in the column and are skipped —
+    /// the envelope inside the band (on a chain of 6-unknown nodes, a
+    /// column of a node's first unknown starts 5 rows below the band's top).
+    top: Vec<usize>,
     /// Equilibrating scale of each row of the band storage, following the
     /// row interchanges during a factorisation.
     row_scale: Vec<f64>,
@@ -272,10 +280,12 @@ impl BandLu {
         let mut slot = Vec::with_capacity(row_idx.len());
         let mut diagonal = vec![None; n];
         let mut columns = vec![0..0; n];
+        let mut top: Vec<usize> = (0..n).collect();
         for j in 0..n {
             columns[band.perm[j]] = col_ptr[j]..col_ptr[j + 1];
             for (k, &i) in row_idx[col_ptr[j]..col_ptr[j + 1]].iter().enumerate() {
                 let (r, c) = (band.perm[i], band.perm[j]);
+                top[c] = top[c].min(r);
                 // Below `ld`, which `fits` bounds by 2³².
                 slot.push((kv + r - c) as u32);
                 if i == j {
@@ -291,6 +301,7 @@ impl BandLu {
             columns,
             sources: None,
             diagonal,
+            top,
             row_scale: vec![1.0; n],
             col_scale: vec![1.0; n],
             pivot_range: (0.0, 0.0),
@@ -366,12 +377,23 @@ impl BandLu {
             // interchanges.
             // Columns past the first `ku` whose band lies inside the matrix,
             // no interchange so far: the common bandwidths in registers.
+            // Without interchanges so far, the steps before the column's
+            // top change nothing in it.
             let unrolled = farthest == 0
                 && c >= ku
                 && c + kl < n
-                && eliminate_unrolled((kl, ku, ld), &mut column[kl..], &done[(c - ku) * ld..]);
+                && eliminate_unrolled(
+                    (kl, ku, ld),
+                    self.top[c] - (c - ku),
+                    &mut column[kl..],
+                    &done[(c - ku) * ld..],
+                );
             if !unrolled {
-                for j in c.saturating_sub(ku + farthest)..c {
+                let first = match farthest {
+                    0 => self.top[c].max(c.saturating_sub(ku)),
+                    _ => c.saturating_sub(ku + farthest),
+                };
+                for j in first..c {
                     let rj = kv + j - c;
                     let jp = piv[j] - j;
                     if jp != 0 {
@@ -574,25 +596,52 @@ impl Entries<'_> {
 /// (`kl = ku` = 11 for 2-node elements, 17 for 3-node ones, 12 for the
 /// mechanisms of 2-node links closed by joints: the slider-crank's and the
 /// four-bar's of `data/benchmarks`); `false` (and
-/// nothing done) for others. `window`: the column's storage from row
-/// `c − ku` on; `earlier`: the storage from column `c − ku` on. The same
-/// operations in the same order as the general loop.
+/// nothing done) for others. `lead`: the rows of the window that stay
+/// zero (the column's top is `c − ku + lead`), whose steps are skipped;
+/// `window`: the column's storage from row `c − ku` on; `earlier`: the
+/// storage from column `c − ku` on. The same operations in the same order
+/// as the general loop.
 fn eliminate_unrolled(
     (kl, ku, ld): (usize, usize, usize),
+    lead: usize,
     window: &mut [f64],
     earlier: &[f64],
 ) -> bool {
     match (kl, ku) {
-        (11, 11) => eliminate_fixed::<11, 11, 23>(ld, window, earlier),
-        (12, 12) => eliminate_fixed::<12, 12, 25>(ld, window, earlier),
-        (17, 17) => eliminate_fixed::<17, 17, 35>(ld, window, earlier),
+        (11, 11) => eliminate_led::<11, 11, 23>(ld, lead, window, earlier),
+        (12, 12) => eliminate_led::<12, 12, 25>(ld, lead, window, earlier),
+        (17, 17) => eliminate_led::<17, 17, 35>(ld, lead, window, earlier),
         _ => false,
     }
 }
 
-/// [`eliminate_unrolled`] for `kl = KL`, `ku = KU`, `W = KL + KU + 1`.
+/// [`eliminate_fixed`] with the zero rows it skips fixed at compile time:
+/// up to [`MOST_LEAD`] (a column of a 6-unknown node has at most 5), fewer
+/// than there are for a longer lead (skipping fewer is always right).
 #[inline(always)]
-fn eliminate_fixed<const KL: usize, const KU: usize, const W: usize>(
+fn eliminate_led<const KL: usize, const KU: usize, const W: usize>(
+    ld: usize,
+    lead: usize,
+    window: &mut [f64],
+    earlier: &[f64],
+) -> bool {
+    match lead {
+        0 => eliminate_fixed::<KL, KU, W, 0>(ld, window, earlier),
+        1 => eliminate_fixed::<KL, KU, W, 1>(ld, window, earlier),
+        2 => eliminate_fixed::<KL, KU, W, 2>(ld, window, earlier),
+        3 => eliminate_fixed::<KL, KU, W, 3>(ld, window, earlier),
+        4 => eliminate_fixed::<KL, KU, W, 4>(ld, window, earlier),
+        _ => eliminate_fixed::<KL, KU, W, MOST_LEAD>(ld, window, earlier),
+    }
+}
+
+/// The most leading zero rows of a column the unrolled update skips.
+const MOST_LEAD: usize = 5;
+
+/// [`eliminate_unrolled`] for `kl = KL`, `ku = KU`, `W = KL + KU + 1`,
+/// the first `T` rows of the window zero (`T < KU`).
+#[inline(always)]
+fn eliminate_fixed<const KL: usize, const KU: usize, const W: usize, const T: usize>(
     ld: usize,
     window: &mut [f64],
     earlier: &[f64],
@@ -612,14 +661,14 @@ fn eliminate_fixed<const KL: usize, const KU: usize, const W: usize>(
     // positions — so that no update loads entries the previous one has just
     // stored at an offset of one, which the processor cannot forward from
     // the stores.
-    for i in 1..KU {
+    for i in (T + 1)..KU {
         let mut t = x[i];
-        for jj in i.saturating_sub(KL)..i {
+        for jj in i.saturating_sub(KL).max(T)..i {
             t -= earlier[jj * ld + kv + i - jj] * x[jj];
         }
         x[i] = t;
     }
-    for jj in 0..KU {
+    for jj in T..KU {
         let (u, lo, hi) = (x[jj], KU.max(jj + 1), jj + KL);
         let m = &earlier[jj * ld + kv + lo - jj..=jj * ld + kv + hi - jj];
         for (t, &l) in x[lo..=hi].iter_mut().zip(m) {
@@ -793,6 +842,59 @@ pub(crate) mod tests {
             assert_eq!(lu.u_width, width, "an interchange");
             let err = solve_error(&pattern, &values, band);
             assert!(err < 1e-12, "n = {n}, width {width}: error {err:e}");
+        }
+    }
+
+    /// A chain of `nodes` nodes of `per` unknowns, each node coupled to the
+    /// next (a 2-node element's `2·per` square block), with pseudo-random
+    /// entries and a dominant diagonal (no interchanges).
+    fn node_chain(nodes: usize, per: usize) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
+        let n = nodes * per;
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            let node = j / per;
+            let rows = node.saturating_sub(1) * per..((node + 2) * per).min(n);
+            for i in rows {
+                let k = values.len();
+                values.push(if i == j {
+                    8.0 * per as f64
+                } else {
+                    (k as f64 * 0.618).sin()
+                });
+                row_idx.push(i);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        (pattern, values)
+    }
+
+    /// The steps skipped above each column's top (its first row of the
+    /// pattern) change nothing: factors and solutions are bitwise those of
+    /// the whole band, through the unrolled updates (nodes of 6 and 9
+    /// unknowns: bandwidths 11 and 17) and the general loop (5: 9).
+    #[test]
+    fn skipping_the_steps_above_a_columns_top_gives_the_bits_of_the_whole_band() {
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for per in [6, 9, 5] {
+            let (pattern, values) = node_chain(40, per);
+            let n = pattern.nrows();
+            let band = BandStructure::of(&pattern);
+            assert_eq!((band.kl, band.ku), (2 * per - 1, 2 * per - 1));
+            let mut skipping = BandLu::new(&pattern, band.clone());
+            let mut whole = skipping.clone();
+            whole.top = (0..n).map(|c| c.saturating_sub(band.ku)).collect();
+            assert!(skipping.top != whole.top, "{per}: no column to skip in");
+            skipping.factor(&values);
+            whole.factor(&values);
+            assert_eq!(skipping.u_width, band.ku, "{per}: an interchange");
+            assert_eq!(bits(&skipping.ab), bits(&whole.ab), "{per}: factors");
+            assert_eq!(bits(&skipping.pivot_inverse), bits(&whole.pivot_inverse));
+            let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
+            let (mut a, mut b) = (rhs.clone(), rhs);
+            skipping.solve(&mut a);
+            whole.solve(&mut b);
+            assert_eq!(bits(&a), bits(&b), "{per}: solutions");
         }
     }
 
