@@ -242,12 +242,12 @@ pub struct BandLu {
     /// Position in the CSC values of each unknown's diagonal entry.
     diagonal: Vec<Option<usize>>,
     /// For each column of the band storage, its first row that is not zero
-    /// in the pattern (the diagonal at the latest): without interchanges,
-    /// the rows above it stay zero in `U` (`u(i, c) = a(i, c) − Σ_{k<i} l(i, k) u(k, c)`, zero for every `i` above
-    /// the top by induction), so
-    /// the steps before it change nothing in the column and are skipped —
-    /// the envelope inside the band (on a chain of 6-unknown nodes, a
-    /// column of a node's first unknown starts 5 rows below the band's top).
+    /// in the pattern (the diagonal at the latest). Without interchanges the
+    /// rows above it stay zero in `U` — `u(i, c) = a(i, c) − Σ_{k<i} l(i, k)
+    /// u(k, c)`, zero above the top by induction — so the steps before it
+    /// change nothing in the column and are skipped: the envelope inside the
+    /// band (on a chain of 6-unknown nodes, the column of a node's first
+    /// unknown starts 5 rows below the band's top).
     top: Vec<usize>,
     /// Equilibrating scale of each row of the band storage, following the
     /// row interchanges during a factorisation.
