@@ -37,7 +37,7 @@
 use crate::element::{BeamElement, Strains};
 use crate::rotation::{exp, log, tangent_inverse};
 use crate::rotation_derivatives::{exp_transpose_first, tangent_inverse_transpose_derivative};
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, SMatrix, SMatrixViewMut, SVector, SVectorViewMut, Vector3};
 
 /// The total strains `(Γ, K) = (exp(½φ̂)ᵀΛ₁ᵀd/L, φ/L)`, `φ = log(Λ₁ᵀΛ₂)`,
 /// of a 2-node element with nodal triads `lam`, chord `d = x₂ − x₁` and
@@ -111,6 +111,21 @@ impl BeamElement<2> {
         x: &[Vector3<f64>; 2],
         rot: &[Matrix3<f64>; 2],
     ) -> (SVector<f64, 12>, SMatrix<f64, 12, 12>) {
+        let (mut r, mut k) = (SVector::<f64, 12>::zeros(), SMatrix::<f64, 12, 12>::zeros());
+        self.residual_tangent_linear_into(x, rot, r.as_view_mut(), k.as_view_mut());
+        (r, k)
+    }
+
+    /// [`BeamElement::residual_tangent_linear`] written into `r` and `k`
+    /// (every entry; views of an assembler's buffers, so that the 144
+    /// entries are not returned and then copied).
+    pub fn residual_tangent_linear_into(
+        &self,
+        x: &[Vector3<f64>; 2],
+        rot: &[Matrix3<f64>; 2],
+        mut r: SVectorViewMut<f64, 12>,
+        mut k: SMatrixViewMut<f64, 12, 12>,
+    ) {
         let lam = self.nodal_triads(rot);
         let l = self.length;
         let lt = lam[0].transpose();
@@ -167,7 +182,7 @@ impl BeamElement<2> {
             [-pp, k21, pp, pq],
             [-qp, k41, qp, qq],
         ];
-        let mut k = SMatrix::<f64, 12, 12>::zeros();
+        // The sixteen blocks cover the whole of k.
         for (a, row) in blocks.iter().enumerate() {
             for (b, blk) in row.iter().enumerate() {
                 k.fixed_view_mut::<3, 3>(3 * a, 3 * b).copy_from(blk);
@@ -176,7 +191,6 @@ impl BeamElement<2> {
         // r = Jᵀe.
         let u = s.transpose() * e_phi;
         let b = lam[0] * ea;
-        let mut r = SVector::<f64, 12>::zeros();
         r.fixed_rows_mut::<3>(0).copy_from(&(-b));
         r.fixed_rows_mut::<3>(3).copy_from(&(-u - dh * b));
         r.fixed_rows_mut::<3>(6).copy_from(&b);
@@ -196,7 +210,6 @@ impl BeamElement<2> {
         add(6, 3, -b_hat);
         add(3, 0, -b_hat);
         add(3, 6, b_hat);
-        (r, k)
     }
 }
 

@@ -6,7 +6,7 @@ use crate::element::{BeamElement, Strains};
 use crate::rotation::{exp, log};
 use crate::section::Section;
 use crate::Scalar;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, SMatrixViewMut, SVectorViewMut, Vector3};
 use thiserror::Error;
 
 /// Degenerate beam geometry (the model loader reports these with file context;
@@ -304,9 +304,8 @@ impl Element {
         match self {
             Element::Linear(e) => {
                 let (xe, re) = gather(&e.nodes, x, rot);
-                let (rv, km) = e.residual_tangent_linear(&xe, &re);
-                r.copy_from_slice(rv.as_slice());
-                k.copy_from_slice(km.as_slice());
+                let rv = SVectorViewMut::<f64, 12>::from_slice(r);
+                e.residual_tangent_linear_into(&xe, &re, rv, SMatrixViewMut::from_slice(k));
             }
             Element::Quadratic(e) => {
                 let (xe, re) = gather(&e.nodes, x, rot);
