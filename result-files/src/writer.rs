@@ -419,11 +419,13 @@ impl Series {
     }
 
     /// Extends a `T×n×N` series by `blocks.len()` rows from row `t`, each
-    /// block `n` rows of `N`.
+    /// block `n` rows of `N`, gathered in `flat` (scratch: one buffer for
+    /// every series of a write, whose pages are then touched once).
     fn push_blocks<const N: usize>(
         &self,
         t: usize,
         blocks: &[&[[f64; N]]],
+        flat: &mut Vec<f64>,
         path: &Path,
     ) -> Result<(), ResultError> {
         self.set_rows(t + blocks.len(), path)?;
@@ -431,13 +433,12 @@ impl Series {
             return Ok(());
         };
         // One contiguous slab for all the rows: one write, not one per row.
-        let flat: Vec<f64> = blocks
-            .iter()
-            .flat_map(|b| b.iter().flatten())
-            .copied()
-            .collect();
+        flat.clear();
+        for b in blocks {
+            flat.extend_from_slice(b.as_flattened());
+        }
         let rows = || format!("writing rows {t}.. of {}", self.name);
-        let view = ndarray::ArrayView3::from_shape((blocks.len(), n, N), &flat)
+        let view = ndarray::ArrayView3::from_shape((blocks.len(), n, N), &flat[..])
             .map_err(|e| hdf5::Error::from(e.to_string()))
             .ctx(path, rows)?;
         self.ds
@@ -866,13 +867,15 @@ impl ConfigurationSets {
     /// Writes every node's rows of `recs` from row `t0`.
     fn write(&self, t0: usize, recs: &[StepRecord], path: &Path) -> Result<(), ResultError> {
         let blocks3 = |f: fn(&StepRecord) -> &[[f64; 3]]| recs.iter().map(f).collect::<Vec<_>>();
+        let mut flat = Vec::new();
         self.position
-            .push_blocks(t0, &blocks3(|r| &r.positions), path)?;
+            .push_blocks(t0, &blocks3(|r| &r.positions), &mut flat, path)?;
         let quaternions: Vec<&[[f64; 4]]> = recs.iter().map(|r| &r.quaternions[..]).collect();
-        self.quaternion.push_blocks(t0, &quaternions, path)?;
+        self.quaternion
+            .push_blocks(t0, &quaternions, &mut flat, path)?;
         if let Some([v, w]) = &self.velocity {
-            v.push_blocks(t0, &blocks3(|r| &r.velocities), path)?;
-            w.push_blocks(t0, &blocks3(|r| &r.angular_velocities), path)?;
+            v.push_blocks(t0, &blocks3(|r| &r.velocities), &mut flat, path)?;
+            w.push_blocks(t0, &blocks3(|r| &r.angular_velocities), &mut flat, path)?;
         }
         Ok(())
     }
@@ -927,8 +930,9 @@ fn write_resultants(
     let (force, moment): (Vec<_>, Vec<_>) = recs.iter().map(|r| meta.of(r)).unzip();
     let force: Vec<&[[f64; 3]]> = force.iter().map(Vec::as_slice).collect();
     let moment: Vec<&[[f64; 3]]> = moment.iter().map(Vec::as_slice).collect();
-    n.push_blocks(t0, &force, path)?;
-    m.push_blocks(t0, &moment, path)
+    let mut flat = Vec::new();
+    n.push_blocks(t0, &force, &mut flat, path)?;
+    m.push_blocks(t0, &moment, &mut flat, path)
 }
 
 /// Every dataset handle of the file, kept open for the whole run.
