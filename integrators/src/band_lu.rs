@@ -371,42 +371,13 @@ impl BandLu {
                 entries.load(c + LOAD_AHEAD, &mut rest[ahead..ahead + ld], from);
             }
             let column = &mut rest[..ld];
-            // The earlier steps that reach this column, in order: each
-            // step's interchange, then its multipliers times the entry of
-            // its pivot row. Rows above c − ku are reached only through
-            // interchanges.
-            // Columns past the first `ku` whose band lies inside the matrix,
-            // no interchange so far: the common bandwidths in registers.
-            // Without interchanges so far, the steps before the column's
-            // top change nothing in it.
-            let unrolled = farthest == 0
-                && c >= ku
-                && c + kl < n
-                && eliminate_unrolled(
-                    (kl, ku, ld),
-                    self.top[c] - (c - ku),
-                    &mut column[kl..],
-                    &done[(c - ku) * ld..],
-                );
-            if !unrolled {
-                let first = match farthest {
-                    0 => self.top[c].max(c.saturating_sub(ku)),
-                    _ => c.saturating_sub(ku + farthest),
-                };
-                for j in first..c {
-                    let rj = kv + j - c;
-                    let jp = piv[j] - j;
-                    if jp != 0 {
-                        column.swap(rj, rj + jp);
-                    }
-                    // No test for a zero `u`: on these bands it is rare, and a
-                    // mispredicted branch costs more than the update.
-                    let u = column[rj];
-                    let km = kl.min(n - 1 - j);
-                    let multipliers = &done[j * ld + kv + 1..=j * ld + kv + km];
-                    subtract_multiple(&mut column[rj + 1..=rj + km], multipliers, u);
-                }
-            }
+            update_column(
+                (kl, ku, ld, n),
+                (c, self.top[c], farthest),
+                column,
+                done,
+                piv,
+            );
             let km = kl.min(n - 1 - c);
             // Pivot: the diagonal unless an equilibrated entry below it is
             // more than 1/τ times larger, then the largest.
@@ -553,6 +524,53 @@ impl BandLu {
     /// The renumbering and bandwidths the factorisation works in.
     pub(crate) fn structure(&self) -> &BandStructure {
         &self.band
+    }
+}
+
+/// The earlier steps that reach column `c` of a left-looking band LU, in
+/// order: each step's interchange, then its multipliers times the entry of
+/// its pivot row (`column`: the column's storage; `done`: the columns
+/// before it; `piv`: their interchanges). Rows above `c − ku` are reached
+/// only through interchanges (`farthest`, the farthest so far). Without
+/// any, the steps before the column's `top` change nothing in it, and
+/// columns past the first `ku` whose band lies inside the matrix take the
+/// unrolled update of the common bandwidths.
+fn update_column(
+    (kl, ku, ld, n): (usize, usize, usize, usize),
+    (c, top, farthest): (usize, usize, usize),
+    column: &mut [f64],
+    done: &[f64],
+    piv: &[usize],
+) {
+    let kv = kl + ku;
+    if farthest == 0
+        && c >= ku
+        && c + kl < n
+        && eliminate_unrolled(
+            (kl, ku, ld),
+            top - (c - ku),
+            &mut column[kl..],
+            &done[(c - ku) * ld..],
+        )
+    {
+        return;
+    }
+    let first = match farthest {
+        0 => top.max(c.saturating_sub(ku)),
+        _ => c.saturating_sub(ku + farthest),
+    };
+    for j in first..c {
+        let rj = kv + j - c;
+        let jp = piv[j] - j;
+        if jp != 0 {
+            column.swap(rj, rj + jp);
+        }
+        // No test for a zero `u`: on these bands it is rare, and a
+        // mispredicted branch costs more than the update.
+        let u = column[rj];
+        let km = kl.min(n - 1 - j);
+        let multipliers = &done[j * ld + kv + 1..=j * ld + kv + km];
+        subtract_multiple(&mut column[rj + 1..=rj + km], multipliers, u);
     }
 }
 
