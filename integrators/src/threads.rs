@@ -155,6 +155,27 @@ pub fn map_nodes<T: Send>(nodes: usize, f: impl Fn(usize) -> T + Sync + Send) ->
     map_split(nodes, split_nodes(nodes), f)
 }
 
+/// [`map_nodes`] into `out`, cleared first: a loop run at every
+/// evaluation keeps its buffer's allocation from one call to the next.
+pub fn map_nodes_into<T: Send>(
+    nodes: usize,
+    out: &mut Vec<T>,
+    f: impl Fn(usize) -> T + Sync + Send,
+) {
+    out.clear();
+    if split_nodes(nodes) {
+        out.append(&mut map_split(nodes, true, f));
+    } else {
+        out.extend((0..nodes).map(f));
+    }
+}
+
+/// A guard of `m`'s contents, a poisoned lock's too (its holder panicked,
+/// which the team resumes): for scratch buffers kept behind a lock.
+pub fn scratch<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    lock(m)
+}
+
 /// `f(i)` for every `i < n`, in order — on two threads unless
 /// [`sequential`]: for loops whose every item is costly (an element's
 /// energy terms), split from [`PARALLEL_MIN_ELEMENTS`] items on.

@@ -22,12 +22,27 @@ type Rotary<'a> = (&'a [Matrix3<f64>], &'a [Matrix3<f64>], &'a [Matrix3<f64>]);
 /// Every node's moment (zero where the node has no rotary inertia `j0`),
 /// two nodes at a time by `pair` (`None`: where its lanes part, each node
 /// by `single`): [`in_node_pairs`] of moments.
+#[cfg(test)]
 pub(super) fn moments_in_pairs(
     j0: &[Matrix3<f64>],
     single: impl Fn(usize) -> Vector3<f64> + Sync,
     pair: impl Fn([usize; 2]) -> Option<V2> + Sync,
 ) -> Vec<Vector3<f64>> {
-    in_node_pairs(j0, single, |i| pair(i).map(|m| [lane(&m, 0), lane(&m, 1)]))
+    let mut out = Vec::new();
+    moments_in_pairs_into(j0, single, pair, &mut out);
+    flat(out, j0.len())
+}
+
+/// [`moments_in_pairs`] into `out` as [`in_node_pairs_into`] leaves them:
+/// node `i`'s moment is `out[i / 2][i % 2]`.
+pub(super) fn moments_in_pairs_into(
+    j0: &[Matrix3<f64>],
+    single: impl Fn(usize) -> Vector3<f64> + Sync,
+    pair: impl Fn([usize; 2]) -> Option<V2> + Sync,
+    out: &mut Vec<[Vector3<f64>; 2]>,
+) {
+    let pair = |i| pair(i).map(|m: V2| [lane(&m, 0), lane(&m, 1)]);
+    in_node_pairs_into(j0, single, pair, out);
 }
 
 /// Every node's value (the default where the node has no rotary inertia
@@ -35,11 +50,26 @@ pub(super) fn moments_in_pairs(
 /// on two threads for a large mesh, each pair on its own, so the same
 /// either way. A last odd node, and a pair with a node without rotary
 /// inertia, go by `single`.
+#[cfg(test)]
 pub(super) fn in_node_pairs<T: Copy + Default + Send>(
     j0: &[Matrix3<f64>],
     single: impl Fn(usize) -> T + Sync,
     pair: impl Fn([usize; 2]) -> Option<[T; 2]> + Sync,
 ) -> Vec<T> {
+    let mut out = Vec::new();
+    in_node_pairs_into(j0, single, pair, &mut out);
+    flat(out, j0.len())
+}
+
+/// [`in_node_pairs`] into `out` (cleared first; its allocation kept from
+/// one evaluation to the next), two nodes to an entry: node `i`'s value
+/// is `out[i / 2][i % 2]` (a last odd node's partner is the default).
+pub(super) fn in_node_pairs_into<T: Copy + Default + Send>(
+    j0: &[Matrix3<f64>],
+    single: impl Fn(usize) -> T + Sync,
+    pair: impl Fn([usize; 2]) -> Option<[T; 2]> + Sync,
+    out: &mut Vec<[T; 2]>,
+) {
     let n = j0.len();
     let one = |i: usize| {
         if i >= n || j0[i] == Matrix3::zeros() {
@@ -48,13 +78,18 @@ pub(super) fn in_node_pairs<T: Copy + Default + Send>(
             single(i)
         }
     };
-    let pairs = crate::threads::map_nodes(n.div_ceil(2), |p| {
+    crate::threads::map_nodes_into(n.div_ceil(2), out, |p| {
         let i = [2 * p, 2 * p + 1];
         let both = i[1] < n && j0[i[0]] != Matrix3::zeros() && j0[i[1]] != Matrix3::zeros();
         both.then(|| pair(i))
             .flatten()
             .unwrap_or_else(|| i.map(one))
     });
+}
+
+/// The first `n` values of pairs in node order.
+#[cfg(test)]
+fn flat<T: Copy>(pairs: Vec<[T; 2]>, n: usize) -> Vec<T> {
     pairs.into_iter().flatten().take(n).collect()
 }
 

@@ -24,7 +24,7 @@
 
 use super::bordered::{self, Bordered};
 use super::checkpoint::{CheckpointMismatch, Tape};
-use super::inertia_pairs::{midpoint_moment_pair, moments_in_pairs};
+use super::inertia_pairs::{midpoint_moment_pair, moments_in_pairs_into};
 use super::mass_slots::MassSlots;
 use super::midpoint_kernels::{
     correction_size, element_force, element_kernel, start_of, started_force, started_force_pair,
@@ -150,6 +150,9 @@ pub(crate) struct MidpointTerms {
     /// step being solved (empty for the other schemes; an entry is used only
     /// for the start it was computed at).
     starts: Vec<Option<StepStart>>,
+    /// The node pairs' moments of the last residual-only evaluation, kept
+    /// for their allocation ([`moments_in_pairs_into`]).
+    moments: std::sync::Mutex<Vec<[Vector3<f64>; 2]>>,
 }
 
 impl MidpointTerms {
@@ -180,6 +183,7 @@ impl MidpointTerms {
             predictor: MidpointPredictor::default(),
             exact_tangent: true,
             tally: CorrectionTally::default(),
+            moments: Default::default(),
             starts: Vec::new(),
         }
     }
@@ -242,16 +246,20 @@ impl StepTerms for MidpointTerms {
         let dt = self.dt;
         // Translational inertia: Σⱼ m_ij (vⱼ,ₙ₊₁ − vⱼ,ₙ)/Δt, vₙ₊₁ = 2(xₙ₊₁ − xₙ)/Δt − vₙ;
         // rotational (πₙ₊₁ − πₙ)/Δt, node by node — without the tangent two
-        // nodes at a time ([`moments_in_pairs`], the same bits).
+        // nodes at a time ([`moments_in_pairs_into`], the same bits).
         let (j0, w_n) = (&self.inertia.rotational, &self.w_n);
-        let moments = tangent.is_none().then(|| {
+        let mut moments = crate::threads::scratch(&self.moments);
+        let paired = tangent.is_none();
+        if paired {
             let pi_n = |i: usize| start.rot[i] * (j0[i] * w_n[i]);
-            moments_in_pairs(
+            moments_in_pairs_into(
                 j0,
                 |i| inertial_moment_at(&j0[i], &start.rot[i], &end.rot[i], &w_n[i], dt),
                 |i| midpoint_moment_pair((j0, &start.rot, &end.rot), (w_n, pi_n), i, dt),
-            )
-        });
+                &mut moments,
+            );
+        }
+        let moments = &*moments;
         self.slots.add_inertia(
             &self.inertia,
             g,
@@ -260,8 +268,8 @@ impl StepTerms for MidpointTerms {
             |j| (end.x[j] - start.x[j]) * (2.0 / dt) - self.v_n[j] * 2.0,
             |m, dv| dv.map(|d| m * d / dt),
             2.0 / (dt * dt),
-            |i, j0, tangent| match (tangent, &moments) {
-                (false, Some(m)) => (m[i], Matrix3::zeros()),
+            |i, j0, tangent| match (tangent, paired) {
+                (false, true) => (moments[i / 2][i % 2], Matrix3::zeros()),
                 _ => inertial_moment(j0, &start.rot[i], &end.rot[i], &w_n[i], dt, tangent),
             },
         );

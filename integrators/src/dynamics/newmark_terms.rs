@@ -6,7 +6,7 @@
 
 use super::checkpoint::{CheckpointMismatch, Tape};
 use super::inertia_pairs::{
-    in_node_pairs, moments_in_pairs, newmark_moment_pair, newmark_tangent_pair,
+    in_node_pairs_into, moments_in_pairs_into, newmark_moment_pair, newmark_tangent_pair,
 };
 use super::mass_slots::MassSlots;
 use super::newmark_sensitivity::NewmarkSensitivities;
@@ -25,6 +25,7 @@ use crate::system::{ReducedSystem, Reduction, StepTerms};
 use flexmech_core::rotation::{log, tangent_inverse};
 use flexmech_core::{Configuration, Element, Inertia};
 use nalgebra::{Matrix3, Vector3};
+use std::sync::Mutex;
 
 /// The coefficients of a Newmark-family scheme: Newmark's `β`, `γ` and the
 /// generalized-α weights `α_m`, `α_f` of the pseudo-acceleration `a`,
@@ -219,6 +220,16 @@ pub(crate) struct NewmarkTerms {
     pub(super) dt: f64,
     /// The drivers' reactions at the end of the last accepted step.
     reactions: Option<(Vec<Vec<f64>>, Vec<f64>)>,
+    /// The rotational inertia's node pairs of the last evaluation, kept for
+    /// their allocations: moments, or moments with their tangents.
+    pairs: Mutex<NodePairs>,
+}
+
+/// Node pairs' values ([`in_node_pairs_into`]): node `i`'s is `[i / 2][i % 2]`.
+#[derive(Default)]
+struct NodePairs {
+    moments: Vec<[Vector3<f64>; 2]>,
+    tangents: Vec<[(Vector3<f64>, Matrix3<f64>); 2]>,
 }
 
 impl NewmarkTerms {
@@ -267,6 +278,7 @@ impl NewmarkTerms {
             },
             dt: f64::NAN,
             reactions: None,
+            pairs: Mutex::default(),
             initial_rates: initial.joint_rates.clone(),
             rates: super::midpoint::initial_released_rates(mech, initial),
         }
@@ -343,8 +355,10 @@ impl StepTerms for NewmarkTerms {
         // Rₙ₊₁ ([`inertial_moment_tangent`]). Both two nodes at a time
         // (`inertia_pairs`, the same bits).
         let j0 = &self.inertia.rotational;
-        let moments = tangent.is_none().then(|| {
-            moments_in_pairs(
+        let mut pairs = crate::threads::scratch(&self.pairs);
+        let NodePairs { moments, tangents } = &mut *pairs;
+        if tangent.is_none() {
+            moments_in_pairs_into(
                 j0,
                 |i| inertial_moment(k, &j0[i], &start.rot[i], &end.rot[i], prev, i, dt),
                 |i| {
@@ -356,18 +370,21 @@ impl StepTerms for NewmarkTerms {
                         dt,
                     ))
                 },
-            )
-        });
-        let tangents = tangent.is_some().then(|| {
-            in_node_pairs(
+                moments,
+            );
+        } else {
+            in_node_pairs_into(
                 j0,
                 |i| inertial_moment_tangent(k, &j0[i], &start.rot[i], &end.rot[i], prev, i, dt),
                 |i| {
                     let rotary = (&j0[..], &start.rot[..], &end.rot[..]);
                     Some(newmark_tangent_pair(k, rotary, prev, i, dt))
                 },
-            )
-        });
+                tangents,
+            );
+        }
+        let (moments, tangents) = (&*moments, &*tangents);
+        let with_tangent = tangent.is_some();
         self.slots.add_inertia(
             &self.inertia,
             g,
@@ -379,13 +396,10 @@ impl StepTerms for NewmarkTerms {
             },
             |m, a| a.map(|a| m * a),
             k.stiffness(dt),
-            |i, j0, tangent| match (tangent, &moments) {
-                (true, _) => match &tangents {
-                    Some(t) => t[i],
-                    None => inertial_moment_tangent(k, j0, &start.rot[i], &end.rot[i], prev, i, dt),
-                },
-                (false, Some(m)) => (m[i], Matrix3::zeros()),
-                (false, None) => {
+            |i, j0, tangent| match (tangent, with_tangent) {
+                (true, _) => tangents[i / 2][i % 2],
+                (false, false) => (moments[i / 2][i % 2], Matrix3::zeros()),
+                (false, true) => {
                     let m = inertial_moment(k, j0, &start.rot[i], &end.rot[i], prev, i, dt);
                     (m, Matrix3::zeros())
                 }
