@@ -135,7 +135,19 @@ pub fn relative_rotation_pair(e: [&BeamElement<2>; 2], rot: &[[Matrix3<f64>; 2];
 /// Every element's [`Element::relative_rotations`] at the nodes' rotations
 /// `rot`, two 2-node elements next to each other at a time: the same bits.
 pub fn relative_rotations_of(elements: &[Element], rot: &[Matrix3<f64>]) -> Vec<RelativeRotations> {
-    let all = std::cell::RefCell::new(Vec::with_capacity(elements.len()));
+    let mut all = Vec::with_capacity(elements.len());
+    relative_rotations_into(elements, rot, &mut all);
+    all
+}
+
+/// [`relative_rotations_of`] appended to `out` (whose allocation a caller
+/// keeps from one state to the next).
+pub fn relative_rotations_into(
+    elements: &[Element],
+    rot: &[Matrix3<f64>],
+    out: &mut Vec<RelativeRotations>,
+) {
+    let all = std::cell::RefCell::new(out);
     in_pairs(
         elements,
         |_, a, b| {
@@ -146,7 +158,6 @@ pub fn relative_rotations_of(elements: &[Element], rot: &[Matrix3<f64>]) -> Vec<
         },
         |_, el| all.borrow_mut().push(el.relative_rotations(rot)),
     );
-    all.into_inner()
 }
 
 #[cfg(test)]

@@ -17,7 +17,7 @@
 use crate::constraints::MechanismState;
 use crate::error::{NewtonFailure, SolveError};
 use crate::mechanism::Mechanism;
-use flexmech_core::element_pair::relative_rotations_of;
+use flexmech_core::element_pair::{relative_rotations_into, relative_rotations_of};
 use flexmech_core::mesh::RelativeRotations;
 use flexmech_core::{Configuration, Element};
 
@@ -45,14 +45,19 @@ pub(crate) fn as_step_failure(error: SolveError) -> Result<NewtonFailure, SolveE
 #[derive(Debug, Clone)]
 pub(crate) struct RotationGuard {
     previous: Vec<RelativeRotations>,
+    /// The state being checked's, kept for its allocation.
+    now: Vec<RelativeRotations>,
     prescribed: Vec<f64>,
 }
 
 impl RotationGuard {
     /// The guard at the initial (or any accepted) state.
     pub(crate) fn new(mech: &Mechanism, state: &MechanismState) -> Self {
+        let mut previous = Vec::new();
+        rotations(mech, &state.config, &mut previous);
         Self {
-            previous: rotations(mech, &state.config),
+            previous,
+            now: Vec::new(),
             prescribed: state.prescribed.clone(),
         }
     }
@@ -85,8 +90,8 @@ impl RotationGuard {
                 });
             }
         }
-        let now = rotations(mech, &state.config);
-        for (element, (a, b)) in now.iter().zip(&self.previous).enumerate() {
+        rotations(mech, &state.config, &mut self.now);
+        for (element, (a, b)) in self.now.iter().zip(&self.previous).enumerate() {
             for (phi, before) in a.iter().zip(b.iter()) {
                 let (angle, change) = (phi.norm(), (phi - before).norm());
                 if angle > Element::ROTATION_LIMIT || change > Element::ROTATION_STEP_LIMIT {
@@ -100,16 +105,19 @@ impl RotationGuard {
                 }
             }
         }
-        self.previous = now;
+        std::mem::swap(&mut self.previous, &mut self.now);
         self.prescribed.clone_from(&state.prescribed);
         Ok(())
     }
 }
 
-fn rotations(mech: &Mechanism, config: &Configuration) -> Vec<RelativeRotations> {
+/// Every element's relative rotations at `config` into `out` (cleared
+/// first).
+fn rotations(mech: &Mechanism, config: &Configuration, out: &mut Vec<RelativeRotations>) {
     let elements = &mech.mesh.elements;
+    out.clear();
     if !crate::threads::split_nodes(elements.len()) {
-        return relative_rotations_of(elements, &config.rot);
+        return relative_rotations_into(elements, &config.rot, out);
     }
     // On two threads for a large mesh, half the elements each (cut at an
     // even element), each element's on its own: the same either way.
@@ -120,6 +128,7 @@ fn rotations(mech: &Mechanism, config: &Configuration) -> Vec<RelativeRotations>
         let rotations = relative_rotations_of(halves[h], &config.rot);
         *outs[h].lock().unwrap_or_else(|e| e.into_inner()) = rotations;
     });
-    let [first, second] = outs.map(|o| o.into_inner().unwrap_or_else(|e| e.into_inner()));
-    [first, second].concat()
+    for half in outs {
+        out.append(&mut half.into_inner().unwrap_or_else(|e| e.into_inner()));
+    }
 }

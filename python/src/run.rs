@@ -66,6 +66,16 @@ pub struct Watched<S: Sink> {
     pub interrupt: Interrupt,
 }
 
+impl<S: Sink> Watched<S> {
+    /// The interrupt as the error that stops the run, if the user made it.
+    fn watch(&self) -> Result<(), SinkError> {
+        if self.interrupt.interrupted() {
+            return Err(INTERRUPTED.into());
+        }
+        Ok(())
+    }
+}
+
 /// The message a run stopped by Ctrl-C ends with.
 pub const INTERRUPTED: &str = "interrupted by the user (KeyboardInterrupt)";
 
@@ -76,10 +86,12 @@ impl<S: Sink> Sink for Watched<S> {
 
     fn step(&mut self, record: &StepRecord) -> Result<(), SinkError> {
         self.inner.step(record)?;
-        if self.interrupt.interrupted() {
-            return Err(INTERRUPTED.into());
-        }
-        Ok(())
+        self.watch()
+    }
+
+    fn take_step(&mut self, record: StepRecord) -> Result<(), SinkError> {
+        self.inner.take_step(record)?;
+        self.watch()
     }
 
     fn checkpoint(&mut self, state: &Checkpoint) -> Result<(), SinkError> {

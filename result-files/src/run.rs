@@ -242,9 +242,9 @@ struct Keeper<'a> {
 
 impl Keeper<'_> {
     /// Takes a step's record; returns whether it was handed to the sink now.
-    fn push(&mut self, step: &StepRecord) -> bool {
-        self.checks.push(self.mech, step);
-        self.merit.push(step);
+    fn push(&mut self, step: StepRecord) -> bool {
+        self.checks.push(self.mech, &step);
+        self.merit.push(&step);
         self.critical.extend(step.critical);
         self.count += 1;
         self.iterations += step.iterations;
@@ -255,14 +255,14 @@ impl Keeper<'_> {
             self.pending = None;
             self.give(step)
         } else {
-            self.pending = Some(step.clone());
+            self.pending = Some(step);
             false
         }
     }
 
     /// Hands `step` to the sink; returns whether it took it.
-    fn give(&mut self, step: &StepRecord) -> bool {
-        match self.sink.step(step) {
+    fn give(&mut self, step: StepRecord) -> bool {
+        match self.sink.take_step(step) {
             Ok(()) => {
                 self.written += 1;
                 true
@@ -278,7 +278,7 @@ impl Keeper<'_> {
     /// it did.
     fn flush_last(&mut self) -> bool {
         match (self.pending.take(), &self.error) {
-            (Some(step), None) => self.give(&step),
+            (Some(step), None) => self.give(step),
             _ => false,
         }
     }
@@ -583,7 +583,7 @@ fn solve(
             };
             let params = built.sensitivity_parameters(model);
             let outcome = solve_static_with(mech, &settings, &params, |s| {
-                keeper.push(s);
+                keeper.push(s.clone());
             });
             (outcome.map(|o| end_reason(model, o.end)), 0.0)
         }
@@ -602,7 +602,7 @@ fn solve(
             };
             let params = built.sensitivity_parameters(model);
             let outcome = solve_arc_length_with(mech, &settings, &params, |s| {
-                keeper.push(s);
+                keeper.push(s.clone());
             });
             (outcome.map(|o| end_reason(model, o.end)), 0.0)
         }
@@ -620,14 +620,14 @@ fn solve(
                 },
             };
             let outcome = solve_modal(mech, &settings, |s| {
-                keeper.push(s);
+                keeper.push(s.clone());
             });
             (outcome.map(|set| keeper.modes(&set)).map(|()| None), 0.0)
         }
         Analysis::Buckling { modes } => {
             let state = initial_state(mech);
             let fext = vec![0.0; 6 * mech.mesh.node_count()];
-            keeper.push(&static_record(mech, &state, &fext, 0.0, 0.0, None));
+            keeper.push(static_record(mech, &state, &fext, 0.0, 0.0, None));
             let outcome = buckling_modes(mech, modes, model.solver.eigensolver);
             (outcome.map(|set| keeper.modes(&set)).map(|()| None), 0.0)
         }
@@ -724,14 +724,14 @@ fn solve_dynamic(
         Ok(sim) => sim,
         Err(e) => return (Err(e), 0.0),
     };
-    if keeper.push(&sim.record()) {
+    if keeper.push(sim.record()) {
         keeper.offer_checkpoint(&sim);
     }
     let setup = start.elapsed().as_secs_f64();
     let outcome = loop {
         match sim.step() {
             Ok(Some(record)) => {
-                if keeper.push(&record) {
+                if keeper.push(record) {
                     keeper.offer_checkpoint(&sim);
                 }
             }

@@ -69,6 +69,12 @@ pub trait Sink {
     fn begin(&mut self, meta: &RunMeta) -> Result<(), SinkError>;
     /// A kept step.
     fn step(&mut self, record: &StepRecord) -> Result<(), SinkError>;
+    /// A kept step handed over, as a run gives its steps (default:
+    /// [`Self::step`] of it): a sink that keeps its steps takes them
+    /// without copying them.
+    fn take_step(&mut self, record: StepRecord) -> Result<(), SinkError> {
+        self.step(&record)
+    }
     /// The restart state of a dynamic run after a kept step: after every
     /// kept step for which [`Self::wants_checkpoint`] says so, and after the
     /// last one.
@@ -138,6 +144,11 @@ impl Sink for Memory {
 
     fn step(&mut self, record: &StepRecord) -> Result<(), SinkError> {
         self.records.push(record.clone());
+        Ok(())
+    }
+
+    fn take_step(&mut self, record: StepRecord) -> Result<(), SinkError> {
+        self.records.push(record);
         Ok(())
     }
 
@@ -239,6 +250,10 @@ impl Sink for FileSink {
 
     fn step(&mut self, record: &StepRecord) -> Result<(), SinkError> {
         Ok(self.writer()?.append(record)?)
+    }
+
+    fn take_step(&mut self, record: StepRecord) -> Result<(), SinkError> {
+        Ok(self.writer()?.append_owned(record)?)
     }
 
     fn checkpoint(&mut self, state: &Checkpoint) -> Result<(), SinkError> {

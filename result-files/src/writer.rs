@@ -1283,6 +1283,19 @@ impl ResultWriter {
     /// write, the steps stay held (the next write rewrites the same rows) and
     /// `finish` trims the file back to the steps written successfully.
     pub fn append(&mut self, step: &StepRecord) -> Result<(), ResultError> {
+        self.check_record(step)?;
+        self.hold(step.clone())
+    }
+
+    /// [`Self::append`] of a step handed over: held without a copy.
+    pub fn append_owned(&mut self, step: StepRecord) -> Result<(), ResultError> {
+        self.check_record(&step)?;
+        self.hold(step)
+    }
+
+    /// [`ResultError::RecordLength`] where a field of `step` has a length
+    /// other than the [`RunMeta`]'s.
+    fn check_record(&self, step: &StepRecord) -> Result<(), ResultError> {
         let t = self.steps + self.held.len();
         let n_nodes = self.initial_positions.len();
         let lengths = [
@@ -1322,11 +1335,16 @@ impl ResultWriter {
                 });
             }
         }
+        Ok(())
+    }
+
+    /// Holds `step`, after writing the held steps first if they are due.
+    fn hold(&mut self, step: StepRecord) -> Result<(), ResultError> {
         if self.due {
             self.flush()?;
         }
-        self.held_values += record_values(step);
-        self.held.push(step.clone());
+        self.held_values += record_values(&step);
+        self.held.push(step);
         self.due = self.held_values >= HELD_VALUES || self.last_write.elapsed() >= WRITE_INTERVAL;
         Ok(())
     }
