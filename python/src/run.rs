@@ -68,7 +68,7 @@ pub struct Watched<S: Sink> {
 
 impl<S: Sink> Watched<S> {
     /// The interrupt as the error that stops the run, if the user made it.
-    fn watch(&self) -> Result<(), SinkError> {
+    fn watch(&mut self) -> Result<(), SinkError> {
         if self.interrupt.interrupted() {
             return Err(INTERRUPTED.into());
         }
