@@ -136,8 +136,9 @@ fn take<T>(slot: &Mutex<Option<T>>) -> Option<T> {
     lock(slot).take()
 }
 
-/// A lock's guard, a poisoned one's too.
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+/// A lock's guard, a poisoned one's too (its holder panicked, which the
+/// team resumes): also for the scratch buffers terms keep behind a lock.
+pub(crate) fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
@@ -168,12 +169,6 @@ pub fn map_nodes_into<T: Send>(
     } else {
         out.extend((0..nodes).map(f));
     }
-}
-
-/// A guard of `m`'s contents, a poisoned lock's too (its holder panicked,
-/// which the team resumes): for scratch buffers kept behind a lock.
-pub fn scratch<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    lock(m)
 }
 
 /// `f(i)` for every `i < n`, in order — on two threads unless

@@ -248,7 +248,7 @@ impl StepTerms for MidpointTerms {
         // rotational (πₙ₊₁ − πₙ)/Δt, node by node — without the tangent two
         // nodes at a time ([`moments_in_pairs_into`], the same bits).
         let (j0, w_n) = (&self.inertia.rotational, &self.w_n);
-        let mut moments = crate::threads::scratch(&self.moments);
+        let mut moments = crate::threads::lock(&self.moments);
         let paired = tangent.is_none();
         if paired {
             let pi_n = |i: usize| start.rot[i] * (j0[i] * w_n[i]);

@@ -355,7 +355,7 @@ impl StepTerms for NewmarkTerms {
         // Rₙ₊₁ ([`inertial_moment_tangent`]). Both two nodes at a time
         // (`inertia_pairs`, the same bits).
         let j0 = &self.inertia.rotational;
-        let mut pairs = crate::threads::scratch(&self.pairs);
+        let mut pairs = crate::threads::lock(&self.pairs);
         let NodePairs { moments, tangents } = &mut *pairs;
         if tangent.is_none() {
             moments_in_pairs_into(
