@@ -21,20 +21,8 @@ type Rotary<'a> = (&'a [Matrix3<f64>], &'a [Matrix3<f64>], &'a [Matrix3<f64>]);
 
 /// Every node's moment (zero where the node has no rotary inertia `j0`),
 /// two nodes at a time by `pair` (`None`: where its lanes part, each node
-/// by `single`): [`in_node_pairs`] of moments.
-#[cfg(test)]
-pub(super) fn moments_in_pairs(
-    j0: &[Matrix3<f64>],
-    single: impl Fn(usize) -> Vector3<f64> + Sync,
-    pair: impl Fn([usize; 2]) -> Option<V2> + Sync,
-) -> Vec<Vector3<f64>> {
-    let mut out = Vec::new();
-    moments_in_pairs_into(j0, single, pair, &mut out);
-    flat(out, j0.len())
-}
-
-/// [`moments_in_pairs`] into `out` as [`in_node_pairs_into`] leaves them:
-/// node `i`'s moment is `out[i / 2][i % 2]`.
+/// by `single`), into `out` as [`in_node_pairs_into`] leaves them: node
+/// `i`'s moment is `out[i / 2][i % 2]`.
 pub(super) fn moments_in_pairs_into(
     j0: &[Matrix3<f64>],
     single: impl Fn(usize) -> Vector3<f64> + Sync,
@@ -49,21 +37,10 @@ pub(super) fn moments_in_pairs_into(
 /// `j0`), two nodes at a time by `pair` (`None`: each node by `single`) —
 /// on two threads for a large mesh, each pair on its own, so the same
 /// either way. A last odd node, and a pair with a node without rotary
-/// inertia, go by `single`.
-#[cfg(test)]
-pub(super) fn in_node_pairs<T: Copy + Default + Send>(
-    j0: &[Matrix3<f64>],
-    single: impl Fn(usize) -> T + Sync,
-    pair: impl Fn([usize; 2]) -> Option<[T; 2]> + Sync,
-) -> Vec<T> {
-    let mut out = Vec::new();
-    in_node_pairs_into(j0, single, pair, &mut out);
-    flat(out, j0.len())
-}
-
-/// [`in_node_pairs`] into `out` (cleared first; its allocation kept from
-/// one evaluation to the next), two nodes to an entry: node `i`'s value
-/// is `out[i / 2][i % 2]` (a last odd node's partner is the default).
+/// inertia, go by `single`. Into `out` (cleared first; its allocation
+/// kept from one evaluation to the next), two nodes to an entry: node
+/// `i`'s value is `out[i / 2][i % 2]` (a last odd node's partner is the
+/// default).
 pub(super) fn in_node_pairs_into<T: Copy + Default + Send>(
     j0: &[Matrix3<f64>],
     single: impl Fn(usize) -> T + Sync,
@@ -85,12 +62,6 @@ pub(super) fn in_node_pairs_into<T: Copy + Default + Send>(
             .flatten()
             .unwrap_or_else(|| i.map(one))
     });
-}
-
-/// The first `n` values of pairs in node order.
-#[cfg(test)]
-fn flat<T: Copy>(pairs: Vec<[T; 2]>, n: usize) -> Vec<T> {
-    pairs.into_iter().flatten().take(n).collect()
 }
 
 /// The Newmark family's kinematics of a pair of nodes at the step's end:
@@ -215,8 +186,8 @@ pub(super) fn midpoint_moment_pair(
 #[cfg(test)]
 mod tests {
     use super::{
-        in_node_pairs, midpoint_moment_pair, moments_in_pairs, newmark_moment_pair,
-        newmark_tangent_pair,
+        in_node_pairs_into, midpoint_moment_pair, moments_in_pairs_into, newmark_moment_pair,
+        newmark_tangent_pair, V2,
     };
     use crate::dynamics::mass_slots::inertia_oracle::inertia;
     use crate::dynamics::midpoint::inertial_moment_at;
@@ -226,6 +197,29 @@ mod tests {
     use flexmech_core::rotation::exp;
     use nalgebra::{Matrix3, Vector3};
     use proptest::prelude::*;
+
+    /// Every node's value in node order, as the terms read them from
+    /// [`in_node_pairs_into`].
+    fn in_node_pairs<T: Copy + Default + Send>(
+        j0: &[Matrix3<f64>],
+        single: impl Fn(usize) -> T + Sync,
+        pair: impl Fn([usize; 2]) -> Option<[T; 2]> + Sync,
+    ) -> Vec<T> {
+        let mut out = Vec::new();
+        in_node_pairs_into(j0, single, pair, &mut out);
+        out.into_iter().flatten().take(j0.len()).collect()
+    }
+
+    /// Every node's moment in node order ([`moments_in_pairs_into`]).
+    fn moments_in_pairs(
+        j0: &[Matrix3<f64>],
+        single: impl Fn(usize) -> Vector3<f64> + Sync,
+        pair: impl Fn([usize; 2]) -> Option<V2> + Sync,
+    ) -> Vec<Vector3<f64>> {
+        let mut out = Vec::new();
+        moments_in_pairs_into(j0, single, pair, &mut out);
+        out.into_iter().flatten().take(j0.len()).collect()
+    }
 
     const NODES: usize = 5;
 
