@@ -120,7 +120,12 @@ impl<const N: usize> BeamElement<N> {
 
     /// Nodal triads `Λᵢ = Rᵢ Λ₀ᵢ`.
     pub(crate) fn triads<T: Scalar>(&self, rot: &[Matrix3<T>; N]) -> [Matrix3<T>; N] {
-        std::array::from_fn(|i| mm(&rot[i], &self.lambda0[i].map(cst::<T>)))
+        // Filled in place (`std::array::from_fn` copied them out with `memcpy`).
+        let mut out = [Matrix3::zeros(); N];
+        for (o, (r, l0)) in out.iter_mut().zip(rot.iter().zip(&self.lambda0)) {
+            *o = mm(r, &l0.map(cst::<T>));
+        }
+        out
     }
 
     /// Total (not yet reduced by the initial values) material strains

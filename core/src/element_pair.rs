@@ -6,7 +6,7 @@
 //! residual-only evaluations of a mesh go through [`for_each_internal_force`].
 
 use crate::element::BeamElement;
-use crate::mesh::{gather, Element, RelativeRotations};
+use crate::mesh::{gather_into, gather_rotations_into, Element, RelativeRotations};
 use crate::rotation_pair::{
     cross, exp, lane, log_pair, mat_mat, mat_t_mat, mat_t_vec, mat_vec, matrices, pair, scale,
     splat, tangent, tangent_inverse, vectors, M2, V2,
@@ -110,8 +110,10 @@ pub fn for_each_internal_force(
     in_pairs(
         elements,
         |i, a, b| {
-            let ((xa, ra), (xb, rb)) = (gather(&a.nodes, x, rot), gather(&b.nodes, x, rot));
-            let [fa, fb] = internal_force_pair([a, b], &[xa, xb], &[ra, rb]);
+            let (mut xx, mut rr) = ([[Vector3::zeros(); 2]; 2], [[Matrix3::zeros(); 2]; 2]);
+            gather_into(&a.nodes, x, rot, &mut xx[0], &mut rr[0]);
+            gather_into(&b.nodes, x, rot, &mut xx[1], &mut rr[1]);
+            let [fa, fb] = internal_force_pair([a, b], &xx, &rr);
             let mut sink = sink.borrow_mut();
             sink(i, &elements[i], fa.as_slice());
             sink(i + 1, &elements[i + 1], fb.as_slice());
@@ -151,8 +153,10 @@ pub fn relative_rotations_into(
     in_pairs(
         elements,
         |_, a, b| {
-            let (ra, rb) = (gather(&a.nodes, &[], rot).1, gather(&b.nodes, &[], rot).1);
-            let phi = relative_rotation_pair([a, b], &[ra, rb]);
+            let mut rr = [[Matrix3::zeros(); 2]; 2];
+            gather_rotations_into(&a.nodes, rot, &mut rr[0]);
+            gather_rotations_into(&b.nodes, rot, &mut rr[1]);
+            let phi = relative_rotation_pair([a, b], &rr);
             let mut all = all.borrow_mut();
             all.extend([0, 1].map(|k| RelativeRotations::one(lane(&phi, k))));
         },

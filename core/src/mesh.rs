@@ -169,7 +169,8 @@ impl Element {
     ) -> f64 {
         match self {
             Element::Linear(e) => {
-                let (xe, re) = gather(&e.nodes, x, rot);
+                let (mut xe, mut re) = ([Vector3::zeros(); 2], [Matrix3::zeros(); 2]);
+                gather_into(&e.nodes, x, rot, &mut xe, &mut re);
                 e.energy_linear_with(&relative.values[0], &xe, &re)
             }
             Element::Quadratic(_) => self.energy(x, rot),
@@ -184,7 +185,8 @@ impl Element {
     pub fn relative_rotations(&self, rot: &[Matrix3<f64>]) -> RelativeRotations {
         match self {
             Element::Linear(e) => {
-                let (_, r) = gather(&e.nodes, &[], rot);
+                let mut r = [Matrix3::zeros(); 2];
+                gather_rotations_into(&e.nodes, rot, &mut r);
                 let l = e.nodal_triads(&r);
                 RelativeRotations {
                     values: [log(&(l[0].transpose() * l[1])), Vector3::zeros()],
@@ -192,7 +194,7 @@ impl Element {
                 }
             }
             Element::Quadratic(e) => {
-                let (_, r) = gather(&e.nodes, &[], rot);
+                let r = gather(&e.nodes, &[], rot).1;
                 let l = e.nodal_triads(&r);
                 RelativeRotations {
                     values: [
@@ -303,7 +305,8 @@ impl Element {
     ) {
         match self {
             Element::Linear(e) => {
-                let (xe, re) = gather(&e.nodes, x, rot);
+                let (mut xe, mut re) = ([Vector3::zeros(); 2], [Matrix3::zeros(); 2]);
+                gather_into(&e.nodes, x, rot, &mut xe, &mut re);
                 let rv = SVectorViewMut::<f64, 12>::from_slice(r);
                 e.residual_tangent_linear_into(&xe, &re, rv, SMatrixViewMut::from_slice(k));
             }
@@ -373,15 +376,44 @@ fn dissipation_of<const N: usize>(
     2.0 * psi
 }
 
+#[inline(always)]
 pub(crate) fn gather<const N: usize>(
     nodes: &[usize; N],
     x: &[Vector3<f64>],
     rot: &[Matrix3<f64>],
 ) -> ([Vector3<f64>; N], [Matrix3<f64>; N]) {
-    (
-        std::array::from_fn(|i| x.get(nodes[i]).copied().unwrap_or_default()),
-        std::array::from_fn(|i| rot[nodes[i]]),
-    )
+    let mut out = ([Vector3::zeros(); N], [Matrix3::zeros(); N]);
+    gather_into(nodes, x, rot, &mut out.0, &mut out.1);
+    out
+}
+
+/// [`gather`] into arrays the caller holds. The element loops that run on
+/// every evaluation take this one: two 3 × 3 rotations are 144 bytes, and an
+/// array of them returned by value was moved with a call to `memcpy`.
+#[inline(always)]
+pub(crate) fn gather_into<const N: usize>(
+    nodes: &[usize; N],
+    x: &[Vector3<f64>],
+    rot: &[Matrix3<f64>],
+    xs: &mut [Vector3<f64>; N],
+    rs: &mut [Matrix3<f64>; N],
+) {
+    for (xi, &n) in xs.iter_mut().zip(nodes) {
+        *xi = x.get(n).copied().unwrap_or_default();
+    }
+    gather_rotations_into(nodes, rot, rs);
+}
+
+/// The element's nodal rotations alone ([`gather_into`] without positions).
+#[inline(always)]
+pub(crate) fn gather_rotations_into<const N: usize>(
+    nodes: &[usize; N],
+    rot: &[Matrix3<f64>],
+    rs: &mut [Matrix3<f64>; N],
+) {
+    for (r, &n) in rs.iter_mut().zip(nodes) {
+        *r = rot[n];
+    }
 }
 
 /// An element's relative rotations ([`Element::relative_rotations`]): one

@@ -26,6 +26,11 @@ impl StepStart {
         self.pose == *pose
     }
 
+    /// The pose this is the start of.
+    pub fn pose(&self) -> &Pose<f64> {
+        &self.pose
+    }
+
     /// The start pose's rotation pieces.
     pub(crate) fn frames(&self) -> &Frames<f64> {
         &self.frames

@@ -11,7 +11,7 @@ use flexmech_core::frames_pair::energy_momentum_force_parts_pair;
 use flexmech_core::rotation::exp;
 use flexmech_core::step_start::StepStart;
 use flexmech_core::{cst, BeamElement, Configuration, Element, Scalar};
-use nalgebra::{Const, SVector, Vector3, U1};
+use nalgebra::{Const, Matrix3, SVector, Vector3, U1};
 use num_dual::DualSVec64;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
@@ -203,7 +203,7 @@ pub(crate) fn start_of<'a>(
     start: &Configuration,
 ) -> Option<(&'a BeamElement<2>, &'a StepStart)> {
     match (el, starts.get(index)) {
-        (Element::Linear(e), Some(Some(s))) if s.is_of(&pose_of(e, start)) => Some((e, s)),
+        (Element::Linear(e), Some(Some(s))) if is_pose_in(e, s.pose(), start) => Some((e, s)),
         _ => None,
     }
 }
@@ -303,9 +303,25 @@ fn averaged_resultants<T: Scalar>(
 }
 
 /// A 2-node element's nodal positions and rotations in a configuration.
+/// Filled in place: a pose is 192 bytes, and one built as an expression was
+/// moved into its place with a call to `memcpy`, for every element of every
+/// evaluation.
 pub(crate) fn pose_of(e: &BeamElement<2>, c: &Configuration) -> Pose<f64> {
-    let n = e.nodes;
-    ([c.x[n[0]], c.x[n[1]]], [c.rot[n[0]], c.rot[n[1]]])
+    let mut pose = ([Vector3::zeros(); 2], [Matrix3::zeros(); 2]);
+    for (k, &n) in e.nodes.iter().enumerate() {
+        pose.0[k] = c.x[n];
+        pose.1[k] = c.rot[n];
+    }
+    pose
+}
+
+/// Whether `pose` is the element's pose in `c` (compared in place,
+/// [`StepStart::is_of`] without building the pose).
+fn is_pose_in(e: &BeamElement<2>, pose: &Pose<f64>, c: &Configuration) -> bool {
+    e.nodes
+        .iter()
+        .enumerate()
+        .all(|(k, &n)| pose.0[k] == c.x[n] && pose.1[k] == c.rot[n])
 }
 
 /// The energy–momentum scheme's consistency measure of a converged step:
