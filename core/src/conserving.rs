@@ -53,6 +53,20 @@ pub(crate) struct Frames<T: Scalar> {
     pub(crate) d: Vector3<T>,
 }
 
+impl Frames<f64> {
+    /// Zero pieces, to be overwritten (a place for `frames_pair_into`).
+    pub(crate) fn zeros() -> Self {
+        Frames {
+            lam: [Matrix3::zeros(); 2],
+            rel: Vector4::zeros(),
+            phi: Vector3::zeros(),
+            half: Vector4::zeros(),
+            lam_r: Matrix3::zeros(),
+            d: Vector3::zeros(),
+        }
+    }
+}
+
 /// A configuration of one 3-node element: nodal positions and rotations.
 pub type Pose3<T> = ([Vector3<T>; 3], [Matrix3<T>; 3]);
 

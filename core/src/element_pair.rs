@@ -19,7 +19,7 @@ use wide::f64x2;
 pub const MOST_DOFS: usize = 18;
 
 /// Two elements' nodal triads `Λᵢ = Rᵢ Λ₀ᵢ` as pairs, node by node.
-pub(crate) fn triads(e: [&BeamElement<2>; 2], rot: &[[Matrix3<f64>; 2]; 2]) -> [M2; 2] {
+pub(crate) fn triads(e: [&BeamElement<2>; 2], rot: [&[Matrix3<f64>; 2]; 2]) -> [M2; 2] {
     [0, 1].map(|i| {
         let r = matrices([&rot[0][i], &rot[1][i]]);
         mat_mat(&r, &matrices([&e[0].lambda0[i], &e[1].lambda0[i]]))
@@ -38,7 +38,7 @@ pub fn internal_force_pair(
     x: &[[Vector3<f64>; 2]; 2],
     rot: &[[Matrix3<f64>; 2]; 2],
 ) -> [SVector<f64, 12>; 2] {
-    let lam = triads(e, rot);
+    let lam = triads(e, [&rot[0], &rot[1]]);
     let l = pair(e[0].length, e[1].length);
     let half = splat(0.5);
     let phi = log_pair(&mat_t_mat(&lam[0], &lam[1]));
@@ -130,7 +130,7 @@ pub fn for_each_internal_force(
 /// triads at the nodes' rotations `rot[k]`, `k` the element (the
 /// logarithm of [`Element::relative_rotations`], two at a time).
 pub fn relative_rotation_pair(e: [&BeamElement<2>; 2], rot: &[[Matrix3<f64>; 2]; 2]) -> V2 {
-    let lam = triads(e, rot);
+    let lam = triads(e, [&rot[0], &rot[1]]);
     log_pair(&mat_t_mat(&lam[0], &lam[1]))
 }
 

@@ -11,7 +11,7 @@ use crate::element::BeamElement;
 use crate::element_pair::triads;
 use crate::rotation_pair::{
     exp, from_trace, lane, log_factor, mat_mat, mat_t_mat, quaternion_from_trace, scale, splat,
-    unpack, M2,
+    unpack,
 };
 use crate::step_start::StepStart;
 use nalgebra::{SVector, Vector4};
@@ -21,14 +21,19 @@ use wide::f64x2;
 /// relative rotation's quaternion is not read from its trace (a relative
 /// rotation beyond a half turn's neighbourhood: the one-element path
 /// handles it).
-pub(crate) fn frames_pair(
+///
+/// Written into `out` (unchanged where `false`): two `Frames` are 656
+/// bytes, and an array of them returned by value was moved with a call to
+/// `memcpy`.
+pub(crate) fn frames_pair_into(
     e: [&BeamElement<2>; 2],
     poses: [&Pose<f64>; 2],
-) -> Option<[Frames<f64>; 2]> {
-    let lam = triads(e, &[poses[0].1, poses[1].1]);
+    out: &mut [Frames<f64>; 2],
+) -> bool {
+    let lam = triads(e, [&poses[0].1, &poses[1].1]);
     let rel = mat_t_mat(&lam[0], &lam[1]);
     if !(0..2).all(|k| from_trace(&unpack(&rel, k))) {
-        return None;
+        return false;
     }
     // `log_quaternion`: `w ≥ 0` from the trace, no sign flip.
     let [w, x, y, z] = quaternion_from_trace(&rel);
@@ -41,26 +46,32 @@ pub(crate) fn frames_pair(
     let half = [w1 * f, x * f, y * f, z * f];
     let lam_r = mat_mat(&lam[0], &exp(&scale(&phi, splat(0.5))));
     let quaternion = |q: &[f64x2; 4], k: usize| Vector4::from_fn(|i, _| q[i].to_array()[k]);
-    let of = |m: &M2, k| unpack(m, k);
-    Some([0, 1].map(|k| Frames {
-        lam: [of(&lam[0], k), of(&lam[1], k)],
-        rel: quaternion(&[w, x, y, z], k),
-        phi: lane(&phi, k),
-        half: quaternion(&half, k),
-        lam_r: of(&lam_r, k),
-        d: poses[k].0[1] - poses[k].0[0],
-    }))
+    for (k, f) in out.iter_mut().enumerate() {
+        f.lam[0] = unpack(&lam[0], k);
+        f.lam[1] = unpack(&lam[1], k);
+        f.rel = quaternion(&[w, x, y, z], k);
+        f.phi = lane(&phi, k);
+        f.half = quaternion(&half, k);
+        f.lam_r = unpack(&lam_r, k);
+        f.d = poses[k].0[1] - poses[k].0[0];
+    }
+    true
 }
 
 /// [`BeamElement::energy_momentum_force_parts_from`] of two elements from
 /// their step starts to their end poses, the end poses' pieces two at a
-/// time (`frames_pair`): the same bits.
+/// time (`frames_pair_into`): the same bits.
 pub fn energy_momentum_force_parts_pair(
     e: [&BeamElement<2>; 2],
     start: [&StepStart; 2],
     end: [&Pose<f64>; 2],
 ) -> [(SVector<f64, 12>, SVector<f64, 12>); 2] {
-    let ends = frames_pair(e, end).unwrap_or_else(|| [0, 1].map(|k| e[k].frames(end[k])));
+    let mut ends = [Frames::zeros(); 2];
+    if !frames_pair_into(e, end, &mut ends) {
+        for (f, (e, end)) in ends.iter_mut().zip(e.iter().zip(end)) {
+            *f = e.frames(end);
+        }
+    }
     [0, 1].map(|k| {
         let (s, f) = (start[k].frames(), &ends[k]);
         let (nbar, mbar) = e[k].averaged_resultants(s, f);
@@ -131,11 +142,12 @@ mod tests {
                 pose(std::array::from_fn(|i| x[6 * k + i]), p)
             });
             let one = [0, 1].map(|k| es[k].frames(&poses[k]));
-            match frames_pair([&es[0], &es[1]], [&poses[0], &poses[1]]) {
-                Some(two) => for k in 0..2 {
+            let mut two = [Frames::zeros(); 2];
+            match frames_pair_into([&es[0], &es[1]], [&poses[0], &poses[1]], &mut two) {
+                true => for k in 0..2 {
                     prop_assert_eq!(bits(&two[k]), bits(&one[k]), "lane {}", k);
                 },
-                None => prop_assert!((0..2).any(|k| !from_trace(
+                false => prop_assert!((0..2).any(|k| !from_trace(
                     &(one[k].lam[0].transpose() * one[k].lam[1])
                 ))),
             }
@@ -161,6 +173,10 @@ mod tests {
             [0.0, 0.0, 0.0, 0.5, 0.0, 0.0],
             [0.0, 0.0, 0.0, 3.0, 0.0, 0.0],
         );
-        assert!(frames_pair([&e, &e], [&p, &p]).is_none());
+        assert!(!frames_pair_into(
+            [&e, &e],
+            [&p, &p],
+            &mut [Frames::zeros(); 2]
+        ));
     }
 }
