@@ -119,6 +119,7 @@ impl<const N: usize> BeamElement<N> {
     }
 
     /// Nodal triads `Λᵢ = Rᵢ Λ₀ᵢ`.
+    #[inline(always)]
     pub(crate) fn triads<T: Scalar>(&self, rot: &[Matrix3<T>; N]) -> [Matrix3<T>; N] {
         // Filled in place (`std::array::from_fn` copied them out with `memcpy`).
         let mut out = [Matrix3::zeros(); N];
