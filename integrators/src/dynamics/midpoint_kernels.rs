@@ -404,50 +404,51 @@ impl CorrectionTally {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::builder::{BeamDef, BeamShape, MechanismBuilder, SectionValues};
-    use crate::constraints::initial_state;
+    use flexmech_core::Section;
 
     /// A step start is found for the configuration it was made at (compared
     /// in place, node by node) and refused for any other: a moved node or a
     /// turned one.
     #[test]
     fn a_step_start_is_used_only_from_its_own_start() {
-        let mut b = MechanismBuilder::new();
-        let section = SectionValues {
-            ea: 1e6,
-            ga: [1e6; 2],
-            gj: 1e3,
-            ei: [1e3; 2],
-            rho_a: 1.0,
-            rho_j: [1e-3; 3],
+        let sec = Section::new([1e6; 3], [1e3; 3], 1.0, [1e-3; 3]);
+        let x: Vec<_> = (0..4)
+            .map(|i| Vector3::new(f64::from(i), 0.0, 0.0))
+            .collect();
+        let els: Vec<_> = (0..3)
+            .map(|i| {
+                let ends = [x[i], x[i + 1]];
+                Element::Linear(BeamElement::new(
+                    [i, i + 1],
+                    sec,
+                    1.0,
+                    &ends,
+                    [Matrix3::identity(); 2],
+                ))
+            })
+            .collect();
+        let start = Configuration {
+            x,
+            rot: vec![Matrix3::identity(); 4],
         };
-        let shape = BeamShape::Straight {
-            start: Vector3::zeros(),
-            end: Vector3::x(),
-            e2: Vector3::y(),
-        };
-        let def = BeamDef {
-            shape,
-            elements: 3,
-            nodes_per_element: 2,
-            section,
-        };
-        b.beam(def).unwrap();
-        let mech = b.build();
-        let start = initial_state(&mech).config;
-        let starts = step_starts(&mech, &start);
-        let els = &mech.mesh.elements;
-        assert!((0..3).all(|i| start_of(&starts, &els[i], i, &start).is_some()));
-        let mut moved = start.clone();
-        moved.x[1].y += 1e-12;
-        let mut turned = start.clone();
-        turned.rot[3] = exp(&Vector3::new(0.0, 0.0, 1e-9)) * turned.rot[3];
+        let starts: Vec<_> = els
+            .iter()
+            .map(|el| match el {
+                Element::Linear(e) => Some(e.step_start(&pose_of(e, &start))),
+                Element::Quadratic(_) => None,
+            })
+            .collect();
         let found = |c: &Configuration| -> Vec<bool> {
             (0..3)
                 .map(|i| start_of(&starts, &els[i], i, c).is_some())
                 .collect()
         };
+        assert_eq!(found(&start), [true; 3]);
+        let mut moved = start.clone();
+        moved.x[1].y += 1e-12;
         assert_eq!(found(&moved), [false, false, true]);
+        let mut turned = start.clone();
+        turned.rot[3] = exp(&Vector3::new(0.0, 0.0, 1e-9)) * turned.rot[3];
         assert_eq!(found(&turned), [true, true, false]);
     }
 }
