@@ -17,14 +17,11 @@ use crate::step_start::StepStart;
 use nalgebra::{SVector, Vector4};
 use wide::f64x2;
 
-/// [`BeamElement::frames`] of two elements' poses, or `None` where a
-/// relative rotation's quaternion is not read from its trace (a relative
-/// rotation beyond a half turn's neighbourhood: the one-element path
-/// handles it).
-///
-/// Written into `out` (unchanged where `false`): two `Frames` are 656
-/// bytes, and an array of them returned by value was moved with a call to
-/// `memcpy`.
+/// [`BeamElement::frames`] of two elements' poses, written into `out`;
+/// `false` (and `out` unchanged) where a relative rotation's quaternion is
+/// not read from its trace (a relative rotation beyond a half turn's
+/// neighbourhood: the one-element path handles it). Two `Frames` are 656
+/// bytes: returned by value, they were moved with a call to `memcpy`.
 pub(crate) fn frames_pair_into(
     e: [&BeamElement<2>; 2],
     poses: [&Pose<f64>; 2],
