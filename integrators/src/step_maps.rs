@@ -41,29 +41,38 @@ impl StepMaps {
         end: &MechanismState,
         lanes: Option<&[StepLanes]>,
     ) -> Self {
+        let mut maps = Self::default();
+        maps.fill(mech, start, end, lanes);
+        maps
+    }
+
+    /// [`Self::new`] in place: the vectors keep their storage from one
+    /// Newton evaluation to the next (one allocation each an evaluation
+    /// otherwise).
+    pub fn fill(
+        &mut self,
+        mech: &Mechanism,
+        start: &MechanismState,
+        end: &MechanismState,
+        lanes: Option<&[StepLanes]>,
+    ) {
         let joints = 0..mech.joints.len();
+        self.values.clear();
+        self.seeded.clear();
         if let Some(lanes) = lanes {
-            let seeded: Vec<_> = joints
-                .map(|j| {
-                    let (master, released) = ends(mech, j, start, end);
-                    mech.joints[j]
-                        .map
-                        .incremental_step_lanes(master, released, lanes[j])
-                })
-                .collect();
-            let values = seeded.iter().map(|s| s.value.clone()).collect();
-            Self { values, seeded }
+            self.seeded.extend(joints.map(|j| {
+                let (master, released) = ends(mech, j, start, end);
+                mech.joints[j]
+                    .map
+                    .incremental_step_lanes(master, released, lanes[j])
+            }));
+            let values = self.seeded.iter().map(|s| s.value.clone());
+            self.values.extend(values);
         } else {
-            let values = joints
-                .map(|j| {
-                    let (master, released) = ends(mech, j, start, end);
-                    mech.joints[j].map.incremental_step(master, released)
-                })
-                .collect();
-            Self {
-                values,
-                seeded: Vec::new(),
-            }
+            self.values.extend(joints.map(|j| {
+                let (master, released) = ends(mech, j, start, end);
+                mech.joints[j].map.incremental_step(master, released)
+            }));
         }
     }
 }

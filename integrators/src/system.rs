@@ -137,6 +137,9 @@ pub struct ReducedSystem<'m, T> {
     pub floor: f64,
     /// The mechanism's steady spin with the inertia it acts on.
     spin: Option<(FrameSpin, Inertia)>,
+    /// The joints' incremental maps of the last evaluation (their storage
+    /// reused by the next).
+    maps: StepMaps,
     /// The scheme's terms.
     pub terms: T,
 }
@@ -168,6 +171,7 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
                 let inertia = mech.inertia(s.mass);
                 (s, inertia)
             }),
+            maps: StepMaps::default(),
             terms,
         }
     }
@@ -175,18 +179,22 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
     /// The reduced residual of nodal residuals `g` into `out`, through the
     /// scheme's [`Reduction`].
     pub fn reduce(&self, g: &[f64], out: &mut [f64]) {
-        let maps = self.step_maps(false);
-        self.reduce_with(maps.as_ref(), g, out);
+        let mut maps = StepMaps::default();
+        let incremental = self.fill_step_maps(false, &mut maps);
+        self.reduce_with(incremental.then_some(&maps), g, out);
     }
 
-    /// The joints' incremental maps of the step `start → end` for the
-    /// conserving schemes' [`Reduction::Incremental`] (seeded along the end
-    /// state with `seeded`); `None` for [`Reduction::Variation`].
-    fn step_maps(&self, seeded: bool) -> Option<StepMaps> {
-        (self.terms.reduction() == Reduction::Incremental).then(|| {
+    /// The joints' incremental maps of the step `start → end` into `maps`
+    /// for the conserving schemes' [`Reduction::Incremental`] (seeded along
+    /// the end state with `seeded`); `false` (and `maps` untouched) for
+    /// [`Reduction::Variation`].
+    fn fill_step_maps(&self, seeded: bool, maps: &mut StepMaps) -> bool {
+        let incremental = self.terms.reduction() == Reduction::Incremental;
+        if incremental {
             let lanes = seeded.then(|| self.topo.step_lanes(self.mech));
-            StepMaps::new(self.mech, &self.start, &self.end, lanes.as_deref())
-        })
+            maps.fill(self.mech, &self.start, &self.end, lanes.as_deref());
+        }
+        incremental
     }
 
     /// [`Self::reduce`] with the step's maps (given for
@@ -223,8 +231,11 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
         self.topo.refresh(mech, &self.end);
         // One map per joint serves the rows, the residual and the tangent;
         // the rows only matter to the tangent.
-        let maps = self.step_maps(tangent && joints);
-        if let Some(maps) = maps.as_ref().filter(|_| tangent && joints) {
+        let mut kept = std::mem::take(&mut self.maps);
+        let maps = self
+            .fill_step_maps(tangent && joints, &mut kept)
+            .then_some(&kept);
+        if let Some(maps) = maps.filter(|_| tangent && joints) {
             self.topo.refresh_rows(mech, &maps.values);
         }
         let (start, end) = (&self.start.config, &self.end.config);
@@ -251,9 +262,9 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
             let residual = (&mut self.nodal[..], &mut self.abs[..]);
             spin.add_steady(inertia, &self.end.config, self.load_time, residual, blocks);
         }
-        self.reduce_with(maps.as_ref(), &self.nodal, r);
+        self.reduce_with(maps, &self.nodal, r);
         if tangent && joints {
-            let blocks = match &maps {
+            let blocks = match maps {
                 None => self.topo.geometric_blocks(mech, &self.end, &self.nodal),
                 Some(maps) => self
                     .topo
@@ -263,6 +274,7 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
                 self.asm.add_block(b, block);
             }
         }
+        self.maps = kept;
         let dofs = &self.topo.dofs;
         let f_ext = dofs.reduced_norm(&self.fext, &mut self.scratch);
         f_ext.max(dofs.reduced_norm(&self.abs, &mut self.scratch))
