@@ -171,10 +171,21 @@ pub trait NewtonSystem {
     /// residual only, into `r`; default `false`): where something the
     /// system reports after the solve is taken from the last evaluation and
     /// must match the state exactly (the energy–momentum scheme's drivers'
-    /// work). The result is accepted whatever its residual, unless it is not
+    /// work; see [`NewtonSystem::evaluate_closing`] for what is evaluated).
+    /// The result is accepted whatever its residual, unless it is not
     /// finite.
     fn evaluates_closing(&self) -> bool {
         false
+    }
+    /// Evaluates a closing correction's result for
+    /// [`NewtonSystem::evaluates_closing`]: its scaled residual where the
+    /// system computes it (the default: [`NewtonSystem::residual`] into
+    /// `r`), which ends the history; `None` where it evaluates only what it
+    /// reports after the solve and found it finite. A non-finite result is
+    /// a non-finite value (`NaN`) either way.
+    fn evaluate_closing(&mut self, r: &mut [f64]) -> Option<f64> {
+        let scale = self.residual(r);
+        Some(scaled_norm(r, scale).1)
     }
     /// Asks for the exact tangent (`true`) or the system's cheaper one
     /// (`false`) at the next tangent evaluation. Default: nothing to switch.
@@ -201,8 +212,9 @@ pub struct NewtonReport {
     /// closing correction (an iterate at the round-off floor corrected once
     /// more, its result not evaluated: FORMULATION §4) of a system that
     /// does not ask for its evaluation
-    /// ([`NewtonSystem::evaluates_closing`]), where the history has one
-    /// entry per solve.
+    /// ([`NewtonSystem::evaluates_closing`]) or evaluates it without its
+    /// scaled residual ([`NewtonSystem::evaluate_closing`]), where the
+    /// history has one entry per solve.
     pub history: Vec<f64>,
 }
 
@@ -594,8 +606,9 @@ fn closes<S: NewtonSystem>(
 /// tolerance where the floor is below it); its residual is not evaluated —
 /// the stall test would evaluate it only to find it there. Returns the
 /// solves made, `it + 1`; where the system asks for it
-/// ([`NewtonSystem::evaluates_closing`]) the result's residual is evaluated
-/// into `r` and its scaled norm ends the `history`.
+/// ([`NewtonSystem::evaluates_closing`]) the result is evaluated
+/// ([`NewtonSystem::evaluate_closing`]); its scaled residual, where that is
+/// computed, ends the `history`.
 fn close<S: NewtonSystem>(
     sys: &mut S,
     lu: &mut SparseLu,
@@ -618,11 +631,11 @@ fn close<S: NewtonSystem>(
     }
     sys.apply(dq);
     if sys.evaluates_closing() {
-        let scale = sys.residual(r);
-        let (_, res) = scaled_norm(r, scale);
-        history.push(res);
-        if !res.is_finite() {
-            return Err(not_finite);
+        if let Some(res) = sys.evaluate_closing(r) {
+            history.push(res);
+            if !res.is_finite() {
+                return Err(not_finite);
+            }
         }
     }
     Ok(it + 1)

@@ -21,6 +21,10 @@ struct Cubic {
     floor_noises: f64,
     /// A floor set outright (0: none).
     floor_at: f64,
+    /// [`NewtonSystem::evaluates_closing`], and whether the closing's
+    /// evaluation computes the scaled residual (`Some(true)`) or only what
+    /// the system reports (`Some(false)`).
+    closing: Option<bool>,
 }
 
 impl Cubic {
@@ -35,6 +39,7 @@ impl Cubic {
             noise: 0.0,
             floor_noises: 4.0,
             floor_at: 0.0,
+            closing: None,
         }
     }
 }
@@ -77,6 +82,14 @@ impl NewtonSystem for Cubic {
     }
     fn set_exact_tangent(&mut self, exact: bool) {
         self.exact = exact;
+    }
+    fn evaluates_closing(&self) -> bool {
+        self.closing.is_some()
+    }
+    fn evaluate_closing(&mut self, r: &mut [f64]) -> Option<f64> {
+        let scale = self.residual(r);
+        let (_, res) = scaled_norm(r, scale);
+        (self.closing == Some(true) || !res.is_finite()).then_some(res)
     }
     fn free_motion(&self, _mode: &[f64], _tangent: TangentRef) -> FreeMotion {
         FreeMotion::default()
@@ -302,6 +315,40 @@ fn a_cheap_tangents_landing_at_the_floor_is_closed_when_its_contraction_promises
     // Two factorisations: the chord step and the closing correction reuse
     // the second.
     assert_eq!(report.factorizations, report.iterations - 2, "{report:?}");
+}
+
+#[test]
+fn a_closing_evaluated_for_what_the_system_reports_ends_the_history_only_with_its_residual() {
+    // The closing of the test above, not evaluated, evaluated with its
+    // scaled residual, and evaluated for what the system reports alone
+    // (the energy–momentum scheme's nodal residual for the drivers' work):
+    // the same iterates and solution to the bit; the residual ends the
+    // history only where it was computed, and the evaluation is made where
+    // it is asked for.
+    let solve = |closing: Option<bool>| {
+        let mut sys = Cubic::new(1.003);
+        sys.noise = 1e-9;
+        sys.floor_noises = 16.0;
+        sys.closing = closing;
+        let report = run_to(&mut sys, false, 1e-10);
+        (sys.q, sys.cheap_count, report)
+    };
+    let (q, evaluations, report) = solve(None);
+    assert_eq!(report.history.len(), report.iterations, "{report:?}");
+    let (q_res, evaluations_res, with_res) = solve(Some(true));
+    assert_eq!(
+        with_res.history.len(),
+        report.iterations + 1,
+        "{with_res:?}"
+    );
+    assert_eq!(&with_res.history[..report.iterations], &report.history[..]);
+    let (q_own, evaluations_own, own) = solve(Some(false));
+    assert_eq!(own.history, report.history, "{own:?}");
+    assert_eq!((q_res, q_own), (q, q), "the same solution");
+    assert_eq!(
+        (evaluations_res, evaluations_own),
+        (evaluations + 1, evaluations + 1)
+    );
 }
 
 #[test]
