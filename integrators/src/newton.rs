@@ -134,6 +134,14 @@ pub trait NewtonSystem {
     /// `scratch` (length `n_eq`) receives the residual the evaluation
     /// computes alongside.
     fn update_tangent(&mut self, _scratch: &mut [f64]) {}
+    /// [`NewtonSystem::update_tangent`] at an iterate whose residual
+    /// ([`NewtonSystem::residual`]) was just evaluated, the iterate not
+    /// moved since — as Newton calls it: the system may keep that
+    /// evaluation's residual and compute the tangent alone. Default:
+    /// [`NewtonSystem::update_tangent`].
+    fn update_tangent_at_residual(&mut self, scratch: &mut [f64]) {
+        self.update_tangent(scratch);
+    }
     /// CSC values of the tangent from the last evaluation that computed it.
     fn tangent_values(&self) -> &[f64];
     /// Applies the increment `dq` to the current iterate.
@@ -362,8 +370,9 @@ fn scaled_norm(r: &[f64], scale: f64) -> (f64, f64) {
 }
 
 /// Factorises the tangent at the current iterate (brought up to date
-/// first where `update`: `dq` is scratch until the solve), checking its
-/// regularity where `check`.
+/// first where `update` — at an iterate whose residual was just evaluated,
+/// [`NewtonSystem::update_tangent_at_residual`]: `dq` is scratch until the
+/// solve), checking its regularity where `check`.
 fn refactor<S: NewtonSystem>(
     sys: &mut S,
     lu: &mut SparseLu,
@@ -372,7 +381,7 @@ fn refactor<S: NewtonSystem>(
     dq: &mut [f64],
 ) -> Result<(), NewtonFailure> {
     if update {
-        sys.update_tangent(dq);
+        sys.update_tangent_at_residual(dq);
     }
     lu.factor(sys.tangent_values())
         .map_err(NewtonFailure::LinearSolve)?;

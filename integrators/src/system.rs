@@ -68,6 +68,31 @@ pub trait StepTerms {
         }
     }
 
+    /// Whether the scheme's [`Self::element_tangents`] leave the elements'
+    /// forces out, so that a tangent at an iterate whose residual was just
+    /// evaluated is computed alone
+    /// ([`NewtonSystem::update_tangent_at_residual`]: the residual's nodal
+    /// forces are kept for the joints' blocks). Default: `false`, a whole
+    /// evaluation with the tangent.
+    fn tangents_alone(&self) -> bool {
+        false
+    }
+
+    /// [`Self::elements`] with the tangent where only the tangent is wanted
+    /// (the forces at this iterate were evaluated just before and are
+    /// kept, [`Self::tangents_alone`]): a scheme may leave its forces out of
+    /// `asm`. Default: the whole [`Self::elements`].
+    fn element_tangents(
+        &self,
+        mech: &Mechanism,
+        dofs: &DofMap,
+        asm: &mut Assembler,
+        start: &Configuration,
+        end: &Configuration,
+    ) {
+        self.elements(mech, dofs, asm, start, end, true);
+    }
+
     /// Adds the scheme's inertial forces at `end` to the nodal residual `g`
     /// and their magnitudes to `abs`; with `tangent`, their tangent blocks
     /// to the assembler. Default: none (statics).
@@ -140,6 +165,9 @@ pub struct ReducedSystem<'m, T> {
     /// The joints' incremental maps of the last evaluation (their storage
     /// reused by the next).
     maps: StepMaps,
+    /// Where a tangent-only evaluation puts the nodal residual and scale it
+    /// computes alongside, so that those of the residual it follows stay.
+    spare: (Vec<f64>, Vec<f64>),
     /// The scheme's terms.
     pub terms: T,
 }
@@ -172,6 +200,7 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
                 (s, inertia)
             }),
             maps: StepMaps::default(),
+            spare: (vec![0.0; 6 * nodes], vec![0.0; 6 * nodes]),
             terms,
         }
     }
@@ -225,30 +254,12 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
     /// The residual into `r` (returns the force scale) and, if `tangent`,
     /// the tangent values (see the module docs for the steps).
     pub fn evaluate_with(&mut self, r: &mut [f64], tangent: bool) -> f64 {
-        let mech = self.mech;
-        let joints = !mech.joints.is_empty();
-        self.topo.refresh(mech, &self.end);
-        // One map per joint serves the rows, the residual and the tangent;
-        // the rows only matter to the tangent.
         let mut kept = std::mem::take(&mut self.maps);
-        let maps = self
-            .fill_step_maps(tangent && joints, &mut kept)
-            .then_some(&kept);
-        if let Some(maps) = maps.filter(|_| tangent && joints) {
-            self.topo.refresh_rows(mech, &maps.values);
-        }
-        self.nodal_residual(tangent);
+        let maps = self.refreshed_maps(tangent, &mut kept);
+        self.nodal_residual(tangent, false);
         self.reduce_with(maps, &self.nodal, r);
-        if tangent && joints {
-            let blocks = match maps {
-                None => self.topo.geometric_blocks(mech, &self.end, &self.nodal),
-                Some(maps) => self
-                    .topo
-                    .incremental_blocks(mech, &maps.seeded, &self.nodal),
-            };
-            for (b, block) in blocks.iter().enumerate() {
-                self.asm.add_block(b, block);
-            }
+        if tangent {
+            self.joint_blocks(maps);
         }
         self.maps = kept;
         let dofs = &self.topo.dofs;
@@ -256,16 +267,82 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
         f_ext.max(dofs.reduced_norm(&self.abs, &mut self.scratch))
     }
 
+    /// The tangent values alone at an iterate whose residual
+    /// ([`Self::evaluate_with`]) was just evaluated: the same values as an
+    /// evaluation with the tangent, whose nodal residual would be that
+    /// residual's again (`nodal` and `abs` keep it; the joints' tangent
+    /// blocks are formed from it). The elements may leave their forces out
+    /// ([`StepTerms::element_tangents`]); the other terms' forces go to
+    /// spare buffers.
+    fn tangent_at_residual(&mut self) {
+        let mut kept = std::mem::take(&mut self.maps);
+        let maps = self.refreshed_maps(true, &mut kept);
+        std::mem::swap(&mut self.nodal, &mut self.spare.0);
+        std::mem::swap(&mut self.abs, &mut self.spare.1);
+        self.nodal_residual(true, true);
+        std::mem::swap(&mut self.nodal, &mut self.spare.0);
+        std::mem::swap(&mut self.abs, &mut self.spare.1);
+        self.joint_blocks(maps);
+        self.maps = kept;
+    }
+
+    /// The slaves' node maps refreshed at the iterate and the joints' maps
+    /// of the step filled into `kept` (seeded with `tangent`; `None` for
+    /// [`Reduction::Variation`]), the slaves' rows set from them with the
+    /// tangent: one map per joint serves the rows, the residual and the
+    /// tangent.
+    fn refreshed_maps<'k>(
+        &mut self,
+        tangent: bool,
+        kept: &'k mut StepMaps,
+    ) -> Option<&'k StepMaps> {
+        let mech = self.mech;
+        let joints = !mech.joints.is_empty();
+        self.topo.refresh(mech, &self.end);
+        let maps = self
+            .fill_step_maps(tangent && joints, kept)
+            .then_some(&*kept);
+        if let Some(maps) = maps.filter(|_| tangent && joints) {
+            self.topo.refresh_rows(mech, &maps.values);
+        }
+        maps
+    }
+
+    /// The joints' tangent blocks (from the nodal residual) added to the
+    /// tangent values: through the step's seeded maps, or the variation
+    /// map's geometric blocks at the iterate.
+    fn joint_blocks(&mut self, maps: Option<&StepMaps>) {
+        let mech = self.mech;
+        if mech.joints.is_empty() {
+            return;
+        }
+        let blocks = match maps {
+            None => self.topo.geometric_blocks(mech, &self.end, &self.nodal),
+            Some(maps) => self
+                .topo
+                .incremental_blocks(mech, &maps.seeded, &self.nodal),
+        };
+        for (b, block) in blocks.iter().enumerate() {
+            self.asm.add_block(b, block);
+        }
+    }
+
     /// The nodal residual at the iterate (internal and inertial minus
     /// external forces, 6 per node) into `nodal`, the sums of their
     /// magnitudes into `abs`, and, if `tangent`, the elements', inertia's,
     /// follower loads' and spin's tangent values (the slaves' maps and rows
-    /// set by the caller).
-    fn nodal_residual(&mut self, tangent: bool) {
+    /// set by the caller); `tangent_only`: the elements' tangents alone
+    /// where the scheme leaves their forces out
+    /// ([`StepTerms::element_tangents`]).
+    fn nodal_residual(&mut self, tangent: bool, tangent_only: bool) {
         let mech = self.mech;
         let (start, end) = (&self.start.config, &self.end.config);
-        self.terms
-            .elements(mech, &self.topo.dofs, &mut self.asm, start, end, tangent);
+        let (dofs, asm) = (&self.topo.dofs, &mut self.asm);
+        if tangent_only {
+            self.terms.element_tangents(mech, dofs, asm, start, end);
+        } else {
+            self.terms.elements(mech, dofs, asm, start, end, tangent);
+        }
         for (g, (fi, fe)) in self
             .nodal
             .iter_mut()
@@ -349,6 +426,14 @@ impl<T: StepTerms> NewtonSystem for ReducedSystem<'_, T> {
         self.evaluate_with(scratch, true);
     }
 
+    fn update_tangent_at_residual(&mut self, scratch: &mut [f64]) {
+        if self.terms.tangents_alone() {
+            self.tangent_at_residual();
+        } else {
+            self.evaluate_with(scratch, true);
+        }
+    }
+
     fn tangent_key(&self) -> f64 {
         self.terms.tangent_key()
     }
@@ -387,7 +472,7 @@ impl<T: StepTerms> NewtonSystem for ReducedSystem<'_, T> {
     /// number that only ends the history. A non-finite nodal residual is
     /// `NaN`.
     fn evaluate_closing(&mut self, _r: &mut [f64]) -> Option<f64> {
-        self.nodal_residual(false);
+        self.nodal_residual(false, false);
         (!self.nodal.iter().all(|v| v.is_finite())).then_some(f64::NAN)
     }
 

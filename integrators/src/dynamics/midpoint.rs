@@ -28,7 +28,7 @@ use super::inertia_pairs::{midpoint_moment_pair, moments_in_pairs_into};
 use super::mass_slots::MassSlots;
 use super::midpoint_kernels::{
     correction_size, element_force, element_kernel, start_of, started_force, started_force_pair,
-    started_kernel, step_starts, CorrectionTally,
+    started_kernel, started_tangent, step_starts, CorrectionTally,
 };
 use super::midpoint_sensitivity::MidpointSensitivities;
 use super::time_scheme::{SchemeSensitivities, TimeScheme};
@@ -48,7 +48,7 @@ use crate::sensitivity::Parameter;
 use crate::system::{ReducedSystem, Reduction, StepTerms};
 use flexmech_core::rotation::{cayley_inverse, cayley_tangent_inverse, log};
 use flexmech_core::step_start::StepStart;
-use flexmech_core::{Configuration, Inertia};
+use flexmech_core::{BeamElement, Configuration, Inertia};
 use nalgebra::{Matrix3, Vector3};
 
 /// Velocities at the end of a step from the configurations at both ends.
@@ -187,7 +187,32 @@ impl MidpointTerms {
             starts: Vec::new(),
         }
     }
+
+    /// The elements' forces and tangents between `start` and `end` into
+    /// `asm`: a 2-node element with its step start by `started` (while the
+    /// cheap tangent is asked for), any other by [`element_kernel`].
+    fn tangents(
+        &self,
+        mech: &Mechanism,
+        dofs: &DofMap,
+        asm: &mut Assembler,
+        (start, end): (&Configuration, &Configuration),
+        started: StartedKernel,
+    ) {
+        let (scheme, beta, exact) = (self.scheme, self.beta, self.exact_tangent);
+        let starts = &self.starts;
+        asm.assemble_with(&mech.mesh, dofs, |el, i, re, ke| {
+            match start_of(starts, el, i, start).filter(|_| !exact) {
+                Some(from) => started(from, end, re, ke),
+                None => element_kernel(el, start, end, scheme, beta, exact, re, ke),
+            }
+        });
+    }
 }
+
+/// A kernel of a 2-node element from its step start ([`started_kernel`],
+/// [`started_tangent`]).
+type StartedKernel = fn((&BeamElement<2>, &StepStart), &Configuration, &mut [f64], &mut [f64]);
 
 impl StepTerms for MidpointTerms {
     fn reduction(&self) -> Reduction {
@@ -203,17 +228,11 @@ impl StepTerms for MidpointTerms {
         end: &Configuration,
         tangent: bool,
     ) {
-        let (scheme, beta, exact, tally) =
-            (self.scheme, self.beta, self.exact_tangent, &self.tally);
+        let (scheme, beta, tally) = (self.scheme, self.beta, &self.tally);
         tally.start(!tangent);
         let starts = &self.starts;
         if tangent {
-            asm.assemble_with(&mech.mesh, dofs, |el, i, re, ke| {
-                match start_of(starts, el, i, start).filter(|_| !exact) {
-                    Some(from) => started_kernel(from, end, re, ke),
-                    None => element_kernel(el, start, end, scheme, beta, exact, re, ke),
-                }
-            });
+            self.tangents(mech, dofs, asm, (start, end), started_kernel);
         } else {
             asm.assemble_residual_paired(
                 &mech.mesh,
@@ -233,6 +252,24 @@ impl StepTerms for MidpointTerms {
                 },
             );
         }
+    }
+
+    /// The energy–momentum scheme's cheap tangent is worth computing alone:
+    /// its force, the discrete gradient, is most of its kernel's work.
+    fn tangents_alone(&self) -> bool {
+        self.scheme == Scheme::EnergyMomentum && !self.exact_tangent
+    }
+
+    fn element_tangents(
+        &self,
+        mech: &Mechanism,
+        dofs: &DofMap,
+        asm: &mut Assembler,
+        start: &Configuration,
+        end: &Configuration,
+    ) {
+        self.tally.start(false);
+        self.tangents(mech, dofs, asm, (start, end), started_tangent);
     }
 
     fn inertia(
@@ -494,7 +531,79 @@ pub(super) fn released_rate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::constraints::initial_state;
     use crate::dynamics::mass_slots::inertia_oracle::{assert_equals_ad, inertia, rotations};
+    use crate::newton::NewtonSystem;
+    use crate::JointInstance;
+    use flexmech_core::{MassKind, Mesh, Section};
+    use flexmech_joints::{ReleasedState, Screw, MAX_RELEASED};
+    use std::sync::Arc;
+
+    /// A clamped post and an arm on a screw joint at its top, under
+    /// gravity: 2-node elements with their step starts, and a joint.
+    fn screw_arm() -> Mechanism {
+        let sec = Section::new([1e6, 4e5, 4e5], [1e3; 3], 2.0, [0.02, 0.01, 0.01]);
+        let mut mesh = Mesh::default();
+        let (z, top) = (Vector3::z(), Vector3::new(0.0, 0.0, 2.0));
+        let post = mesh.add_straight_beam(Vector3::zeros(), top, Vector3::x(), 2, 2, sec);
+        let end = Vector3::new(1.0, 0.0, 2.0);
+        let arm = mesh.add_straight_beam(top, end, Vector3::y(), 4, 2, sec);
+        let (post, arm) = (post.unwrap(), arm.unwrap());
+        let mut mech = Mechanism::new(mesh);
+        mech.fixed[post[0]] = [true; 6];
+        mech.gravity = z * -9.81;
+        mech.joints.push(JointInstance {
+            name: "screw".into(),
+            master: *post.last().unwrap(),
+            slave: arm[0],
+            map: Arc::new(Screw {
+                axis: z,
+                pitch: 0.1,
+            }),
+            initial: ReleasedState::new([0.0; MAX_RELEASED]),
+            driven: vec![None],
+        });
+        mech
+    }
+
+    /// The tangent Newton brings up to date at an iterate whose residual it
+    /// has just evaluated is computed alone (the energy–momentum scheme's
+    /// cheap tangent without its discrete gradient): the values of a whole
+    /// evaluation with the tangent to the bit, and the residual's nodal
+    /// forces kept — which the whole evaluation gives again.
+    #[test]
+    fn a_tangent_computed_alone_is_a_whole_evaluations_to_the_bit() {
+        let mech = screw_arm();
+        let mut state = initial_state(&mech);
+        let topo = Topology::new(&mech, &state).unwrap();
+        topo.impose(&mech, &mut state, 0.0);
+        let asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
+        let (inertia, rest) = (
+            mech.inertia(MassKind::Consistent),
+            Motion::rest(mech.mesh.node_count()),
+        );
+        let scheme = Scheme::EnergyMomentum;
+        let terms = MidpointTerms::new(&mech, &topo, &asm, &state, inertia, &rest, scheme);
+        let mut sys = ReducedSystem::new(&mech, topo, asm, state, terms);
+        sys.terms.set_step(1e-2);
+        sys.terms.starts = step_starts(&mech, &sys.start.config);
+        sys.set_exact_tangent(false);
+        assert!(sys.terms.tangents_alone());
+        let n = sys.topo.dofs.n_eq;
+        let dq: Vec<f64> = (0..n).map(|i| 1e-3 * (0.7 * i as f64).sin()).collect();
+        sys.apply(&dq);
+        let mut r = vec![0.0; n];
+        sys.residual(&mut r);
+        let nodal = sys.nodal.clone();
+        sys.update_tangent_at_residual(&mut vec![0.0; n]);
+        let alone = sys.asm.values.clone();
+        assert_eq!(sys.nodal, nodal, "the residual's nodal forces kept");
+        sys.evaluate(&mut r);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&alone), bits(&sys.asm.values));
+        assert_eq!(sys.nodal, nodal);
+        assert!(alone.iter().any(|v| *v != 0.0));
+    }
 
     #[test]
     fn closed_form_inertial_tangent_equals_forward_ad() {

@@ -221,6 +221,21 @@ pub(crate) fn started_kernel(
     k.copy_from_slice(jac.as_slice());
 }
 
+/// [`started_kernel`]'s cheap tangent alone, the force left out (`r`
+/// zeroed): for a tangent at an iterate whose residual was just evaluated.
+pub(crate) fn started_tangent(
+    (e, s): (&BeamElement<2>, &StepStart),
+    end: &Configuration,
+    r: &mut [f64],
+    k: &mut [f64],
+) {
+    r.fill(0.0);
+    k.copy_from_slice(
+        e.energy_momentum_cheap_tangent_from(s, &pose_of(e, end))
+            .as_slice(),
+    );
+}
+
 /// The energy–momentum scheme's force ([`element_force`]) from the
 /// element's step start.
 pub(crate) fn started_force(
