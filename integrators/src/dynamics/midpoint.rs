@@ -190,15 +190,19 @@ impl MidpointTerms {
 
     /// The elements' forces and tangents between `start` and `end` into
     /// `asm`: a 2-node element with its step start by `started` (while the
-    /// cheap tangent is asked for), any other by [`element_kernel`].
-    fn tangents(
+    /// cheap tangent is asked for: [`started_kernel`], or
+    /// [`started_tangent`] for the tangent alone), any other by
+    /// [`element_kernel`].
+    fn tangents<K>(
         &self,
         mech: &Mechanism,
         dofs: &DofMap,
         asm: &mut Assembler,
         (start, end): (&Configuration, &Configuration),
-        started: StartedKernel,
-    ) {
+        started: K,
+    ) where
+        K: Fn((&BeamElement<2>, &StepStart), &Configuration, &mut [f64], &mut [f64]) + Sync,
+    {
         let (scheme, beta, exact) = (self.scheme, self.beta, self.exact_tangent);
         let starts = &self.starts;
         asm.assemble_with(&mech.mesh, dofs, |el, i, re, ke| {
@@ -209,10 +213,6 @@ impl MidpointTerms {
         });
     }
 }
-
-/// A kernel of a 2-node element from its step start ([`started_kernel`],
-/// [`started_tangent`]).
-type StartedKernel = fn((&BeamElement<2>, &StepStart), &Configuration, &mut [f64], &mut [f64]);
 
 impl StepTerms for MidpointTerms {
     fn reduction(&self) -> Reduction {
