@@ -347,15 +347,8 @@ impl Topology {
                 }
             }
         });
-        for (n, map) in self.dofs.nodes.iter().enumerate() {
-            if self.slave_of[n].is_some() {
-                continue;
-            }
-            let gn = Vector6::from_column_slice(&acc[6 * n..6 * n + 6]);
-            for (&e, c) in map.eqs.iter().zip(&map.cols) {
-                out[e] += c.dot(&gn);
-            }
-        }
+        self.dofs
+            .add_reduced_except(&acc, out, |n| self.slave_of[n].is_some());
     }
 
     /// The derivative of the conserving schemes' reduced residual `Σ Ñᵀ g`

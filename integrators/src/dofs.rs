@@ -161,7 +161,18 @@ impl DofMap {
             return;
         }
         out.iter_mut().for_each(|v| *v = 0.0);
+        self.add_reduced_except(g, out, |_| false);
+    }
+
+    /// `Tₙᵀ gₙ` of every node `skip` does not name added into `out`: an
+    /// independent node's own DOFs taken as they are (the dot product with a
+    /// unit column gives the same sum, zero signs included, for finite
+    /// forces), any other through its columns.
+    pub fn add_reduced_except(&self, g: &[f64], out: &mut [f64], skip: impl Fn(usize) -> bool) {
         for (n, (m, own)) in self.nodes.iter().zip(&self.own).enumerate() {
+            if skip(n) {
+                continue;
+            }
             let gn = &g[6 * n..6 * n + 6];
             match own {
                 Some(own) => {
