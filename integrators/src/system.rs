@@ -42,6 +42,9 @@ pub enum Reduction {
     Incremental,
 }
 
+/// A step's start and end configurations.
+pub type Ends<'a> = (&'a Configuration, &'a Configuration);
+
 /// What a scheme contributes to the reduced system at an iterate.
 pub trait StepTerms {
     /// How the joints reduce this scheme's residual.
@@ -82,15 +85,8 @@ pub trait StepTerms {
     /// (the forces at this iterate were evaluated just before and are
     /// kept, [`Self::tangents_alone`]): a scheme may leave its forces out of
     /// `asm`. Default: the whole [`Self::elements`].
-    fn element_tangents(
-        &self,
-        mech: &Mechanism,
-        dofs: &DofMap,
-        asm: &mut Assembler,
-        start: &Configuration,
-        end: &Configuration,
-    ) {
-        self.elements(mech, dofs, asm, start, end, true);
+    fn element_tangents(&self, mech: &Mechanism, dofs: &DofMap, asm: &mut Assembler, ends: Ends) {
+        self.elements(mech, dofs, asm, ends.0, ends.1, true);
     }
 
     /// Adds the scheme's inertial forces at `end` to the nodal residual `g`
@@ -339,7 +335,7 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
         let (start, end) = (&self.start.config, &self.end.config);
         let (dofs, asm) = (&self.topo.dofs, &mut self.asm);
         if tangent_only {
-            self.terms.element_tangents(mech, dofs, asm, start, end);
+            self.terms.element_tangents(mech, dofs, asm, (start, end));
         } else {
             self.terms.elements(mech, dofs, asm, start, end, tangent);
         }

@@ -45,7 +45,7 @@ use crate::mechanism::Mechanism;
 use crate::newton::{self, NewtonReport, NewtonSettings};
 use crate::record::Sensitivity;
 use crate::sensitivity::Parameter;
-use crate::system::{ReducedSystem, Reduction, StepTerms};
+use crate::system::{Ends, ReducedSystem, Reduction, StepTerms};
 use flexmech_core::rotation::{cayley_inverse, cayley_tangent_inverse, log};
 use flexmech_core::step_start::StepStart;
 use flexmech_core::{BeamElement, Configuration, Inertia};
@@ -198,7 +198,7 @@ impl MidpointTerms {
         mech: &Mechanism,
         dofs: &DofMap,
         asm: &mut Assembler,
-        (start, end): (&Configuration, &Configuration),
+        (start, end): Ends,
         started: K,
     ) where
         K: Fn((&BeamElement<2>, &StepStart), &Configuration, &mut [f64], &mut [f64]) + Sync,
@@ -260,16 +260,9 @@ impl StepTerms for MidpointTerms {
         self.scheme == Scheme::EnergyMomentum && !self.exact_tangent
     }
 
-    fn element_tangents(
-        &self,
-        mech: &Mechanism,
-        dofs: &DofMap,
-        asm: &mut Assembler,
-        start: &Configuration,
-        end: &Configuration,
-    ) {
+    fn element_tangents(&self, mech: &Mechanism, dofs: &DofMap, asm: &mut Assembler, ends: Ends) {
         self.tally.start(false);
-        self.tangents(mech, dofs, asm, (start, end), started_tangent);
+        self.tangents(mech, dofs, asm, ends, started_tangent);
     }
 
     fn inertia(
