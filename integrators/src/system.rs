@@ -259,8 +259,8 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
         }
         self.maps = kept;
         let dofs = &self.topo.dofs;
-        let f_ext = dofs.reduced_norm(&self.fext, &mut self.scratch);
-        f_ext.max(dofs.reduced_norm(&self.abs, &mut self.scratch))
+        let (f_ext, abs) = dofs.reduced_norms(&self.fext, &self.abs, &mut self.scratch);
+        f_ext.max(abs)
     }
 
     /// The tangent values alone at an iterate whose residual
