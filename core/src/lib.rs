@@ -7,6 +7,7 @@
 pub mod expr;
 pub mod rotation;
 pub mod rotation_derivatives;
+pub mod rotation_derivatives_pair;
 pub mod rotation_pair;
 pub mod scalar;
 mod secant_pair;
@@ -20,6 +21,7 @@ pub mod element;
 pub mod element_linear;
 pub mod element_pair;
 pub mod element_quadratic;
+pub mod element_tangent_pair;
 pub mod frames_pair;
 pub mod inertia;
 pub mod section;

@@ -25,10 +25,10 @@ pub struct MatrixDerivatives {
 
 /// A scalar function of `t = |p|²` with its first and second derivatives.
 #[derive(Clone, Copy)]
-struct Coefficient {
-    value: f64,
-    d1: f64,
-    d2: f64,
+pub(crate) struct Coefficient {
+    pub(crate) value: f64,
+    pub(crate) d1: f64,
+    pub(crate) d2: f64,
 }
 
 impl From<Dual2<f64>> for Coefficient {
@@ -43,7 +43,7 @@ impl From<Dual2<f64>> for Coefficient {
 
 /// The Rodrigues coefficients `(sin ψ/ψ, (1 − cos ψ)/ψ², (ψ − sin ψ)/ψ³)`
 /// with their derivatives in `t = ψ²`.
-fn coefficients(t: f64) -> [Coefficient; 3] {
+pub(crate) fn coefficients(t: f64) -> [Coefficient; 3] {
     let (a, b, c) = rodrigues_coefficients(Dual2::new(t, 1.0, 0.0));
     [a.into(), b.into(), c.into()]
 }

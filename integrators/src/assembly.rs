@@ -23,6 +23,8 @@ use crate::threads::LoopCost;
 use std::ops::Range;
 use std::time::Instant;
 
+mod pairs;
+
 struct Slots {
     /// Sorted, unique global equations the element touches.
     eqs: Vec<usize>,
@@ -294,7 +296,13 @@ impl Assembler {
 
     /// Evaluates every element at `config`: fills [`Self::nodal`],
     /// [`Self::nodal_abs`] and the tangent [`Self::values`].
+    /// On one thread, two neighbouring 2-node elements whose nodes are all
+    /// independent are evaluated at once (`assembly/pairs.rs`): the same
+    /// bits.
     pub fn assemble(&mut self, mesh: &Mesh, dofs: &DofMap, config: &Configuration) {
+        if !self.tangent_cost.split(mesh.elements.len()) {
+            return self.assemble_in_pairs(mesh, dofs, config);
+        }
         self.assemble_with(mesh, dofs, |el, _, r, k| {
             el.residual_tangent(&config.x, &config.rot, r, k)
         });
@@ -1018,10 +1026,16 @@ mod tests {
         }
         let n = dofs.n_eq;
         let mut dense = vec![0.0; n * n];
+        let mut nodal = vec![0.0; 6 * mesh.node_count()];
         for el in &mesh.elements {
             let d = el.dofs();
             let (mut r, mut k) = (vec![0.0; d], vec![0.0; d * d]);
             el.residual_tangent(&config.x, &config.rot, &mut r, &mut k);
+            for (a, &nd) in el.nodes().iter().enumerate() {
+                for c in 0..6 {
+                    nodal[6 * nd + c] += r[6 * a + c];
+                }
+            }
             let eqs: Vec<(usize, usize)> = el
                 .nodes()
                 .iter()
@@ -1051,6 +1065,10 @@ mod tests {
                 assert!(v == dense[j * n + i], "entry ({i}, {j})");
             }
         }
+        // The nodal forces to the bit (the first two 2-node elements are
+        // evaluated as a pair, `assembly/pairs.rs`).
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&asm.nodal), bits(&nodal));
         // Block 0's entry (2, 30) is no element's: zeroed.
         assert!(!asm.untouched.is_empty());
     }
