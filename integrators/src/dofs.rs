@@ -188,24 +188,30 @@ impl DofMap {
         scratch.iter().map(|x| x * x).sum::<f64>().sqrt()
     }
 
-    /// [`Self::reduced_norm`] of `a` and of `b`, the same two numbers: where
-    /// the reduction is a gather, read from the nodal values in the
-    /// unknowns' order with the two sums side by side (each sum waits on
-    /// its last addition; two in one loop wait once).
-    pub fn reduced_norms(&self, a: &[f64], b: &[f64], scratch: &mut [f64]) -> (f64, f64) {
+    /// [`Self::reduced_norm`] of each of `g`, the same numbers: where the
+    /// reduction is a gather, read from the nodal values in the unknowns'
+    /// order with the sums side by side (each sum waits on its last
+    /// addition; several in one loop wait once).
+    pub fn reduced_norms<const K: usize>(&self, g: [&[f64]; K], scratch: &mut [f64]) -> [f64; K] {
         if !self.gather {
-            return (self.reduced_norm(a, scratch), self.reduced_norm(b, scratch));
+            return g.map(|g| self.reduced_norm(g, scratch));
         }
-        let (mut sa, mut sb) = (0.0f64, 0.0f64);
+        let mut sums = [0.0f64; K];
         for r in &self.runs {
-            let (ra, rb) = (&a[r.from..r.from + r.len], &b[r.from..r.from + r.len]);
-            for (&x, &y) in ra.iter().zip(rb) {
-                // `0 + x` as the gather forms it: its square is `x²`.
-                sa += x * x;
-                sb += y * y;
+            for j in r.from..r.from + r.len {
+                for (s, g) in sums.iter_mut().zip(&g) {
+                    // `0 + g` as the gather forms it: its square is `g²`.
+                    *s += g[j] * g[j];
+                }
             }
         }
-        (sa.sqrt(), sb.sqrt())
+        sums.map(f64::sqrt)
+    }
+
+    /// Whether the reduction is a gather ([`Self::reduce`]): each unknown
+    /// one node's DOF.
+    pub fn is_gather(&self) -> bool {
+        self.gather
     }
 
     /// Reduced residual `Σₙ Tₙᵀ gₙ` from nodal residuals `g` (6 per node).
@@ -288,7 +294,7 @@ mod tests {
         let h: Vec<f64> = g.iter().map(|v| 3.0 * v - 1e-3).collect();
         let mut scratch = vec![0.0; map.n_eq];
         let norms = |m: &DofMap, s: &mut [f64]| {
-            let (x, y) = m.reduced_norms(&g, &h, s);
+            let [x, y] = m.reduced_norms([&g, &h], s);
             [x, y, m.reduced_norm(&g, s), m.reduced_norm(&h, s)].map(f64::to_bits)
         };
         let [x, y, xa, ya] = norms(&map, &mut scratch);

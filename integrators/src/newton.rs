@@ -193,7 +193,15 @@ pub trait NewtonSystem {
     /// a non-finite value (`NaN`) either way.
     fn evaluate_closing(&mut self, r: &mut [f64]) -> Option<f64> {
         let scale = self.residual(r);
-        Some(scaled_norm(r, scale).1)
+        let norm = self.residual_norm(r);
+        Some(scaled_norm(norm, scale).1)
+    }
+    /// `‖r‖₂` of the residual the last [`NewtonSystem::evaluate`] or
+    /// [`NewtonSystem::residual`] wrote into `r`, its squares summed in the
+    /// unknowns' order. Default: [`residual_norm`] of `r`; a system that
+    /// formed the same sum alongside the residual returns it.
+    fn residual_norm(&mut self, r: &[f64]) -> f64 {
+        residual_norm(r)
     }
     /// Asks for the exact tangent (`true`) or the system's cheaper one
     /// (`false`) at the next tangent evaluation. Default: nothing to switch.
@@ -280,7 +288,7 @@ fn iterate<S: NewtonSystem>(
         } else {
             sys.residual(r)
         };
-        let (norm, res) = scaled_norm(r, scale);
+        let (norm, res) = scaled_norm(sys.residual_norm(r), scale);
         history.push(res);
         if !res.is_finite() {
             return Err(NewtonFailure::NotFinite { iteration: it });
@@ -357,10 +365,14 @@ fn iterate<S: NewtonSystem>(
     })
 }
 
-/// The residual's norm and its scaled norm `‖r‖₂ / scale` (0 for a zero
-/// residual, whatever the scale).
-fn scaled_norm(r: &[f64], scale: f64) -> (f64, f64) {
-    let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+/// `‖r‖₂`, the squares summed in order.
+pub fn residual_norm(r: &[f64]) -> f64 {
+    r.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+/// The residual's norm `norm` and its scaled norm `norm / scale` (0 for a
+/// zero residual, whatever the scale).
+fn scaled_norm(norm: f64, scale: f64) -> (f64, f64) {
     let res = if norm == 0.0 {
         0.0
     } else {

@@ -88,7 +88,7 @@ impl NewtonSystem for Cubic {
     }
     fn evaluate_closing(&mut self, r: &mut [f64]) -> Option<f64> {
         let scale = self.residual(r);
-        let (_, res) = scaled_norm(r, scale);
+        let (_, res) = scaled_norm(residual_norm(r), scale);
         (self.closing == Some(true) || !res.is_finite()).then_some(res)
     }
     fn free_motion(&self, _mode: &[f64], _tangent: TangentRef) -> FreeMotion {

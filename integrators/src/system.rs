@@ -164,6 +164,10 @@ pub struct ReducedSystem<'m, T> {
     /// Where a tangent-only evaluation puts the nodal residual and scale it
     /// computes alongside, so that those of the residual it follows stay.
     spare: (Vec<f64>, Vec<f64>),
+    /// `‖r‖₂` of the residual the last evaluation wrote, where it was
+    /// summed alongside the force scale (taken by
+    /// [`NewtonSystem::residual_norm`]).
+    formed_norm: Option<f64>,
     /// The scheme's terms.
     pub terms: T,
 }
@@ -197,6 +201,7 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
             }),
             maps: StepMaps::default(),
             spare: (vec![0.0; 6 * nodes], vec![0.0; 6 * nodes]),
+            formed_norm: None,
             terms,
         }
     }
@@ -252,6 +257,7 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
     pub fn evaluate_with(&mut self, r: &mut [f64], tangent: bool) -> f64 {
         let mut kept = std::mem::take(&mut self.maps);
         let maps = self.refreshed_maps(tangent, &mut kept);
+        let gathered = maps.is_none() && self.topo.dofs.is_gather();
         self.nodal_residual(tangent, false);
         self.reduce_with(maps, &self.nodal, r);
         if tangent {
@@ -259,7 +265,17 @@ impl<'m, T: StepTerms> ReducedSystem<'m, T> {
         }
         self.maps = kept;
         let dofs = &self.topo.dofs;
-        let (f_ext, abs) = dofs.reduced_norms(&self.fext, &self.abs, &mut self.scratch);
+        // Where `r` is the gather of the nodal residual, its norm is summed
+        // with the force scale's ([`NewtonSystem::residual_norm`]).
+        let (g, fext, abs) = (&self.nodal[..], &self.fext[..], &self.abs[..]);
+        let (norm, f_ext, abs) = if gathered {
+            let [norm, f_ext, abs] = dofs.reduced_norms([g, fext, abs], &mut self.scratch);
+            (Some(norm), f_ext, abs)
+        } else {
+            let [f_ext, abs] = dofs.reduced_norms([fext, abs], &mut self.scratch);
+            (None, f_ext, abs)
+        };
+        self.formed_norm = norm;
         f_ext.max(abs)
     }
 
@@ -420,6 +436,7 @@ impl<T: StepTerms> NewtonSystem for ReducedSystem<'_, T> {
 
     fn update_tangent(&mut self, scratch: &mut [f64]) {
         self.evaluate_with(scratch, true);
+        self.formed_norm = None;
     }
 
     fn update_tangent_at_residual(&mut self, scratch: &mut [f64]) {
@@ -428,6 +445,13 @@ impl<T: StepTerms> NewtonSystem for ReducedSystem<'_, T> {
         } else {
             self.evaluate_with(scratch, true);
         }
+        self.formed_norm = None;
+    }
+
+    fn residual_norm(&mut self, r: &[f64]) -> f64 {
+        self.formed_norm
+            .take()
+            .unwrap_or_else(|| crate::newton::residual_norm(r))
     }
 
     fn tangent_key(&self) -> f64 {
