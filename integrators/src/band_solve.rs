@@ -12,6 +12,30 @@
 //! per column. The same operations in the same order as the general loops
 //! of [`crate::band_lu::BandLu`], so the same bits.
 
+/// Columns a solve asks the processor to fetch ahead of the one it works
+/// on: a column's entries are a few cache lines at a stride of the band's
+/// height, which the residual's evaluation between two solves has pushed
+/// out of the nearer caches.
+const PREFETCH_COLUMNS: usize = 12;
+
+/// Asks for the first and last cache lines of `ab[at..at + len]` (nothing
+/// where they lie outside `ab`): a hint, which changes no value.
+#[inline(always)]
+fn prefetch(ab: &[f64], at: usize, len: usize) {
+    #[cfg(target_arch = "x86_64")]
+    if at.checked_add(len).is_some_and(|end| end <= ab.len()) {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        // SAFETY: both addresses lie inside `ab`; a prefetch reads nothing.
+        unsafe {
+            let p = ab.as_ptr().add(at);
+            _mm_prefetch(p.cast(), _MM_HINT_T0);
+            _mm_prefetch(p.add(len - 1).cast(), _MM_HINT_T0);
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (ab, at, len);
+}
+
 /// The forward solve's columns `from..to` with `kl` multipliers each
 /// (`to + kl ≤ n`) and no interchange, for `kl` ∈ {11, 12, 17}; `false`
 /// (and nothing done) for other bandwidths. `ab`: the band storage
@@ -45,6 +69,7 @@ fn forward_fixed<const KL: usize>(
     }
     let mut w: [f64; KL] = std::array::from_fn(|i| b[from + i]);
     for j in from..to {
+        prefetch(ab, (j + PREFETCH_COLUMNS) * ld + kv + 1, KL);
         let bj = w[0];
         b[j] = bj;
         let l: &[f64; KL] = ab[j * ld + kv + 1..][..KL].try_into().expect("KL entries");
@@ -91,6 +116,7 @@ fn backward_fixed<const KU: usize, const W: usize>(
     let mut w: [f64; W] = std::array::from_fn(|i| b[top + i]);
     for j in (to..from).rev() {
         let col = j * ld + kv;
+        prefetch(ab, col.wrapping_sub(PREFETCH_COLUMNS * ld + KU), KU);
         let bj = w[KU] * inverse[j];
         b[j] = bj;
         let u: &[f64; KU] = ab[col - KU..col].try_into().expect("KU entries");
