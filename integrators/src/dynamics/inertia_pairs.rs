@@ -88,12 +88,8 @@ fn newmark_node_pair(
     let (j0, rn, r1) = (at(j0), at(r_n), at(r1));
     let v = |x: &[Vector3<f64>]| vectors([&x[i[0]], &x[i[1]]]);
     let s = f64x2::splat;
-    // ω = log(Rₙ₊₁Rₙᵀ), the body increment Rₙᵀω and the pseudo-acceleration.
-    let omega = log_pair(&mat_mat_t(&r1, &rn));
-    let big = mat_t_vec(&rn, &omega);
     let (w_n, a_n) = (v(&prev.w), v(&prev.alpha));
-    let (c_a, c_div) = (dt * dt * (0.5 - k.beta), k.beta * dt * dt);
-    let a1: V2 = std::array::from_fn(|c| (big[c] - w_n[c] * s(dt) - a_n[c] * s(c_a)) / s(c_div));
+    let (omega, a1) = increment_pair(k, (&rn, &r1), (&w_n, &a_n), dt);
     // Wₙ₊₁ and Ȧₙ₊₁ (generalized-α's average; Newmark's when α_m = α_f = 0).
     let (c_w, c_g) = (dt * (1.0 - k.gamma), dt * k.gamma);
     let w1: V2 = std::array::from_fn(|c| (w_n[c] + a_n[c] * s(c_w)) + a1[c] * s(c_g));
@@ -110,6 +106,41 @@ fn newmark_node_pair(
         rn,
         r1,
     }
+}
+
+/// The spatial increment `ω = log(Rₙ₊₁Rₙᵀ)` of two nodes and their body
+/// angular pseudo-accelerations `aₙ₊₁ = (Rₙᵀω − Δt Wₙ − Δt²(½ − β)aₙ)/(βΔt²)`
+/// (as `angular_acceleration` forms them), from the start and end
+/// rotations `(rn, r1)` and the start's `(Wₙ, aₙ)`.
+fn increment_pair(
+    k: &Coefficients,
+    (rn, r1): (&M2, &M2),
+    (w_n, a_n): (&V2, &V2),
+    dt: f64,
+) -> (V2, V2) {
+    let s = f64x2::splat;
+    // ω = log(Rₙ₊₁Rₙᵀ), the body increment Rₙᵀω and the pseudo-acceleration.
+    let omega = log_pair(&mat_mat_t(r1, rn));
+    let big = mat_t_vec(rn, &omega);
+    let (c_a, c_div) = (dt * dt * (0.5 - k.beta), k.beta * dt * dt);
+    let a1: V2 = std::array::from_fn(|c| (big[c] - w_n[c] * s(dt) - a_n[c] * s(c_a)) / s(c_div));
+    (omega, a1)
+}
+
+/// The Newmark family's body angular pseudo-accelerations at the step's
+/// end of nodes `i` (start rotations `r_n`, end rotations `r1`, the start's
+/// `W` and `a` in `w`, `alpha`), as `angular_acceleration` gives each.
+pub(super) fn angular_acceleration_pair(
+    k: &Coefficients,
+    (r_n, r1): (&[Matrix3<f64>], &[Matrix3<f64>]),
+    (w, alpha): (&[Vector3<f64>], &[Vector3<f64>]),
+    i: [usize; 2],
+    dt: f64,
+) -> [Vector3<f64>; 2] {
+    let at = |m: &[Matrix3<f64>]| matrices([&m[i[0]], &m[i[1]]]);
+    let v = |x: &[Vector3<f64>]| vectors([&x[i[0]], &x[i[1]]]);
+    let (_, a1) = increment_pair(k, (&at(r_n), &at(r1)), (&v(w), &v(alpha)), dt);
+    [lane(&a1, 0), lane(&a1, 1)]
 }
 
 impl NodePair {
@@ -186,13 +217,13 @@ pub(super) fn midpoint_moment_pair(
 #[cfg(test)]
 mod tests {
     use super::{
-        in_node_pairs_into, midpoint_moment_pair, moments_in_pairs_into, newmark_moment_pair,
-        newmark_tangent_pair, V2,
+        angular_acceleration_pair, in_node_pairs_into, midpoint_moment_pair, moments_in_pairs_into,
+        newmark_moment_pair, newmark_tangent_pair, V2,
     };
     use crate::dynamics::mass_slots::inertia_oracle::inertia;
     use crate::dynamics::midpoint::inertial_moment_at;
     use crate::dynamics::newmark_terms::{
-        inertial_moment, inertial_moment_tangent, Coefficients, Kinematics,
+        angular_acceleration, inertial_moment, inertial_moment_tangent, Coefficients, Kinematics,
     };
     use flexmech_core::rotation::exp;
     use nalgebra::{Matrix3, Vector3};
@@ -260,6 +291,13 @@ mod tests {
                 ang_acc: vectors(&ang_acc),
             };
             for (k, dt) in [(Coefficients::TRAPEZOIDAL, 1e-3), (Coefficients::generalized_alpha(0.6), 0.05)] {
+                for i in [[0, 1], [2, 3]] {
+                    let two = angular_acceleration_pair(&k, (&r_n, &r1), (&prev.w, &prev.alpha), i, dt);
+                    for (lane, &n) in i.iter().enumerate() {
+                        let one = angular_acceleration(&k, &r_n[n], &r1[n], &prev.w[n], &prev.alpha[n], dt);
+                        prop_assert!(one.iter().zip(two[lane].iter()).all(|(a, b)| a.to_bits() == b.to_bits()), "angular acceleration of node {}", n);
+                    }
+                }
                 let one = |i: usize| inertial_moment(&k, &j0[i], &r_n[i], &r1[i], &prev, i, dt);
                 let pair = |i| Some(newmark_moment_pair(&k, (&j0, &r_n, &r1), &prev, i, dt));
                 let pairs = moments_in_pairs(&j0, one, pair);

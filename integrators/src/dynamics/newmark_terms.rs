@@ -6,7 +6,8 @@
 
 use super::checkpoint::{CheckpointMismatch, Tape};
 use super::inertia_pairs::{
-    in_node_pairs_into, moments_in_pairs_into, newmark_moment_pair, newmark_tangent_pair,
+    angular_acceleration_pair, in_node_pairs_into, moments_in_pairs_into, newmark_moment_pair,
+    newmark_tangent_pair,
 };
 use super::mass_slots::MassSlots;
 use super::newmark_sensitivity::NewmarkSensitivities;
@@ -120,7 +121,7 @@ fn pseudo_acceleration(
 
 /// Body angular pseudo-acceleration at `n+1` for the end rotation `r1`,
 /// with the body increment `Ω = Rₙᵀ log(Rₙ₊₁Rₙᵀ)` (generic, for AD).
-fn angular_acceleration<T: flexmech_core::Scalar>(
+pub(super) fn angular_acceleration<T: flexmech_core::Scalar>(
     k: &Coefficients,
     r_n: &Matrix3<f64>,
     r1: &Matrix3<T>,
@@ -577,15 +578,23 @@ impl TimeScheme for NewmarkTerms {
             );
         }
         let (kin, k) = (&mut sys.terms.prev, &sys.terms.coefficients);
-        // The angular accelerations (a logarithm each) node by node, on two
-        // threads for a large mesh.
+        // The angular accelerations (a logarithm each) two nodes at a time
+        // (the same bits), on two threads for a large mesh.
+        let nodes = start.x.len();
         let angular = {
             let kin = &*kin;
-            crate::threads::map_nodes(start.x.len(), |i| {
+            let one = |i| {
                 angular_acceleration(k, &start.rot[i], &end.rot[i], &kin.w[i], &kin.alpha[i], dt)
+            };
+            crate::threads::map_nodes(nodes.div_ceil(2), |p| match [2 * p, 2 * p + 1] {
+                i if i[1] < nodes => {
+                    let rotations = (&start.rot[..], &end.rot[..]);
+                    angular_acceleration_pair(k, rotations, (&kin.w, &kin.alpha), i, dt)
+                }
+                i => [one(i[0]), Vector3::zeros()],
             })
         };
-        for (i, al) in angular.into_iter().enumerate() {
+        for (i, al) in angular.into_iter().flatten().take(nodes).enumerate() {
             let a1 = pseudo_acceleration(k, end.x[i] - start.x[i], &kin.v[i], &kin.a[i], dt);
             kin.v[i] += (kin.a[i] * (1.0 - k.gamma) + a1 * k.gamma) * dt;
             kin.acc[i] = k.acceleration(a1, &kin.a[i], &kin.acc[i]);
