@@ -233,6 +233,12 @@ pub struct BandLu {
     /// For each column of the band storage, the range of its entries in the
     /// CSC values (the column it is renumbered from).
     columns: Vec<std::ops::Range<usize>>,
+    /// The entries of each column of the band storage as runs whose band
+    /// rows go up or down by one from entry to entry ([`SlotRun`]), so that
+    /// a column is loaded by copies: its runs are `runs[run_of[c]..run_of[c + 1]]`.
+    runs: Vec<SlotRun>,
+    /// Where each column's runs start in `runs` (and where they end).
+    run_of: Vec<usize>,
     /// Where each stored entry's value is: its position in the values a
     /// factorisation is given, or (`None`) the entry's own index — the CSC
     /// values of the pattern itself. A half of a split band
@@ -293,12 +299,15 @@ impl BandLu {
                 }
             }
         }
+        let (runs, run_of) = slot_runs(&slot, &columns);
         Self {
             ld,
             ab: vec![0.0; ld * n],
             piv: vec![0; n],
             slot,
             columns,
+            runs,
+            run_of,
             sources: None,
             diagonal,
             top,
@@ -357,6 +366,7 @@ impl BandLu {
         let entries = Entries {
             slot: &self.slot,
             columns: &self.columns,
+            runs: (&self.runs, &self.run_of),
             sources: self.sources.as_deref(),
             values,
         };
@@ -579,10 +589,63 @@ fn update_column(
 /// pairs, which waits where the stores are still in flight.
 const LOAD_AHEAD: usize = 4;
 
+/// A run of a band column's entries: the `len` values from `at` in the CSC
+/// values go to the band rows from `row` on, down the column (`up`
+/// false: rows `row, row + 1, …`) or up it (`row, row − 1, …`).
+#[derive(Debug, Clone, Copy)]
+struct SlotRun {
+    row: u32,
+    len: u32,
+    up: bool,
+    at: usize,
+}
+
+/// The runs of every band column's entries ([`BandLu::runs`]): maximal
+/// stretches of a column's CSC entries whose band rows step by one in one
+/// direction.
+fn slot_runs(slot: &[u32], columns: &[std::ops::Range<usize>]) -> (Vec<SlotRun>, Vec<usize>) {
+    let mut runs: Vec<SlotRun> = Vec::new();
+    let mut run_of = Vec::with_capacity(columns.len() + 1);
+    for entries in columns {
+        run_of.push(runs.len());
+        let first = runs.len();
+        for k in entries.clone() {
+            let row = slot[k];
+            if let Some(r) = runs[first..].last_mut() {
+                let next = |up: bool| {
+                    if up {
+                        r.row.checked_sub(r.len)
+                    } else {
+                        r.row.checked_add(r.len)
+                    }
+                };
+                if r.len == 1 && (row + 1 == r.row || r.row + 1 == row) {
+                    r.up = row + 1 == r.row;
+                    r.len = 2;
+                    continue;
+                }
+                if r.len > 1 && next(r.up) == Some(row) {
+                    r.len += 1;
+                    continue;
+                }
+            }
+            runs.push(SlotRun {
+                row,
+                len: 1,
+                up: false,
+                at: k,
+            });
+        }
+    }
+    run_of.push(runs.len());
+    (runs, run_of)
+}
+
 /// The pattern's values as the band storage's columns take them.
 struct Entries<'a> {
     slot: &'a [u32],
     columns: &'a [std::ops::Range<usize>],
+    runs: (&'a [SlotRun], &'a [usize]),
     sources: Option<&'a [usize]>,
     values: &'a [f64],
 }
@@ -596,8 +659,18 @@ impl Entries<'_> {
         let slots = &self.slot[entries.clone()];
         match self.sources {
             None => {
-                for (&row, &v) in slots.iter().zip(&self.values[entries]) {
-                    column[row as usize] = v;
+                let (runs, run_of) = self.runs;
+                for r in &runs[run_of[c]..run_of[c + 1]] {
+                    let (row, len) = (r.row as usize, r.len as usize);
+                    let src = &self.values[r.at..r.at + len];
+                    if r.up {
+                        let dst = &mut column[row + 1 - len..=row];
+                        for (d, &v) in dst.iter_mut().rev().zip(src) {
+                            *d = v;
+                        }
+                    } else {
+                        column[row..row + len].copy_from_slice(src);
+                    }
                 }
             }
             Some(src) => {
@@ -885,6 +958,38 @@ pub(crate) mod tests {
         }
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         (pattern, values)
+    }
+
+    /// A column loaded by its runs holds the values the entries' slots
+    /// scatter, on a node chain (long runs, up or down the column as the
+    /// renumbering goes) and on a scrambled pattern (short ones).
+    #[test]
+    fn a_column_loaded_by_runs_holds_what_its_slots_scatter() {
+        let (chain, chain_values) = node_chain(7, 6);
+        let (scrambled, scrambled_values) = scrambled(40, 5, 3);
+        let mut longest = 0;
+        for (pattern, values) in [(chain, chain_values), (scrambled, scrambled_values)] {
+            let lu = BandLu::new(&pattern, BandStructure::of(&pattern));
+            let entries = Entries {
+                slot: &lu.slot,
+                columns: &lu.columns,
+                runs: (&lu.runs, &lu.run_of),
+                sources: None,
+                values: &values,
+            };
+            for c in 0..lu.columns.len() {
+                let mut column = vec![f64::NAN; lu.ld];
+                entries.load(c, &mut column, 0);
+                let mut expected = vec![0.0; lu.ld];
+                for k in lu.columns[c].clone() {
+                    expected[lu.slot[k] as usize] = values[k];
+                }
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&column), bits(&expected), "column {c}");
+            }
+            longest = longest.max(lu.runs.iter().map(|r| r.len).max().unwrap_or(0));
+        }
+        assert!(longest >= 12, "a chain's column is a few runs: {longest}");
     }
 
     /// The steps skipped above each column's top (its first row of the
