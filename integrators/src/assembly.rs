@@ -15,7 +15,8 @@ use crate::dofs::DofMap;
 use crate::sparsity::symmetric_pattern;
 use faer::sparse::SymbolicSparseColMat;
 use flexmech_core::element_pair::{for_each_internal_force, MOST_DOFS};
-use flexmech_core::{Configuration, Element, Inertia, Mesh};
+use flexmech_core::element_tangent_pair::residual_tangent_pair_at;
+use flexmech_core::{BeamElement, Configuration, Element, Inertia, Mesh};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector6};
 
 use crate::element_split::{Shared, Split};
@@ -24,6 +25,10 @@ use std::ops::Range;
 use std::time::Instant;
 
 mod pairs;
+
+/// A kernel of two neighbouring 2-node elements: their residuals and
+/// tangents (column-major) into the two pairs of buffers.
+type PairKernel<'a> = dyn Fn([&BeamElement<2>; 2], [&mut [f64]; 2], [&mut [f64]; 2]) + Sync + 'a;
 
 struct Slots {
     /// Sorted, unique global equations the element touches.
@@ -303,8 +308,15 @@ impl Assembler {
         if !self.tangent_cost.split(mesh.elements.len()) {
             return self.assemble_in_pairs(mesh, dofs, config);
         }
-        self.assemble_with(mesh, dofs, |el, _, r, k| {
-            el.residual_tangent(&config.x, &config.rot, r, k)
+        let (x, rot) = (&config.x[..], &config.rot[..]);
+        let pair = |e: [&BeamElement<2>; 2], r: [&mut [f64]; 2], k: [&mut [f64]; 2]| {
+            residual_tangent_pair_at(e, x, rot, r, k)
+        };
+        self.split_loop(mesh, true, Some(&pair), |w, _, el, s| {
+            el.residual_tangent(x, rot, w.r.as_mut_slice(), w.k.as_mut_slice());
+            if s.direct.is_none() {
+                reduce_tangent(w, el, dofs, s);
+            }
         });
     }
 
@@ -345,7 +357,7 @@ impl Assembler {
             }
             return;
         }
-        self.split_loop(mesh, true, element);
+        self.split_loop(mesh, true, None, element);
     }
 
     /// The element loop over the chunks of [`Self::split`]: `evaluate(w,
@@ -353,7 +365,11 @@ impl Assembler {
     /// the reduced tangent; otherwise the residual `w.r`), which is added to
     /// the nodal forces (and the tangent values) as [`crate::element_split`]
     /// says.
-    fn split_loop<F>(&mut self, mesh: &Mesh, tangent: bool, evaluate: F)
+    /// `pair`: with the tangent, a kernel of two neighbouring 2-node
+    /// elements ([`residual_tangent_pair_at`], the one-element bits), which
+    /// two such elements of a chunk whose tangents go straight into the
+    /// values and that are not late take instead of `evaluate`.
+    fn split_loop<F>(&mut self, mesh: &Mesh, tangent: bool, pair: Option<&PairKernel>, evaluate: F)
     where
         F: Fn(&mut Work, usize, &Element, &Slots) + Sync,
     {
@@ -381,7 +397,25 @@ impl Assembler {
             .into_iter()
             .zip(chunk_scratch.iter_mut());
         crate::threads::for_each_item(items.collect(), |c, (part, scratch)| {
+            let mut skip = false;
             for (w_own, index) in part.iter_mut().zip(split.chunks[c].clone()) {
+                if std::mem::take(&mut skip) {
+                    continue;
+                }
+                let in_chunk = split.chunks[c].contains(&(index + 1));
+                let late = |i| split.is_late(i);
+                if let Some((pair, els)) = pair
+                    .filter(|_| tangent && in_chunk && !late(index) && !late(index + 1))
+                    .zip(pairs::direct_pair(&mesh.elements, slots, index))
+                {
+                    // SAFETY: chunk `c` owns both elements' values and
+                    // nodes (neither is late).
+                    let elements = [&mesh.elements[index], &mesh.elements[index + 1]];
+                    let s = [&slots[index], &slots[index + 1]];
+                    unsafe { pairs::add_pair(&sinks, pair, (els, elements), s) };
+                    skip = true;
+                    continue;
+                }
                 let (el, s) = (&mesh.elements[index], &slots[index]);
                 let late = split.is_late(index);
                 // Late elements keep their output for the second phase;
@@ -541,7 +575,7 @@ impl Assembler {
     {
         let n = mesh.elements.len();
         if self.residual_cost.split(n) {
-            return self.split_loop(mesh, false, |w, index, el, _| {
+            return self.split_loop(mesh, false, None, |w, index, el, _| {
                 kernel(el, index, w.r.as_mut_slice())
             });
         }
@@ -870,6 +904,21 @@ impl<'a> Sinks<'a> {
                     }
                 }
             }
+        }
+    }
+
+    /// Adds the forces `r` and tangent `k` (its kernel's buffer) of an
+    /// element `el` whose tangent goes straight into the values
+    /// ([`Slots::direct`]) — all of them, as [`Sinks::add`] without `only`.
+    ///
+    /// # Safety
+    /// As for [`Sinks::add`].
+    unsafe fn add_direct(&self, el: &Element, r: &[f64], k: &[f64], s: &Slots) {
+        // SAFETY: by the caller's contract.
+        unsafe { self.add_forces(el, r, None) };
+        for &(e, p, len, first) in s.direct.iter().flatten() {
+            // SAFETY: by the caller's contract.
+            unsafe { self.values.add_or_store(p, &k[e..e + len], first) };
         }
     }
 

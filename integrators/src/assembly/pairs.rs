@@ -4,7 +4,10 @@
 //! every element's forces and tangent summed in element order as the
 //! element-by-element loop sums them.
 
-use super::{add_forces, add_run, add_tangent, reduce_tangent, scratch_for, Assembler, Slots};
+use super::{
+    add_forces, add_run, add_tangent, reduce_tangent, scratch_for, Assembler, PairKernel, Sinks,
+    Slots,
+};
 use crate::dofs::DofMap;
 use flexmech_core::element_tangent_pair::residual_tangent_pair_at;
 use flexmech_core::{BeamElement, Configuration, Element, Mesh};
@@ -15,7 +18,7 @@ const DOFS: usize = 12;
 
 /// Elements `i` and `i + 1` when both are 2-node elements whose tangents
 /// go straight into the values ([`Slots::direct`]).
-fn direct_pair<'a>(
+pub(super) fn direct_pair<'a>(
     elements: &'a [Element],
     slots: &[Slots],
     i: usize,
@@ -24,6 +27,27 @@ fn direct_pair<'a>(
         return None;
     };
     (slots[i].direct.is_some() && slots[i + 1].direct.is_some()).then_some([a, b])
+}
+
+/// Evaluates two neighbouring direct 2-node elements `els` (the mesh's
+/// `elements`, slots `s`) by `pair` and adds them to `sinks`, the first
+/// first.
+///
+/// # Safety
+/// As for [`Sinks::add`]: the caller's chunk owns everything both add to.
+pub(super) unsafe fn add_pair(
+    sinks: &Sinks<'_>,
+    pair: &PairKernel,
+    (els, elements): ([&BeamElement<2>; 2], [&Element; 2]),
+    s: [&Slots; 2],
+) {
+    let (mut r, mut k) = ([[0.0; DOFS]; 2], [[0.0; DOFS * DOFS]; 2]);
+    let ([r0, r1], [k0, k1]) = (&mut r, &mut k);
+    pair(els, [r0, r1], [k0, k1]);
+    for j in 0..2 {
+        // SAFETY: by the caller's contract.
+        unsafe { sinks.add_direct(elements[j], &r[j], &k[j], s[j]) };
+    }
 }
 
 /// Adds the tangent `k` of an element with direct runs `s` to `values`.
