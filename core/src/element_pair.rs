@@ -165,7 +165,7 @@ pub fn relative_rotations_into(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::{for_each_internal_force, internal_force_pair, relative_rotations_of};
     use crate::element::BeamElement;
     use crate::mesh::Element;
@@ -174,7 +174,8 @@ mod tests {
     use nalgebra::Vector3;
     use proptest::prelude::*;
 
-    fn element(length: f64, tilt: [f64; 3], prestrain: f64) -> BeamElement<2> {
+    /// A curved (`tilt`), prestrained element of `length`.
+    pub(crate) fn element(length: f64, tilt: [f64; 3], prestrain: f64) -> BeamElement<2> {
         let section = Section::new(
             [1.0e7, 5.0e6, 4.0e6],
             [7.0e5, 8.0e5, 8.3e5],
@@ -231,6 +232,52 @@ mod tests {
         }
     }
 
+    /// Two elements (`tilt`, `lengths`, the second prestrained) and their
+    /// nodes' positions (moved by `moves`) and rotations (turned from
+    /// `dirs[2k]` by `dirs[2k + 1]` scaled by `10^scales[k]`): the property
+    /// tests' pairs.
+    pub(crate) fn two_elements(
+        dirs: [[f64; 3]; 4],
+        scales: [f64; 2],
+        tilt: [[f64; 3]; 2],
+        moves: [[f64; 3]; 4],
+        lengths: [f64; 2],
+    ) -> Pair {
+        let e = [0, 1].map(|k| element(lengths[k], tilt[k], 0.1 * k as f64));
+        let rot = [0, 1].map(|k| {
+            let base = exp(&Vector3::from(dirs[2 * k]));
+            [
+                base,
+                exp(&(Vector3::from(dirs[2 * k + 1]) * 10f64.powf(scales[k]))) * base,
+            ]
+        });
+        let x = [0, 1].map(|k| {
+            let end = Vector3::new(lengths[k], 0.0, 0.0) + Vector3::from(moves[2 * k + 1]);
+            [Vector3::from(moves[2 * k]), end]
+        });
+        (e, x, rot)
+    }
+
+    /// [`two_elements`] over the property tests' ranges: relative rotations
+    /// from 10⁻⁵ rad to past 120°, curved elements of 0.1 to 2 length units.
+    pub(crate) fn pairs() -> impl Strategy<Value = Pair> {
+        (
+            prop::array::uniform4(prop::array::uniform3(-1.0..1.0f64)),
+            prop::array::uniform2(-5.0..0.4f64),
+            prop::array::uniform2(prop::array::uniform3(-0.5..0.5f64)),
+            prop::array::uniform4(prop::array::uniform3(-0.3..0.3f64)),
+            prop::array::uniform2(0.1..2.0f64),
+        )
+            .prop_map(|(d, s, t, m, l)| two_elements(d, s, t, m, l))
+    }
+
+    /// Two elements with their nodes' positions and rotations.
+    pub(crate) type Pair = (
+        [BeamElement<2>; 2],
+        [[Vector3<f64>; 2]; 2],
+        [[nalgebra::Matrix3<f64>; 2]; 2],
+    );
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(512))]
 
@@ -240,21 +287,7 @@ mod tests {
         /// quaternion not read from the trace), lanes on different branches,
         /// curved and prestrained elements.
         #[test]
-        fn a_pair_gives_the_bits_of_one_element_at_a_time(
-            dirs in prop::array::uniform4(prop::array::uniform3(-1.0..1.0f64)),
-            scales in prop::array::uniform2(-5.0..0.4f64),
-            tilt in prop::array::uniform2(prop::array::uniform3(-0.5..0.5f64)),
-            moves in prop::array::uniform4(prop::array::uniform3(-0.3..0.3f64)),
-            lengths in prop::array::uniform2(0.1..2.0f64),
-        ) {
-            let e = [0, 1].map(|k| element(lengths[k], tilt[k], 0.1 * k as f64));
-            let rot = [0, 1].map(|k| {
-                let base = exp(&Vector3::from(dirs[2 * k]));
-                [base, exp(&(Vector3::from(dirs[2 * k + 1]) * 10f64.powf(scales[k]))) * base]
-            });
-            let x = [0, 1].map(|k| {
-                [Vector3::from(moves[2 * k]), Vector3::new(lengths[k], 0.0, 0.0) + Vector3::from(moves[2 * k + 1])]
-            });
+        fn a_pair_gives_the_bits_of_one_element_at_a_time((e, x, rot) in pairs()) {
             let both = internal_force_pair([&e[0], &e[1]], &x, &rot);
             for k in 0..2 {
                 let one = e[k].internal_force(&x[k], &rot[k]);

@@ -190,27 +190,8 @@ fn write_out(res: &[V2; 4], blocks: &[[M2; 4]; 4], r: [&mut [f64]; 2], kt: [&mut
 #[cfg(test)]
 mod tests {
     use super::residual_tangent_pair;
-    use crate::element::BeamElement;
-    use crate::rotation::exp;
-    use crate::section::Section;
-    use nalgebra::{Matrix3, Vector3};
+    use crate::element_pair::tests::pairs;
     use proptest::prelude::*;
-
-    /// A curved (`tilt`), prestrained element of `length`.
-    fn element(length: f64, tilt: [f64; 3], prestrain: f64) -> BeamElement<2> {
-        let section = Section::new(
-            [2.0e4, 8.0e3, 9.0e3],
-            [7.0e5, 8.0e5, 8.3e5],
-            1.0,
-            [0.2, 0.1, 0.1],
-        );
-        let x0 = [Vector3::zeros(), Vector3::new(length, 0.0, 0.0)];
-        let l0 = [
-            exp(&Vector3::from(tilt)),
-            exp(&(Vector3::from(tilt) * (1.0 + prestrain))),
-        ];
-        BeamElement::new([0, 1], section, length, &x0, l0)
-    }
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(512))]
@@ -221,21 +202,7 @@ mod tests {
         /// past 120° (the logarithm's quaternion not read from the trace),
         /// lanes on different branches, curved and prestrained elements.
         #[test]
-        fn a_pair_gives_the_bits_of_one_elements_residual_and_tangent(
-            dirs in prop::array::uniform4(prop::array::uniform3(-1.0..1.0f64)),
-            scales in prop::array::uniform2(-5.0..0.4f64),
-            tilt in prop::array::uniform2(prop::array::uniform3(-0.5..0.5f64)),
-            moves in prop::array::uniform4(prop::array::uniform3(-0.3..0.3f64)),
-            lengths in prop::array::uniform2(0.1..2.0f64),
-        ) {
-            let e = [0, 1].map(|k| element(lengths[k], tilt[k], 0.1 * k as f64));
-            let rot: [[Matrix3<f64>; 2]; 2] = [0, 1].map(|k| {
-                let base = exp(&Vector3::from(dirs[2 * k]));
-                [base, exp(&(Vector3::from(dirs[2 * k + 1]) * 10f64.powf(scales[k]))) * base]
-            });
-            let x = [0, 1].map(|k| {
-                [Vector3::from(moves[2 * k]), Vector3::new(lengths[k], 0.0, 0.0) + Vector3::from(moves[2 * k + 1])]
-            });
+        fn a_pair_gives_the_bits_of_one_elements_residual_and_tangent((e, x, rot) in pairs()) {
             let (mut r, mut kt) = ([[0.0; 12]; 2], [[0.0; 144]; 2]);
             let [r0, r1] = &mut r;
             let [k0, k1] = &mut kt;
