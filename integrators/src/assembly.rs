@@ -301,9 +301,9 @@ impl Assembler {
 
     /// Evaluates every element at `config`: fills [`Self::nodal`],
     /// [`Self::nodal_abs`] and the tangent [`Self::values`].
-    /// On one thread, two neighbouring 2-node elements whose nodes are all
-    /// independent are evaluated at once (`assembly/pairs.rs`): the same
-    /// bits.
+    /// Two neighbouring 2-node elements whose nodes are all independent
+    /// are evaluated at once (`assembly/pairs.rs`), on one thread and in the
+    /// chunks of a split loop: the same bits.
     pub fn assemble(&mut self, mesh: &Mesh, dofs: &DofMap, config: &Configuration) {
         if !self.tangent_cost.split(mesh.elements.len()) {
             return self.assemble_in_pairs(mesh, dofs, config);
@@ -403,9 +403,9 @@ impl Assembler {
                     continue;
                 }
                 let in_chunk = split.chunks[c].contains(&(index + 1));
-                let late = |i| split.is_late(i);
+                let is_late = |i| split.is_late(i);
                 if let Some((pair, els)) = pair
-                    .filter(|_| tangent && in_chunk && !late(index) && !late(index + 1))
+                    .filter(|_| tangent && in_chunk && !is_late(index) && !is_late(index + 1))
                     .zip(pairs::direct_pair(&mesh.elements, slots, index))
                 {
                     // SAFETY: chunk `c` owns both elements' values and
