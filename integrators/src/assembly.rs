@@ -305,19 +305,14 @@ impl Assembler {
     /// are evaluated at once (`assembly/pairs.rs`), on one thread and in the
     /// chunks of a split loop: the same bits.
     pub fn assemble(&mut self, mesh: &Mesh, dofs: &DofMap, config: &Configuration) {
-        if !self.tangent_cost.split(mesh.elements.len()) {
-            return self.assemble_in_pairs(mesh, dofs, config);
-        }
         let (x, rot) = (&config.x[..], &config.rot[..]);
         let pair = |e: [&BeamElement<2>; 2], r: [&mut [f64]; 2], k: [&mut [f64]; 2]| {
             residual_tangent_pair_at(e, x, rot, r, k)
         };
-        self.split_loop(mesh, true, Some(&pair), |w, _, el, s| {
-            el.residual_tangent(x, rot, w.r.as_mut_slice(), w.k.as_mut_slice());
-            if s.direct.is_none() {
-                reduce_tangent(w, el, dofs, s);
-            }
-        });
+        let kernel = |el: &Element, _: usize, r: &mut [f64], k: &mut [f64]| {
+            el.residual_tangent(x, rot, r, k)
+        };
+        self.assemble_paired(mesh, dofs, kernel, Some(&pair));
     }
 
     /// As [`Assembler::assemble`], with any element kernel: `kernel(element,
@@ -325,6 +320,20 @@ impl Assembler {
     /// (`6N × 6N`, column-major) with respect to its nodal increments.
     pub fn assemble_with<F>(&mut self, mesh: &Mesh, dofs: &DofMap, kernel: F)
     where
+        F: Fn(&Element, usize, &mut [f64], &mut [f64]) + Sync,
+    {
+        self.assemble_paired(mesh, dofs, kernel, None);
+    }
+
+    /// [`Assembler::assemble_with`], two neighbouring direct 2-node elements
+    /// at a time through `pair` where it is given (see [`Self::split_loop`]).
+    fn assemble_paired<F>(
+        &mut self,
+        mesh: &Mesh,
+        dofs: &DofMap,
+        kernel: F,
+        pair: Option<&PairKernel>,
+    ) where
         F: Fn(&Element, usize, &mut [f64], &mut [f64]) + Sync,
     {
         let element = |w: &mut Work, index: usize, el: &Element, s: &Slots| {
@@ -343,7 +352,27 @@ impl Assembler {
                 self.own_work(mesh);
             }
             self.clear();
-            for (index, (el, s)) in mesh.elements.iter().zip(&self.slots).enumerate() {
+            let mut index = 0;
+            while index < n {
+                let slots = &self.slots;
+                if let Some((pair, els)) =
+                    pair.zip(pairs::direct_pair(&mesh.elements, slots, index))
+                {
+                    let elements = [&mesh.elements[index], &mesh.elements[index + 1]];
+                    let sinks = Sinks::new(&mut self.values, &mut self.nodal, &mut self.nodal_abs);
+                    // SAFETY: one thread: nothing else touches the sinks.
+                    unsafe {
+                        pairs::add_pair(
+                            &sinks,
+                            pair,
+                            (els, elements),
+                            [&slots[index], &slots[index + 1]],
+                        )
+                    };
+                    index += 2;
+                    continue;
+                }
+                let (el, s) = (&mesh.elements[index], &slots[index]);
                 let w = match &s.direct {
                     Some(_) => scratch_for(&mut self.scratch, el.dofs()),
                     None => &mut self.work[index],
@@ -351,13 +380,14 @@ impl Assembler {
                 element(w, index, el, s);
                 add_forces(&mut self.nodal, &mut self.nodal_abs, el, w.r.as_slice());
                 add_tangent(&mut self.values, w, s);
+                index += 1;
             }
             if let Some(start) = start {
                 self.tangent_cost.record(start.elapsed(), n);
             }
             return;
         }
-        self.split_loop(mesh, true, None, element);
+        self.split_loop(mesh, true, pair, element);
     }
 
     /// The element loop over the chunks of [`Self::split`]: `evaluate(w,
