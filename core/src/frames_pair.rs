@@ -55,6 +55,18 @@ pub(crate) fn frames_pair_into(
     true
 }
 
+/// [`BeamElement::frames`] of two elements' poses, two at a time where
+/// [`frames_pair_into`] takes them, else one by one: the same bits.
+pub(crate) fn frames_of_pair(e: [&BeamElement<2>; 2], poses: [&Pose<f64>; 2]) -> [Frames<f64>; 2] {
+    let mut out = [Frames::zeros(); 2];
+    if !frames_pair_into(e, poses, &mut out) {
+        for (f, (e, pose)) in out.iter_mut().zip(e.iter().zip(poses)) {
+            *f = e.frames(pose);
+        }
+    }
+    out
+}
+
 /// [`BeamElement::energy_momentum_force_parts_from`] of two elements from
 /// their step starts to their end poses, the end poses' pieces two at a
 /// time (`frames_pair_into`): the same bits.
@@ -63,12 +75,7 @@ pub fn energy_momentum_force_parts_pair(
     start: [&StepStart; 2],
     end: [&Pose<f64>; 2],
 ) -> [(SVector<f64, 12>, SVector<f64, 12>); 2] {
-    let mut ends = [Frames::zeros(); 2];
-    if !frames_pair_into(e, end, &mut ends) {
-        for (f, (e, end)) in ends.iter_mut().zip(e.iter().zip(end)) {
-            *f = e.frames(end);
-        }
-    }
+    let ends = frames_of_pair(e, end);
     [0, 1].map(|k| {
         let (s, f) = (start[k].frames(), &ends[k]);
         let (nbar, mbar) = e[k].averaged_resultants(s, f);

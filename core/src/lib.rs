@@ -15,6 +15,7 @@ mod secant_pair;
 pub use scalar::{cst, Scalar};
 pub mod conserving;
 pub mod conserving_tangent;
+pub mod conserving_tangent_pair;
 pub mod discrete_gradient;
 pub mod discrete_gradient_quadratic;
 pub mod element;

@@ -26,9 +26,11 @@ use std::time::Instant;
 
 mod pairs;
 
-/// A kernel of two neighbouring 2-node elements: their residuals and
-/// tangents (column-major) into the two pairs of buffers.
-type PairKernel<'a> = dyn Fn([&BeamElement<2>; 2], [&mut [f64]; 2], [&mut [f64]; 2]) + Sync + 'a;
+/// A kernel of two neighbouring 2-node elements, the mesh's `index` and
+/// `index + 1`: their residuals and tangents (column-major) into the two
+/// pairs of buffers.
+pub(crate) type PairKernel<'a> =
+    dyn Fn(usize, [&BeamElement<2>; 2], [&mut [f64]; 2], [&mut [f64]; 2]) + Sync + 'a;
 
 struct Slots {
     /// Sorted, unique global equations the element touches.
@@ -306,7 +308,7 @@ impl Assembler {
     /// chunks of a split loop: the same bits.
     pub fn assemble(&mut self, mesh: &Mesh, dofs: &DofMap, config: &Configuration) {
         let (x, rot) = (&config.x[..], &config.rot[..]);
-        let pair = |e: [&BeamElement<2>; 2], r: [&mut [f64]; 2], k: [&mut [f64]; 2]| {
+        let pair = |_, e: [&BeamElement<2>; 2], r: [&mut [f64]; 2], k: [&mut [f64]; 2]| {
             residual_tangent_pair_at(e, x, rot, r, k)
         };
         let kernel = |el: &Element, _: usize, r: &mut [f64], k: &mut [f64]| {
@@ -327,7 +329,7 @@ impl Assembler {
 
     /// [`Assembler::assemble_with`], two neighbouring direct 2-node elements
     /// at a time through `pair` where it is given (see [`Self::split_loop`]).
-    fn assemble_paired<F>(
+    pub(crate) fn assemble_paired<F>(
         &mut self,
         mesh: &Mesh,
         dofs: &DofMap,
@@ -365,7 +367,7 @@ impl Assembler {
                         pairs::add_pair(
                             &sinks,
                             pair,
-                            (els, elements),
+                            (index, els, elements),
                             [&slots[index], &slots[index + 1]],
                         )
                     };
@@ -442,7 +444,7 @@ impl Assembler {
                     // nodes (neither is late).
                     let elements = [&mesh.elements[index], &mesh.elements[index + 1]];
                     let s = [&slots[index], &slots[index + 1]];
-                    unsafe { pairs::add_pair(&sinks, pair, (els, elements), s) };
+                    unsafe { pairs::add_pair(&sinks, pair, (index, els, elements), s) };
                     skip = true;
                     continue;
                 }

@@ -23,20 +23,20 @@ pub(super) fn direct_pair<'a>(
 }
 
 /// Evaluates two neighbouring direct 2-node elements `els` (the mesh's
-/// `elements`, slots `s`) by `pair` and adds them to `sinks`, the first
-/// first.
+/// `elements` `index` and `index + 1`, slots `s`) by `pair` and adds them
+/// to `sinks`, the first first.
 ///
 /// # Safety
 /// As for [`Sinks::add`]: the caller's chunk owns everything both add to.
 pub(super) unsafe fn add_pair(
     sinks: &Sinks<'_>,
     pair: &PairKernel,
-    (els, elements): ([&BeamElement<2>; 2], [&Element; 2]),
+    (index, els, elements): (usize, [&BeamElement<2>; 2], [&Element; 2]),
     s: [&Slots; 2],
 ) {
     let (mut r, mut k) = ([[0.0; DOFS]; 2], [[0.0; DOFS * DOFS]; 2]);
     let ([r0, r1], [k0, k1]) = (&mut r, &mut k);
-    pair(els, [r0, r1], [k0, k1]);
+    pair(index, els, [r0, r1], [k0, k1]);
     for j in 0..2 {
         // SAFETY: by the caller's contract.
         unsafe { sinks.add_direct(elements[j], &r[j], &k[j], s[j]) };

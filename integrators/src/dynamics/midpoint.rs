@@ -28,13 +28,14 @@ use super::inertia_pairs::{midpoint_moment_pair, moments_in_pairs_into};
 use super::mass_slots::MassSlots;
 use super::midpoint_kernels::{
     correction_size, element_force, element_kernel, start_of, started_force, started_force_pair,
-    started_kernel, started_tangent, step_starts, CorrectionTally,
+    started_kernel, started_kernel_pair, started_tangent, started_tangent_pair, step_starts,
+    CorrectionTally,
 };
 use super::midpoint_sensitivity::MidpointSensitivities;
 use super::time_scheme::{SchemeSensitivities, TimeScheme};
 pub use super::Scheme;
 use super::{increment_work, slave_velocities, Motion};
-use crate::assembly::Assembler;
+use crate::assembly::{Assembler, PairKernel};
 use crate::constraints::{MechanismState, Topology};
 use crate::dofs::DofMap;
 use crate::dynamics::midpoint_predictor::MidpointPredictor;
@@ -48,8 +49,13 @@ use crate::sensitivity::Parameter;
 use crate::system::{Ends, ReducedSystem, Reduction, StepTerms};
 use flexmech_core::rotation::{cayley_inverse, cayley_tangent_inverse, log};
 use flexmech_core::step_start::StepStart;
-use flexmech_core::{BeamElement, Configuration, Inertia};
+use flexmech_core::{BeamElement, Configuration, Element, Inertia};
 use nalgebra::{Matrix3, Vector3};
+
+/// A cheap-tangent kernel of two neighbouring 2-node elements from their
+/// step starts ([`started_tangent_pair`]).
+type StartedPair =
+    fn([(&BeamElement<2>, &StepStart); 2], &Configuration, [&mut [f64]; 2], [&mut [f64]; 2]);
 
 /// Velocities at the end of a step from the configurations at both ends.
 pub fn end_motion(
@@ -191,26 +197,40 @@ impl MidpointTerms {
     /// The elements' forces and tangents between `start` and `end` into
     /// `asm`: a 2-node element with its step start by `started` (while the
     /// cheap tangent is asked for: [`started_kernel`], or
-    /// [`started_tangent`] for the tangent alone), any other by
-    /// [`element_kernel`].
+    /// [`started_tangent`] for the tangent alone), two neighbouring ones by
+    /// `started_pair` ([`started_kernel_pair`], [`started_tangent_pair`]),
+    /// any other by [`element_kernel`].
     fn tangents<K>(
         &self,
         mech: &Mechanism,
         dofs: &DofMap,
         asm: &mut Assembler,
         (start, end): Ends,
-        started: K,
+        (started, started_pair): (K, StartedPair),
     ) where
         K: Fn((&BeamElement<2>, &StepStart), &Configuration, &mut [f64], &mut [f64]) + Sync,
     {
         let (scheme, beta, exact) = (self.scheme, self.beta, self.exact_tangent);
         let starts = &self.starts;
-        asm.assemble_with(&mech.mesh, dofs, |el, i, re, ke| {
-            match start_of(starts, el, i, start).filter(|_| !exact) {
-                Some(from) => started(from, end, re, ke),
-                None => element_kernel(el, start, end, scheme, beta, exact, re, ke),
+        let from = |i: usize| start_of(starts, &mech.mesh.elements[i], i, start).filter(|_| !exact);
+        let one = |el: &Element, i: usize, re: &mut [f64], ke: &mut [f64]| match from(i) {
+            Some(from) => started(from, end, re, ke),
+            None => element_kernel(el, start, end, scheme, beta, exact, re, ke),
+        };
+        let elements = &mech.mesh.elements;
+        let two = |i: usize,
+                   _: [&BeamElement<2>; 2],
+                   [ra, rb]: [&mut [f64]; 2],
+                   [ka, kb]: [&mut [f64]; 2]| {
+            match (from(i), from(i + 1)) {
+                (Some(a), Some(b)) => started_pair([a, b], end, [ra, rb], [ka, kb]),
+                _ => {
+                    one(&elements[i], i, ra, ka);
+                    one(&elements[i + 1], i + 1, rb, kb);
+                }
             }
-        });
+        };
+        asm.assemble_paired(&mech.mesh, dofs, one, Some(&two as &PairKernel));
     }
 }
 
@@ -232,7 +252,13 @@ impl StepTerms for MidpointTerms {
         tally.start(!tangent);
         let starts = &self.starts;
         if tangent {
-            self.tangents(mech, dofs, asm, (start, end), started_kernel);
+            self.tangents(
+                mech,
+                dofs,
+                asm,
+                (start, end),
+                (started_kernel, started_kernel_pair),
+            );
         } else {
             asm.assemble_residual_paired(
                 &mech.mesh,
@@ -262,7 +288,13 @@ impl StepTerms for MidpointTerms {
 
     fn element_tangents(&self, mech: &Mechanism, dofs: &DofMap, asm: &mut Assembler, ends: Ends) {
         self.tally.start(false);
-        self.tangents(mech, dofs, asm, ends, started_tangent);
+        self.tangents(
+            mech,
+            dofs,
+            asm,
+            ends,
+            (started_tangent, started_tangent_pair),
+        );
     }
 
     fn inertia(
@@ -564,27 +596,44 @@ mod tests {
     /// cheap tangent without its discrete gradient): the values of a whole
     /// evaluation with the tangent to the bit, and the residual's nodal
     /// forces kept — which the whole evaluation gives again.
-    #[test]
-    fn a_tangent_computed_alone_is_a_whole_evaluations_to_the_bit() {
-        let mech = screw_arm();
-        let mut state = initial_state(&mech);
-        let topo = Topology::new(&mech, &state).unwrap();
-        topo.impose(&mech, &mut state, 0.0);
+    /// The energy–momentum screw arm's system with its cheap tangent, moved
+    /// off its step start.
+    fn moved_energy_momentum_system(mech: &Mechanism) -> ReducedSystem<'_, MidpointTerms> {
+        let mut state = initial_state(mech);
+        let topo = Topology::new(mech, &state).unwrap();
+        topo.impose(mech, &mut state, 0.0);
         let asm = Assembler::new(&mech.mesh, &topo.dofs, &topo.local_eqs);
         let (inertia, rest) = (
             mech.inertia(MassKind::Consistent),
             Motion::rest(mech.mesh.node_count()),
         );
         let scheme = Scheme::EnergyMomentum;
-        let terms = MidpointTerms::new(&mech, &topo, &asm, &state, inertia, &rest, scheme);
-        let mut sys = ReducedSystem::new(&mech, topo, asm, state, terms);
+        let terms = MidpointTerms::new(mech, &topo, &asm, &state, inertia, &rest, scheme);
+        let mut sys = ReducedSystem::new(mech, topo, asm, state, terms);
         sys.terms.set_step(1e-2);
-        sys.terms.starts = step_starts(&mech, &sys.start.config);
+        sys.terms.starts = step_starts(mech, &sys.start.config);
         sys.set_exact_tangent(false);
-        assert!(sys.terms.tangents_alone());
         let n = sys.topo.dofs.n_eq;
         let dq: Vec<f64> = (0..n).map(|i| 1e-3 * (0.7 * i as f64).sin()).collect();
         sys.apply(&dq);
+        sys
+    }
+
+    fn bits(v: &[f64]) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
+    }
+
+    /// The tangent Newton brings up to date at an iterate whose residual it
+    /// has just evaluated is computed alone (the energy–momentum scheme's
+    /// cheap tangent without its discrete gradient): the values of a whole
+    /// evaluation with the tangent to the bit, and the residual's nodal
+    /// forces kept — which the whole evaluation gives again.
+    #[test]
+    fn a_tangent_computed_alone_is_a_whole_evaluations_to_the_bit() {
+        let mech = screw_arm();
+        let mut sys = moved_energy_momentum_system(&mech);
+        assert!(sys.terms.tangents_alone());
+        let n = sys.topo.dofs.n_eq;
         let mut r = vec![0.0; n];
         sys.residual(&mut r);
         let nodal = sys.nodal.clone();
@@ -592,10 +641,37 @@ mod tests {
         let alone = sys.asm.values.clone();
         assert_eq!(sys.nodal, nodal, "the residual's nodal forces kept");
         sys.evaluate(&mut r);
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&alone), bits(&sys.asm.values));
         assert_eq!(sys.nodal, nodal);
         assert!(alone.iter().any(|v| *v != 0.0));
+    }
+
+    /// The elements' forces and cheap tangents, whole and alone, taken two
+    /// neighbouring elements at a time: the bits of one at a time.
+    #[test]
+    fn element_pairs_give_the_bits_of_one_element_at_a_time() {
+        let mech = screw_arm();
+        let mut sys = moved_energy_momentum_system(&mech);
+        let (start, end) = (&sys.start.config, &sys.end.config);
+        let (terms, asm, dofs) = (&sys.terms, &mut sys.asm, &sys.topo.dofs);
+        type Started = fn((&BeamElement<2>, &StepStart), &Configuration, &mut [f64], &mut [f64]);
+        let kernels: [Started; 2] = [started_kernel, started_tangent];
+        for (alone, started) in [false, true].into_iter().zip(kernels) {
+            match alone {
+                true => terms.element_tangents(&mech, dofs, asm, (start, end)),
+                false => terms.elements(&mech, dofs, asm, start, end, true),
+            }
+            let two = (asm.values.clone(), asm.nodal.clone());
+            asm.assemble_with(&mech.mesh, dofs, |el, i, re, ke| {
+                match start_of(&terms.starts, el, i, start) {
+                    Some(from) => started(from, end, re, ke),
+                    None => element_kernel(el, start, end, terms.scheme, 0.0, false, re, ke),
+                }
+            });
+            assert_eq!(bits(&two.0), bits(&asm.values), "tangent alone: {alone}");
+            assert_eq!(bits(&two.1), bits(&asm.nodal), "tangent alone: {alone}");
+            assert!(two.0.iter().any(|v| *v != 0.0));
+        }
     }
 
     #[test]

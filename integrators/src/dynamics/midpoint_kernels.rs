@@ -236,6 +236,56 @@ pub(crate) fn started_tangent(
     );
 }
 
+/// [`started_kernel`] of two neighbouring elements, their end poses' pieces
+/// and cheap tangents two at a time
+/// ([`BeamElement::energy_momentum_force_cheap_tangent_pair`]): the same
+/// bits.
+pub(crate) fn started_kernel_pair(
+    starts: [(&BeamElement<2>, &StepStart); 2],
+    end: &Configuration,
+    r: [&mut [f64]; 2],
+    k: [&mut [f64]; 2],
+) {
+    started_pair(starts, end, (r, k), true);
+}
+
+/// [`started_tangent`] of two neighbouring elements, their cheap tangents
+/// two at a time ([`BeamElement::energy_momentum_cheap_tangent_pair`]): the
+/// same bits.
+pub(crate) fn started_tangent_pair(
+    starts: [(&BeamElement<2>, &StepStart); 2],
+    end: &Configuration,
+    r: [&mut [f64]; 2],
+    k: [&mut [f64]; 2],
+) {
+    started_pair(starts, end, (r, k), false);
+}
+
+/// Two neighbouring elements' cheap tangents into `k`, with their forces
+/// into `r` (`force`) or `r` zeroed.
+fn started_pair(
+    starts: [(&BeamElement<2>, &StepStart); 2],
+    end: &Configuration,
+    (r, k): ([&mut [f64]; 2], [&mut [f64]; 2]),
+    force: bool,
+) {
+    let [(ea, sa), (eb, sb)] = starts;
+    let poses = [pose_of(ea, end), pose_of(eb, end)];
+    let (e, s, p) = ([ea, eb], [sa, sb], [&poses[0], &poses[1]]);
+    let both = if force {
+        BeamElement::energy_momentum_force_cheap_tangent_pair(e, s, p).map(|(q, t)| (Some(q), t))
+    } else {
+        BeamElement::energy_momentum_cheap_tangent_pair(e, s, p).map(|t| (None, t))
+    };
+    for ((r, k), (q, t)) in r.into_iter().zip(k).zip(&both) {
+        match q {
+            Some(q) => r.copy_from_slice(q.as_slice()),
+            None => r.fill(0.0),
+        }
+        k.copy_from_slice(t.as_slice());
+    }
+}
+
 /// The energy–momentum scheme's force ([`element_force`]) from the
 /// element's step start.
 pub(crate) fn started_force(
