@@ -11,19 +11,14 @@ use crate::discrete_gradient::{dg_step_in_pairs, step_force};
 use crate::element::BeamElement;
 use crate::frames_pair::frames_of_pair;
 use crate::rotation_pair::{
-    exp, log_pair, mat_mat, mat_mat_t, mat_scale, mat_vec, pair, scale, skew, splat, tangent,
-    tangent_inverse, vectors, M2, V2,
+    exp, log_pair, mat_mat, mat_mat_t, mat_scale, mat_vec, matrices, pair, scale, skew, splat,
+    tangent, tangent_inverse, vectors, M2, V2,
 };
 use crate::step_start::StepStart;
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{SMatrix, SVector, Vector3};
 
 /// A 12 × 12 element tangent of each lane.
 type Tangents = [SMatrix<f64, 12, 12>; 2];
-
-/// Two matrices as one matrix of pairs (row by row).
-fn matrices(m: [&Matrix3<f64>; 2]) -> M2 {
-    crate::rotation_pair::matrices(m)
-}
 
 /// `a − b`, entry by entry.
 fn sub(a: &M2, b: &M2) -> M2 {
