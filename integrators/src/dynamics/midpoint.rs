@@ -53,7 +53,8 @@ use flexmech_core::{BeamElement, Configuration, Element, Inertia};
 use nalgebra::{Matrix3, Vector3};
 
 /// A cheap-tangent kernel of two neighbouring 2-node elements from their
-/// step starts ([`started_tangent_pair`]).
+/// step starts, with their forces or alone ([`started_kernel_pair`],
+/// [`started_tangent_pair`]).
 type StartedPair =
     fn([(&BeamElement<2>, &StepStart); 2], &Configuration, [&mut [f64]; 2], [&mut [f64]; 2]);
 
@@ -212,12 +213,12 @@ impl MidpointTerms {
     {
         let (scheme, beta, exact) = (self.scheme, self.beta, self.exact_tangent);
         let starts = &self.starts;
-        let from = |i: usize| start_of(starts, &mech.mesh.elements[i], i, start).filter(|_| !exact);
+        let elements = &mech.mesh.elements;
+        let from = |i: usize| start_of(starts, &elements[i], i, start).filter(|_| !exact);
         let one = |el: &Element, i: usize, re: &mut [f64], ke: &mut [f64]| match from(i) {
             Some(from) => started(from, end, re, ke),
             None => element_kernel(el, start, end, scheme, beta, exact, re, ke),
         };
-        let elements = &mech.mesh.elements;
         let two = |i: usize,
                    _: [&BeamElement<2>; 2],
                    [ra, rb]: [&mut [f64]; 2],
