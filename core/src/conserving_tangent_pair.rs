@@ -4,21 +4,18 @@
 //! ([`crate::rotation_pair`]): the chain rule of that module's docs with the
 //! arithmetic of `BeamElement::momentum_tangent_of` in the same order, so
 //! each lane holds the bits of the one-element tangent (tested). The end
-//! poses' rotation pieces are taken two at a time too (`frames_pair_into`).
+//! poses' rotation pieces are taken two at a time too (`frames_of_pair_into`).
 
 use crate::conserving::{Frames, Pose};
 use crate::discrete_gradient::{dg_step_in_pairs, step_force};
 use crate::element::BeamElement;
-use crate::frames_pair::frames_of_pair;
+use crate::frames_pair::frames_of_pair_into;
 use crate::rotation_pair::{
     exp, log_pair, mat_mat, mat_mat_t, mat_scale, mat_vec, matrices, pair, scale, skew, splat,
     tangent, tangent_inverse, vectors, M2, V2,
 };
 use crate::step_start::StepStart;
-use nalgebra::{SMatrix, SVector, Vector3};
-
-/// A 12 × 12 element tangent of each lane.
-type Tangents = [SMatrix<f64, 12, 12>; 2];
+use nalgebra::Vector3;
 
 /// `a − b`, entry by entry.
 fn sub(a: &M2, b: &M2) -> M2 {
@@ -40,33 +37,34 @@ fn diagonal(v: &V2) -> M2 {
 /// The rows of the element tangent `(−jn, ja − jm, jn, ja + jm)` of the
 /// blocks `(η₁, ε₁, η₂, ε₂)` of `n`, `a` and `m`'s Jacobians (`None`: a
 /// zero block, which takes part in the sums as the one-element `stack`'s
-/// zeros do), written into lane `k`'s matrix.
-fn stack_lanes(jn: &[M2; 4], ja: &[M2; 4], jm: &[Option<M2>; 4]) -> Tangents {
+/// zeros do), written into lane `k`'s 12 × 12 matrix `out[k]` (column-major,
+/// as `SMatrix::as_slice`; every entry written).
+fn stack_lanes(jn: &[M2; 4], ja: &[M2; 4], jm: &[Option<M2>; 4], mut out: [&mut [f64]; 2]) {
     let zero = [splat(0.0); 9];
-    let mut out = [SMatrix::<f64, 12, 12>::zeros(); 2];
     for (b, (n, a)) in jn.iter().zip(ja).enumerate() {
         let m = jm[b].as_ref().unwrap_or(&zero);
         let rows = [neg(n), sub(a, m), *n, std::array::from_fn(|e| a[e] + m[e])];
         for (r, block) in rows.iter().enumerate() {
             for (e, v) in block.iter().enumerate() {
                 let v = v.to_array();
+                let at = 12 * (3 * b + e % 3) + 3 * r + e / 3;
                 for (k, t) in out.iter_mut().enumerate() {
-                    t[(3 * r + e / 3, 3 * b + e % 3)] = v[k];
+                    t[at] = v[k];
                 }
             }
         }
     }
-    out
 }
 
 /// `BeamElement::momentum_tangent_of` of two elements from their step
 /// starts' pieces `s0` to their end poses' pieces `s1`, lane by lane the
-/// same bits.
+/// same bits, into the column-major 12 × 12 slices `out`.
 fn momentum_tangent_pair(
     e: [&BeamElement<2>; 2],
     s0: [&Frames<f64>; 2],
     s1: [&Frames<f64>; 2],
-) -> Tangents {
+    out: [&mut [f64]; 2],
+) {
     let res = [0, 1].map(|k| {
         let ((n0, m0), (n1, m1)) = (e[k].frame_resultants(s0[k]), e[k].frame_resultants(s1[k]));
         ((n0 + n1) * 0.5, (m0 + m1) * 0.5)
@@ -126,44 +124,37 @@ fn momentum_tangent_pair(
             mat_mat(&minus_half_dbar, &jn_e2),
         ],
         &[None, Some(jm_e1), None, Some(jm_e2)],
-    )
+        out,
+    );
 }
 
 impl BeamElement<2> {
     /// [`BeamElement::energy_momentum_cheap_tangent_from`] of two elements
     /// from their step starts to their end poses, two at a time (the end
     /// poses' pieces too, where both relative rotations are read from their
-    /// trace; else one by one): the same bits.
-    pub fn energy_momentum_cheap_tangent_pair(
+    /// trace; else one by one), written into `k` (each a column-major
+    /// 12 × 12 slice, as `SMatrix::as_slice`); with `forces`, each
+    /// element's force of [`BeamElement::energy_momentum_force_cheap_tangent_from`]
+    /// too (its discrete gradient one element at a time). The same bits.
+    ///
+    /// # Panics
+    /// Where a slice of `k` is not 144 long or one of `forces` not 12.
+    pub fn energy_momentum_cheap_tangent_pair_into(
         e: [&Self; 2],
         start: [&StepStart; 2],
         end: [&Pose<f64>; 2],
-    ) -> [SMatrix<f64, 12, 12>; 2] {
-        let ends = frames_of_pair(e, end);
-        momentum_tangent_pair(
-            e,
-            [start[0].frames(), start[1].frames()],
-            [&ends[0], &ends[1]],
-        )
-    }
-
-    /// [`BeamElement::energy_momentum_force_cheap_tangent_from`] of two
-    /// elements, the end poses' pieces and the cheap tangents two at a time
-    /// (as [`Self::energy_momentum_cheap_tangent_pair`]), the forces' discrete
-    /// gradients one by one: the same bits.
-    pub fn energy_momentum_force_cheap_tangent_pair(
-        e: [&Self; 2],
-        start: [&StepStart; 2],
-        end: [&Pose<f64>; 2],
-    ) -> [(SVector<f64, 12>, SMatrix<f64, 12, 12>); 2] {
-        let ends = frames_of_pair(e, end);
+        forces: Option<[&mut [f64]; 2]>,
+        k: [&mut [f64]; 2],
+    ) {
+        let mut ends = [Frames::zeros(); 2];
+        frames_of_pair_into(e, end, &mut ends);
         let s0 = [start[0].frames(), start[1].frames()];
-        let [ka, kb] = momentum_tangent_pair(e, s0, [&ends[0], &ends[1]]);
-        let force = |k: usize| {
-            let (nbar, mbar) = e[k].averaged_resultants(s0[k], &ends[k]);
-            step_force(&dg_step_in_pairs(s0[k], &ends[k]), &nbar, &mbar).0
-        };
-        [(force(0), ka), (force(1), kb)]
+        momentum_tangent_pair(e, s0, [&ends[0], &ends[1]], k);
+        for (i, r) in forces.into_iter().flatten().enumerate() {
+            let (nbar, mbar) = e[i].averaged_resultants(s0[i], &ends[i]);
+            let q = step_force(&dg_step_in_pairs(s0[i], &ends[i]), &nbar, &mbar).0;
+            r.copy_from_slice(q.as_slice());
+        }
     }
 }
 
@@ -173,7 +164,7 @@ mod tests {
     use crate::element_pair::tests::pairs;
     use crate::rotation::exp as exp1;
 
-    fn bits(m: &SMatrix<f64, 12, 12>) -> Vec<u64> {
+    fn bits(m: &[f64]) -> Vec<u64> {
         m.iter().map(|v| v.to_bits()).collect()
     }
 
@@ -196,24 +187,20 @@ mod tests {
                 let moved = x[k].map(|p| p - Vector3::from(spin[k]) * 0.01);
                 es[k].step_start(&(moved, rot[k].map(|r| turn * r)))
             });
-            let two = BeamElement::energy_momentum_cheap_tangent_pair(
-                [&es[0], &es[1]],
-                [&starts[0], &starts[1]],
-                [&poses[0], &poses[1]],
-            );
-            let both = BeamElement::energy_momentum_force_cheap_tangent_pair(
-                [&es[0], &es[1]],
-                [&starts[0], &starts[1]],
-                [&poses[0], &poses[1]],
-            );
+            // Every entry is written: the slices start as NaN.
+            let (mut two, mut both) = ([[f64::NAN; 144]; 2], [[f64::NAN; 144]; 2]);
+            let mut forces = [[f64::NAN; 12]; 2];
+            let (e, s, p) = ([&es[0], &es[1]], [&starts[0], &starts[1]], [&poses[0], &poses[1]]);
+            let [ta, tb] = &mut two;
+            BeamElement::energy_momentum_cheap_tangent_pair_into(e, s, p, None, [ta, tb]);
+            let ([ba, bb], [fa, fb]) = (&mut both, &mut forces);
+            BeamElement::energy_momentum_cheap_tangent_pair_into(e, s, p, Some([fa, fb]), [ba, bb]);
             for k in 0..2 {
                 let one = es[k].energy_momentum_cheap_tangent_from(&starts[k], &poses[k]);
-                proptest::prop_assert_eq!(bits(&two[k]), bits(&one), "lane {}", k);
+                proptest::prop_assert_eq!(bits(&two[k]), bits(one.as_slice()), "lane {}", k);
                 let (q, t) = es[k].energy_momentum_force_cheap_tangent_from(&starts[k], &poses[k]);
-                proptest::prop_assert_eq!(bits(&both[k].1), bits(&t), "lane {}", k);
-                let q_bits: Vec<u64> = q.iter().map(|v| v.to_bits()).collect();
-                let pair_bits: Vec<u64> = both[k].0.iter().map(|v| v.to_bits()).collect();
-                proptest::prop_assert_eq!(pair_bits, q_bits, "lane {}", k);
+                proptest::prop_assert_eq!(bits(&both[k]), bits(t.as_slice()), "lane {}", k);
+                proptest::prop_assert_eq!(bits(&forces[k]), bits(q.as_slice()), "lane {}", k);
             }
         }
     }

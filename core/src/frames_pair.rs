@@ -55,16 +55,20 @@ pub(crate) fn frames_pair_into(
     true
 }
 
-/// [`BeamElement::frames`] of two elements' poses, two at a time where
-/// [`frames_pair_into`] takes them, else one by one: the same bits.
-pub(crate) fn frames_of_pair(e: [&BeamElement<2>; 2], poses: [&Pose<f64>; 2]) -> [Frames<f64>; 2] {
-    let mut out = [Frames::zeros(); 2];
-    if !frames_pair_into(e, poses, &mut out) {
+/// [`BeamElement::frames`] of two elements' poses into `out`, two at a time
+/// where [`frames_pair_into`] takes them, else one by one: the same bits.
+/// (Written in place: returned by value, the two were moved with a call to
+/// `memcpy` at every evaluation.)
+pub(crate) fn frames_of_pair_into(
+    e: [&BeamElement<2>; 2],
+    poses: [&Pose<f64>; 2],
+    out: &mut [Frames<f64>; 2],
+) {
+    if !frames_pair_into(e, poses, out) {
         for (f, (e, pose)) in out.iter_mut().zip(e.iter().zip(poses)) {
             *f = e.frames(pose);
         }
     }
-    out
 }
 
 /// [`BeamElement::energy_momentum_force_parts_from`] of two elements from
@@ -75,7 +79,8 @@ pub fn energy_momentum_force_parts_pair(
     start: [&StepStart; 2],
     end: [&Pose<f64>; 2],
 ) -> [(SVector<f64, 12>, SVector<f64, 12>); 2] {
-    let ends = frames_of_pair(e, end);
+    let mut ends = [Frames::zeros(); 2];
+    frames_of_pair_into(e, end, &mut ends);
     [0, 1].map(|k| {
         let (s, f) = (start[k].frames(), &ends[k]);
         let (nbar, mbar) = e[k].averaged_resultants(s, f);
@@ -154,6 +159,12 @@ mod tests {
                 false => prop_assert!((0..2).any(|k| !from_trace(
                     &(one[k].lam[0].transpose() * one[k].lam[1])
                 ))),
+            }
+            // The step starts of a pair, on either path: each element's bits.
+            let started = BeamElement::step_start_pair([&es[0], &es[1]], [&poses[0], &poses[1]]);
+            for k in 0..2 {
+                prop_assert!(started[k].is_of(&poses[k]));
+                prop_assert_eq!(bits(started[k].frames()), bits(&one[k]), "start {}", k);
             }
             let starts = [0, 1].map(|k| es[k].step_start(&pose([0.0; 6], [0.01 * k as f64; 6])));
             let pair = energy_momentum_force_parts_pair(

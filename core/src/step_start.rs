@@ -9,6 +9,7 @@
 use crate::conserving::{Frames, Pose};
 use crate::discrete_gradient::{dg_step_in_pairs, step_force};
 use crate::element::BeamElement;
+use crate::frames_pair::frames_of_pair_into;
 use nalgebra::{SMatrix, SVector};
 
 /// An element's pose at the start of a step with its rotation pieces.
@@ -44,6 +45,18 @@ impl BeamElement<2> {
             pose: *pose,
             frames: self.frames(pose),
         }
+    }
+
+    /// The [`StepStart`]s of two elements at their poses, their rotation
+    /// pieces two at a time where the pair arithmetic takes them
+    /// (`frames_pair`): the same bits as [`Self::step_start`] of each.
+    pub fn step_start_pair(e: [&Self; 2], poses: [&Pose<f64>; 2]) -> [StepStart; 2] {
+        let mut frames = [Frames::zeros(); 2];
+        frames_of_pair_into(e, poses, &mut frames);
+        [0, 1].map(|k| StepStart {
+            pose: *poses[k],
+            frames: frames[k],
+        })
     }
 
     /// [`Self::energy_momentum_force_parts`] from a step's start.

@@ -185,12 +185,25 @@ pub(crate) fn element_force(
 /// 3-node elements): the energy–momentum scheme's kernels look the start
 /// pose's rotation pieces up instead of recomputing them at every Newton
 /// evaluation of the step.
+///
+/// Neighbouring 2-node elements take their pieces two at a time
+/// ([`BeamElement::step_start_pair`]): the same bits.
 pub(crate) fn step_starts(mech: &Mechanism, start: &Configuration) -> Vec<Option<StepStart>> {
     let elements = &mech.mesh.elements;
-    threads::map_each(elements.len(), |i| match &elements[i] {
-        Element::Linear(e) => Some(e.step_start(&pose_of(e, start))),
-        Element::Quadratic(_) => None,
-    })
+    let one = |i: usize| match elements.get(i) {
+        Some(Element::Linear(e)) => Some(e.step_start(&pose_of(e, start))),
+        _ => None,
+    };
+    let pairs = threads::map_each(elements.len().div_ceil(2), |p| {
+        match (&elements[2 * p], elements.get(2 * p + 1)) {
+            (Element::Linear(a), Some(Element::Linear(b))) => {
+                let poses = [pose_of(a, start), pose_of(b, start)];
+                BeamElement::step_start_pair([a, b], [&poses[0], &poses[1]]).map(Some)
+            }
+            _ => [one(2 * p), one(2 * p + 1)],
+        }
+    });
+    pairs.into_iter().flatten().take(elements.len()).collect()
 }
 
 /// Element `index`'s entry of `starts` when `el` is a 2-node element and the
@@ -238,7 +251,7 @@ pub(crate) fn started_tangent(
 
 /// [`started_kernel`] of two neighbouring elements, their end poses' pieces
 /// and cheap tangents two at a time
-/// ([`BeamElement::energy_momentum_force_cheap_tangent_pair`]): the same
+/// ([`BeamElement::energy_momentum_cheap_tangent_pair_into`]): the same
 /// bits.
 pub(crate) fn started_kernel_pair(
     starts: [(&BeamElement<2>, &StepStart); 2],
@@ -250,7 +263,7 @@ pub(crate) fn started_kernel_pair(
 }
 
 /// [`started_tangent`] of two neighbouring elements, their cheap tangents
-/// two at a time ([`BeamElement::energy_momentum_cheap_tangent_pair`]): the
+/// two at a time ([`BeamElement::energy_momentum_cheap_tangent_pair_into`]): the
 /// same bits.
 pub(crate) fn started_tangent_pair(
     starts: [(&BeamElement<2>, &StepStart); 2],
@@ -272,18 +285,13 @@ fn started_pair(
     let [(ea, sa), (eb, sb)] = starts;
     let poses = [pose_of(ea, end), pose_of(eb, end)];
     let (e, s, p) = ([ea, eb], [sa, sb], [&poses[0], &poses[1]]);
-    let both = if force {
-        BeamElement::energy_momentum_force_cheap_tangent_pair(e, s, p).map(|(q, t)| (Some(q), t))
+    let forces = if force {
+        Some(r)
     } else {
-        BeamElement::energy_momentum_cheap_tangent_pair(e, s, p).map(|t| (None, t))
+        r.into_iter().for_each(|r| r.fill(0.0));
+        None
     };
-    for ((r, k), (q, t)) in r.into_iter().zip(k).zip(&both) {
-        match q {
-            Some(q) => r.copy_from_slice(q.as_slice()),
-            None => r.fill(0.0),
-        }
-        k.copy_from_slice(t.as_slice());
-    }
+    BeamElement::energy_momentum_cheap_tangent_pair_into(e, s, p, forces, k);
 }
 
 /// The energy–momentum scheme's force ([`element_force`]) from the
