@@ -57,18 +57,15 @@ fn stack_lanes(jn: &[M2; 4], ja: &[M2; 4], jm: &[Option<M2>; 4], mut out: [&mut 
 }
 
 /// `BeamElement::momentum_tangent_of` of two elements from their step
-/// starts' pieces `s0` to their end poses' pieces `s1`, lane by lane the
-/// same bits, into the column-major 12 × 12 slices `out`.
+/// starts' pieces `s0` to their end poses' pieces `s1`, with the step
+/// averages of their resultants `res` (`BeamElement::averaged_from`), lane
+/// by lane the same bits, into the column-major 12 × 12 slices `out`.
 fn momentum_tangent_pair(
     e: [&BeamElement<2>; 2],
-    s0: [&Frames<f64>; 2],
-    s1: [&Frames<f64>; 2],
+    (s0, s1): ([&Frames<f64>; 2], [&Frames<f64>; 2]),
+    res: &[(Vector3<f64>, Vector3<f64>); 2],
     out: [&mut [f64]; 2],
 ) {
-    let res = [0, 1].map(|k| {
-        let ((n0, m0), (n1, m1)) = (e[k].frame_resultants(s0[k]), e[k].frame_resultants(s1[k]));
-        ((n0 + n1) * 0.5, (m0 + m1) * 0.5)
-    });
     let (nbar, mbar) = (
         vectors([&res[0].0, &res[1].0]),
         vectors([&res[0].1, &res[1].1]),
@@ -147,12 +144,13 @@ impl BeamElement<2> {
         k: [&mut [f64]; 2],
     ) {
         let mut ends = [Frames::zeros(); 2];
-        frames_of_pair_into(e, end, &mut ends);
+        let [a, b] = &mut ends;
+        frames_of_pair_into(e, end, [a, b]);
         let s0 = [start[0].frames(), start[1].frames()];
-        momentum_tangent_pair(e, s0, [&ends[0], &ends[1]], k);
+        let res = [0, 1].map(|i| e[i].averaged_from(start[i], &ends[i]));
+        momentum_tangent_pair(e, (s0, [&ends[0], &ends[1]]), &res, k);
         for (i, r) in forces.into_iter().flatten().enumerate() {
-            let (nbar, mbar) = e[i].averaged_resultants(s0[i], &ends[i]);
-            let q = step_force(&dg_step_in_pairs(s0[i], &ends[i]), &nbar, &mbar).0;
+            let q = step_force(&dg_step_in_pairs(s0[i], &ends[i]), &res[i].0, &res[i].1).0;
             r.copy_from_slice(q.as_slice());
         }
     }

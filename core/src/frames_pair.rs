@@ -3,7 +3,7 @@
 //! arithmetic of `BeamElement::frames` in the same order, so each lane
 //! holds the bits of the one-element pieces (tested). The energy–momentum
 //! scheme's residual-only evaluations take the end pose's pieces of two
-//! neighbouring elements this way ([`energy_momentum_force_parts_pair`]).
+//! neighbouring elements this way ([`energy_momentum_force_pair_into`]).
 
 use crate::conserving::{Frames, Pose};
 use crate::discrete_gradient::{dg_step_in_pairs, step_force};
@@ -14,7 +14,7 @@ use crate::rotation_pair::{
     unpack,
 };
 use crate::step_start::StepStart;
-use nalgebra::{SVector, Vector4};
+use nalgebra::Vector4;
 use wide::f64x2;
 
 /// [`BeamElement::frames`] of two elements' poses, written into `out`;
@@ -25,7 +25,7 @@ use wide::f64x2;
 pub(crate) fn frames_pair_into(
     e: [&BeamElement<2>; 2],
     poses: [&Pose<f64>; 2],
-    out: &mut [Frames<f64>; 2],
+    out: [&mut Frames<f64>; 2],
 ) -> bool {
     let lam = triads(e, [&poses[0].1, &poses[1].1]);
     let rel = mat_t_mat(&lam[0], &lam[1]);
@@ -43,7 +43,7 @@ pub(crate) fn frames_pair_into(
     let half = [w1 * f, x * f, y * f, z * f];
     let lam_r = mat_mat(&lam[0], &exp(&scale(&phi, splat(0.5))));
     let quaternion = |q: &[f64x2; 4], k: usize| Vector4::from_fn(|i, _| q[i].to_array()[k]);
-    for (k, f) in out.iter_mut().enumerate() {
+    for (k, f) in out.into_iter().enumerate() {
         f.lam[0] = unpack(&lam[0], k);
         f.lam[1] = unpack(&lam[1], k);
         f.rel = quaternion(&[w, x, y, z], k);
@@ -62,10 +62,11 @@ pub(crate) fn frames_pair_into(
 pub(crate) fn frames_of_pair_into(
     e: [&BeamElement<2>; 2],
     poses: [&Pose<f64>; 2],
-    out: &mut [Frames<f64>; 2],
+    out: [&mut Frames<f64>; 2],
 ) {
-    if !frames_pair_into(e, poses, out) {
-        for (f, (e, pose)) in out.iter_mut().zip(e.iter().zip(poses)) {
+    let [a, b] = out;
+    if !frames_pair_into(e, poses, [&mut *a, &mut *b]) {
+        for (f, (e, pose)) in [a, b].into_iter().zip(e.iter().zip(poses)) {
             *f = e.frames(pose);
         }
     }
@@ -73,19 +74,31 @@ pub(crate) fn frames_of_pair_into(
 
 /// [`BeamElement::energy_momentum_force_parts_from`] of two elements from
 /// their step starts to their end poses, the end poses' pieces two at a
-/// time (`frames_pair_into`): the same bits.
-pub fn energy_momentum_force_parts_pair(
+/// time (`frames_pair_into`): each element's force written into `forces`
+/// (12 long each) and the norms `(‖corrections‖, ‖force‖)` of its parts
+/// returned, the same bits. (Written in place: the four vectors returned
+/// by value were moved with a call to `memcpy` at every evaluation.)
+///
+/// # Panics
+/// Where a slice of `forces` is not 12 long.
+pub fn energy_momentum_force_pair_into(
     e: [&BeamElement<2>; 2],
     start: [&StepStart; 2],
     end: [&Pose<f64>; 2],
-) -> [(SVector<f64, 12>, SVector<f64, 12>); 2] {
+    forces: [&mut [f64]; 2],
+) -> [(f64, f64); 2] {
     let mut ends = [Frames::zeros(); 2];
-    frames_of_pair_into(e, end, &mut ends);
-    [0, 1].map(|k| {
+    let [a, b] = &mut ends;
+    frames_of_pair_into(e, end, [a, b]);
+    let mut norms = [(0.0, 0.0); 2];
+    for (k, r) in forces.into_iter().enumerate() {
         let (s, f) = (start[k].frames(), &ends[k]);
-        let (nbar, mbar) = e[k].averaged_resultants(s, f);
-        step_force(&dg_step_in_pairs(s, f), &nbar, &mbar)
-    })
+        let (nbar, mbar) = e[k].averaged_from(start[k], f);
+        let (q, c) = step_force(&dg_step_in_pairs(s, f), &nbar, &mbar);
+        r.copy_from_slice(q.as_slice());
+        norms[k] = (c.norm(), q.norm());
+    }
+    norms
 }
 
 #[cfg(test)]
@@ -152,7 +165,8 @@ mod tests {
             });
             let one = [0, 1].map(|k| es[k].frames(&poses[k]));
             let mut two = [Frames::zeros(); 2];
-            match frames_pair_into([&es[0], &es[1]], [&poses[0], &poses[1]], &mut two) {
+            let [a, b] = &mut two;
+            match frames_pair_into([&es[0], &es[1]], [&poses[0], &poses[1]], [a, b]) {
                 true => for k in 0..2 {
                     prop_assert_eq!(bits(&two[k]), bits(&one[k]), "lane {}", k);
                 },
@@ -161,22 +175,28 @@ mod tests {
                 ))),
             }
             // The step starts of a pair, on either path: each element's bits.
-            let started = BeamElement::step_start_pair([&es[0], &es[1]], [&poses[0], &poses[1]]);
+            let mut started = [StepStart::unset(), StepStart::unset()];
+            let [a, b] = &mut started;
+            BeamElement::step_start_pair_into([&es[0], &es[1]], [&poses[0], &poses[1]], [a, b]);
             for k in 0..2 {
                 prop_assert!(started[k].is_of(&poses[k]));
                 prop_assert_eq!(bits(started[k].frames()), bits(&one[k]), "start {}", k);
             }
             let starts = [0, 1].map(|k| es[k].step_start(&pose([0.0; 6], [0.01 * k as f64; 6])));
-            let pair = energy_momentum_force_parts_pair(
+            let mut forces = [[f64::NAN; 12]; 2];
+            let [fa, fb] = &mut forces;
+            let norms = energy_momentum_force_pair_into(
                 [&es[0], &es[1]],
                 [&starts[0], &starts[1]],
                 [&poses[0], &poses[1]],
+                [fa, fb],
             );
             for k in 0..2 {
-                let single = es[k].energy_momentum_force_parts_from(&starts[k], &poses[k]);
-                let b = |v: &SVector<f64, 12>| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-                prop_assert_eq!(b(&pair[k].0), b(&single.0));
-                prop_assert_eq!(b(&pair[k].1), b(&single.1));
+                let (q, c) = es[k].energy_momentum_force_parts_from(&starts[k], &poses[k]);
+                let b = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                prop_assert_eq!(b(&forces[k]), b(q.as_slice()));
+                prop_assert_eq!(norms[k].0.to_bits(), c.norm().to_bits());
+                prop_assert_eq!(norms[k].1.to_bits(), q.norm().to_bits());
             }
         }
     }
@@ -188,10 +208,7 @@ mod tests {
             [0.0, 0.0, 0.0, 0.5, 0.0, 0.0],
             [0.0, 0.0, 0.0, 3.0, 0.0, 0.0],
         );
-        assert!(!frames_pair_into(
-            [&e, &e],
-            [&p, &p],
-            &mut [Frames::zeros(); 2]
-        ));
+        let [mut a, mut b] = [Frames::zeros(); 2];
+        assert!(!frames_pair_into([&e, &e], [&p, &p], [&mut a, &mut b]));
     }
 }

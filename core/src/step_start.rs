@@ -10,13 +10,17 @@ use crate::conserving::{Frames, Pose};
 use crate::discrete_gradient::{dg_step_in_pairs, step_force};
 use crate::element::BeamElement;
 use crate::frames_pair::frames_of_pair_into;
-use nalgebra::{SMatrix, SVector};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
-/// An element's pose at the start of a step with its rotation pieces.
+/// An element's pose at the start of a step with its rotation pieces and
+/// its resultants there.
 #[derive(Debug, Clone)]
 pub struct StepStart {
     pose: Pose<f64>,
     frames: Frames<f64>,
+    /// The material resultants `(N, M)` at the start pose
+    /// (`BeamElement::frame_resultants` of `frames`).
+    resultants: (Vector3<f64>, Vector3<f64>),
 }
 
 impl StepStart {
@@ -32,6 +36,20 @@ impl StepStart {
         &self.pose
     }
 
+    /// A start of no pose (its pose is NaN, so [`Self::is_of`] holds for
+    /// none): a place for [`BeamElement::step_start_into`] and
+    /// [`BeamElement::step_start_pair_into`].
+    pub fn unset() -> Self {
+        StepStart {
+            pose: (
+                [Vector3::repeat(f64::NAN); 2],
+                [Matrix3::repeat(f64::NAN); 2],
+            ),
+            frames: Frames::zeros(),
+            resultants: (Vector3::zeros(), Vector3::zeros()),
+        }
+    }
+
     /// The start pose's rotation pieces.
     pub(crate) fn frames(&self) -> &Frames<f64> {
         &self.frames
@@ -41,22 +59,39 @@ impl StepStart {
 impl BeamElement<2> {
     /// The element's [`StepStart`] at `pose`.
     pub fn step_start(&self, pose: &Pose<f64>) -> StepStart {
+        let frames = self.frames(pose);
         StepStart {
             pose: *pose,
-            frames: self.frames(pose),
+            resultants: self.frame_resultants(&frames),
+            frames,
         }
     }
 
-    /// The [`StepStart`]s of two elements at their poses, their rotation
-    /// pieces two at a time where the pair arithmetic takes them
-    /// (`frames_pair`): the same bits as [`Self::step_start`] of each.
-    pub fn step_start_pair(e: [&Self; 2], poses: [&Pose<f64>; 2]) -> [StepStart; 2] {
-        let mut frames = [Frames::zeros(); 2];
-        frames_of_pair_into(e, poses, &mut frames);
-        [0, 1].map(|k| StepStart {
-            pose: *poses[k],
-            frames: frames[k],
-        })
+    /// [`Self::step_start`] at `pose`, written into `out`.
+    pub fn step_start_into(&self, pose: &Pose<f64>, out: &mut StepStart) {
+        out.pose = *pose;
+        out.frames = self.frames(pose);
+        out.resultants = self.frame_resultants(&out.frames);
+    }
+
+    /// The [`StepStart`]s of two elements at their poses, written into
+    /// `out`, their rotation pieces two at a time where the pair arithmetic
+    /// takes them (`frames_pair`): the same bits as [`Self::step_start`] of
+    /// each. (In place: a step start is 520 bytes, and moving them by value
+    /// took calls to `memcpy` of the order of the pieces' own cost.)
+    pub fn step_start_pair_into(e: [&Self; 2], poses: [&Pose<f64>; 2], out: [&mut StepStart; 2]) {
+        let [a, b] = out;
+        frames_of_pair_into(e, poses, [&mut a.frames, &mut b.frames]);
+        (a.pose, b.pose) = (*poses[0], *poses[1]);
+        a.resultants = e[0].frame_resultants(&a.frames);
+        b.resultants = e[1].frame_resultants(&b.frames);
+    }
+
+    /// `BeamElement::averaged_resultants` from a step's start to the end
+    /// pose's pieces `end`, the start's resultants looked up: the same bits.
+    pub(crate) fn averaged_from(&self, start: &StepStart, end: &Frames<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let ((n0, m0), (n1, m1)) = (start.resultants, self.frame_resultants(end));
+        ((n0 + n1) * 0.5, (m0 + m1) * 0.5)
     }
 
     /// [`Self::energy_momentum_force_parts`] from a step's start.
@@ -66,7 +101,7 @@ impl BeamElement<2> {
         end: &Pose<f64>,
     ) -> (SVector<f64, 12>, SVector<f64, 12>) {
         let (s, e) = (&start.frames, &self.frames(end));
-        let (nbar, mbar) = self.averaged_resultants(s, e);
+        let (nbar, mbar) = self.averaged_from(start, e);
         step_force(&dg_step_in_pairs(s, e), &nbar, &mbar)
     }
 
@@ -77,7 +112,7 @@ impl BeamElement<2> {
         end: &Pose<f64>,
     ) -> (SVector<f64, 12>, SMatrix<f64, 12, 12>) {
         let (s0, s1) = (&start.frames, &self.frames(end));
-        let (nbar, mbar) = self.averaged_resultants(s0, s1);
+        let (nbar, mbar) = self.averaged_from(start, s1);
         let q = step_force(&dg_step_in_pairs(s0, s1), &nbar, &mbar).0;
         (q, self.momentum_tangent_of(s0, s1).1)
     }

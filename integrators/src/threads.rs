@@ -214,6 +214,25 @@ fn for_each_chunk(chunks: &[Range<usize>], f: impl Fn(usize, Range<usize>) + Syn
     });
 }
 
+/// `f(first, chunk)` on consecutive chunks of `items`, `first` the chunk's
+/// first index — on the team's threads unless [`sequential`] (one chunk
+/// then), as [`map_each`] splits: for loops that write each item in place
+/// from what belongs to it alone, so the same either way.
+pub fn for_each_chunk_mut<T: Send>(items: &mut [T], f: impl Fn(usize, &mut [T]) + Sync + Send) {
+    if sequential(items.len()) {
+        return f(0, items);
+    }
+    let mut parts = Vec::new();
+    let ranges: Vec<_> = node_chunks(items.len()).collect();
+    let mut rest = items;
+    for range in ranges {
+        let (chunk, tail) = std::mem::take(&mut rest).split_at_mut(range.len());
+        parts.push((range.start, chunk));
+        rest = tail;
+    }
+    for_each_item(parts, |_, (first, chunk)| f(first, chunk));
+}
+
 /// `f(i, xᵢ, Rᵢ)` on every node's pose — on two threads where
 /// [`split_nodes`]; each node on its own, so the same either way.
 pub fn for_each_pose(

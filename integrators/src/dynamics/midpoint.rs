@@ -28,7 +28,7 @@ use super::inertia_pairs::{midpoint_moment_pair, moments_in_pairs_into};
 use super::mass_slots::MassSlots;
 use super::midpoint_kernels::{
     correction_size, element_force, element_kernel, start_of, started_force, started_force_pair,
-    started_kernel, started_kernel_pair, started_tangent, started_tangent_pair, step_starts,
+    started_kernel, started_kernel_pair, started_tangent, started_tangent_pair, step_starts_into,
     CorrectionTally,
 };
 use super::midpoint_sensitivity::MidpointSensitivities;
@@ -156,7 +156,7 @@ pub(crate) struct MidpointTerms {
     /// The energy–momentum scheme's 2-node elements' [`StepStart`]s of the
     /// step being solved (empty for the other schemes; an entry is used only
     /// for the start it was computed at).
-    starts: Vec<Option<StepStart>>,
+    starts: Vec<StepStart>,
     /// The node pairs' moments of the last residual-only evaluation, kept
     /// for their allocation ([`moments_in_pairs_into`]).
     moments: std::sync::Mutex<Vec<[Vector3<f64>; 2]>>,
@@ -466,7 +466,7 @@ impl TimeScheme for MidpointTerms {
         match sys.terms.scheme {
             Scheme::Momentum => newton::solve(sys, lu, settings, r, dq).map(|rep| (rep, f64::NAN)),
             Scheme::EnergyMomentum => {
-                sys.terms.starts = step_starts(sys.mech, &sys.start.config);
+                step_starts_into(sys.mech, &sys.start.config, &mut sys.terms.starts);
                 newton::solve(sys, lu, settings, r, dq).map(|rep| {
                     // Newton's last evaluation was at the accepted iterate, or
                     // at the one a closing correction moved on (by less than the
@@ -612,7 +612,7 @@ mod tests {
         let terms = MidpointTerms::new(mech, &topo, &asm, &state, inertia, &rest, scheme);
         let mut sys = ReducedSystem::new(mech, topo, asm, state, terms);
         sys.terms.set_step(1e-2);
-        sys.terms.starts = step_starts(mech, &sys.start.config);
+        step_starts_into(mech, &sys.start.config, &mut sys.terms.starts);
         sys.set_exact_tangent(false);
         let n = sys.topo.dofs.n_eq;
         let dq: Vec<f64> = (0..n).map(|i| 1e-3 * (0.7 * i as f64).sin()).collect();

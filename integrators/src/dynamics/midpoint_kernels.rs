@@ -7,7 +7,7 @@ use super::Scheme;
 use crate::mechanism::Mechanism;
 use crate::threads;
 use flexmech_core::conserving::{MidRotation, Pose, Pose3};
-use flexmech_core::frames_pair::energy_momentum_force_parts_pair;
+use flexmech_core::frames_pair::energy_momentum_force_pair_into;
 use flexmech_core::rotation::exp;
 use flexmech_core::step_start::StepStart;
 use flexmech_core::{cst, BeamElement, Configuration, Element, Scalar};
@@ -181,42 +181,49 @@ pub(crate) fn element_force(
     r.copy_from_slice(q.as_slice());
 }
 
-/// Every 2-node element's [`StepStart`] at the step's start (`None` for
-/// 3-node elements): the energy–momentum scheme's kernels look the start
-/// pose's rotation pieces up instead of recomputing them at every Newton
-/// evaluation of the step.
-///
-/// Neighbouring 2-node elements take their pieces two at a time
-/// ([`BeamElement::step_start_pair`]): the same bits.
-pub(crate) fn step_starts(mech: &Mechanism, start: &Configuration) -> Vec<Option<StepStart>> {
+/// Every 2-node element's [`StepStart`] at the step's start, written into
+/// `starts` (one entry per element; a 3-node element's is
+/// [`StepStart::unset`]): the energy–momentum scheme's kernels look the
+/// start pose's rotation pieces up instead of recomputing them at every
+/// Newton evaluation of the step. Neighbouring 2-node elements take their
+/// pieces two at a time ([`BeamElement::step_start_pair_into`]): the same
+/// bits.
+pub(crate) fn step_starts_into(mech: &Mechanism, start: &Configuration, starts: &mut Vec<StepStart>) {
     let elements = &mech.mesh.elements;
-    let one = |i: usize| match elements.get(i) {
-        Some(Element::Linear(e)) => Some(e.step_start(&pose_of(e, start))),
-        _ => None,
-    };
-    let pairs = threads::map_each(elements.len().div_ceil(2), |p| {
-        match (&elements[2 * p], elements.get(2 * p + 1)) {
-            (Element::Linear(a), Some(Element::Linear(b))) => {
-                let poses = [pose_of(a, start), pose_of(b, start)];
-                BeamElement::step_start_pair([a, b], [&poses[0], &poses[1]]).map(Some)
+    starts.truncate(elements.len());
+    starts.resize_with(elements.len(), StepStart::unset);
+    threads::for_each_chunk_mut(starts, |first, chunk| {
+        for (p, slots) in chunk.chunks_mut(2).enumerate() {
+            let i = first + 2 * p;
+            match (slots, &elements[i..]) {
+                ([a, b], [Element::Linear(ea), Element::Linear(eb), ..]) => {
+                    let poses = [pose_of(ea, start), pose_of(eb, start)];
+                    BeamElement::step_start_pair_into([ea, eb], [&poses[0], &poses[1]], [a, b]);
+                }
+                (slots, els) => {
+                    for (slot, el) in slots.iter_mut().zip(els) {
+                        match el {
+                            Element::Linear(e) => e.step_start_into(&pose_of(e, start), slot),
+                            Element::Quadratic(_) => *slot = StepStart::unset(),
+                        }
+                    }
+                }
             }
-            _ => [one(2 * p), one(2 * p + 1)],
         }
     });
-    pairs.into_iter().flatten().take(elements.len()).collect()
 }
 
 /// Element `index`'s entry of `starts` when `el` is a 2-node element and the
 /// entry is the start of a step from `start` (else `None`: the kernel
 /// computes its own).
 pub(crate) fn start_of<'a>(
-    starts: &'a [Option<StepStart>],
+    starts: &'a [StepStart],
     el: &'a Element,
     index: usize,
     start: &Configuration,
 ) -> Option<(&'a BeamElement<2>, &'a StepStart)> {
     match (el, starts.get(index)) {
-        (Element::Linear(e), Some(Some(s))) if is_pose_in(e, s.pose(), start) => Some((e, s)),
+        (Element::Linear(e), Some(s)) if is_pose_in(e, s.pose(), start) => Some((e, s)),
         _ => None,
     }
 }
@@ -308,7 +315,7 @@ pub(crate) fn started_force(
 }
 
 /// [`started_force`] of two neighbouring elements, their end poses' pieces
-/// two at a time ([`energy_momentum_force_parts_pair`]): the same bits.
+/// two at a time ([`energy_momentum_force_pair_into`]): the same bits.
 pub(crate) fn started_force_pair(
     starts: [(&BeamElement<2>, &StepStart); 2],
     end: &Configuration,
@@ -317,10 +324,9 @@ pub(crate) fn started_force_pair(
 ) {
     let [(ea, sa), (eb, sb)] = starts;
     let poses = [pose_of(ea, end), pose_of(eb, end)];
-    let parts = energy_momentum_force_parts_pair([ea, eb], [sa, sb], [&poses[0], &poses[1]]);
-    for ((q, c), r) in parts.iter().zip(forces) {
-        tally.add(c.norm(), q.norm());
-        r.copy_from_slice(q.as_slice());
+    let norms = energy_momentum_force_pair_into([ea, eb], [sa, sb], [&poses[0], &poses[1]], forces);
+    for (correction, force) in norms {
+        tally.add(correction, force);
     }
 }
 
