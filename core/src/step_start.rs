@@ -89,7 +89,11 @@ impl BeamElement<2> {
 
     /// `BeamElement::averaged_resultants` from a step's start to the end
     /// pose's pieces `end`, the start's resultants looked up: the same bits.
-    pub(crate) fn averaged_from(&self, start: &StepStart, end: &Frames<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    pub(crate) fn averaged_from(
+        &self,
+        start: &StepStart,
+        end: &Frames<f64>,
+    ) -> (Vector3<f64>, Vector3<f64>) {
         let ((n0, m0), (n1, m1)) = (start.resultants, self.frame_resultants(end));
         ((n0 + n1) * 0.5, (m0 + m1) * 0.5)
     }

@@ -571,7 +571,7 @@ mod tests {
         let sec = Section::new([1e6, 4e5, 4e5], [1e3; 3], 2.0, [0.02, 0.01, 0.01]);
         let mut mesh = Mesh::default();
         let (z, top) = (Vector3::z(), Vector3::new(0.0, 0.0, 2.0));
-        let post = mesh.add_straight_beam(Vector3::zeros(), top, Vector3::x(), 2, 2, sec);
+        let post = mesh.add_straight_beam(Vector3::zeros(), top, Vector3::x(), 3, 2, sec);
         let end = Vector3::new(1.0, 0.0, 2.0);
         let arm = mesh.add_straight_beam(top, end, Vector3::y(), 4, 2, sec);
         let (post, arm) = (post.unwrap(), arm.unwrap());
@@ -655,6 +655,17 @@ mod tests {
         let mut sys = moved_energy_momentum_system(&mech);
         let (start, end) = (&sys.start.config, &sys.end.config);
         let (terms, asm, dofs) = (&sys.terms, &mut sys.asm, &sys.topo.dofs);
+        // Every 2-node element finds its own step start (`step_starts_into`
+        // writes pairs in place).
+        let els = &mech.mesh.elements;
+        assert!(
+            els.len() % 2 == 1,
+            "an odd count: the last element on its own"
+        );
+        for (i, el) in els.iter().enumerate() {
+            let found = start_of(&terms.starts, el, i, start).is_some();
+            assert_eq!(found, matches!(el, Element::Linear(_)), "element {i}");
+        }
         type Started = fn((&BeamElement<2>, &StepStart), &Configuration, &mut [f64], &mut [f64]);
         let kernels: [Started; 2] = [started_kernel, started_tangent];
         for (alone, started) in [false, true].into_iter().zip(kernels) {

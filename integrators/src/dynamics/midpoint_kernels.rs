@@ -188,7 +188,11 @@ pub(crate) fn element_force(
 /// Newton evaluation of the step. Neighbouring 2-node elements take their
 /// pieces two at a time ([`BeamElement::step_start_pair_into`]): the same
 /// bits.
-pub(crate) fn step_starts_into(mech: &Mechanism, start: &Configuration, starts: &mut Vec<StepStart>) {
+pub(crate) fn step_starts_into(
+    mech: &Mechanism,
+    start: &Configuration,
+    starts: &mut Vec<StepStart>,
+) {
     let elements = &mech.mesh.elements;
     starts.truncate(elements.len());
     starts.resize_with(elements.len(), StepStart::unset);
@@ -513,10 +517,12 @@ mod tests {
         let starts: Vec<_> = els
             .iter()
             .map(|el| match el {
-                Element::Linear(e) => Some(e.step_start(&pose_of(e, &start))),
-                Element::Quadratic(_) => None,
+                Element::Linear(e) => e.step_start(&pose_of(e, &start)),
+                Element::Quadratic(_) => StepStart::unset(),
             })
             .collect();
+        // An unset start is the start of nothing.
+        assert!(start_of(&[StepStart::unset()], &els[0], 0, &start).is_none());
         let found = |c: &Configuration| -> Vec<bool> {
             (0..3)
                 .map(|i| start_of(&starts, &els[i], i, c).is_some())
