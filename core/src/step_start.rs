@@ -77,8 +77,8 @@ impl BeamElement<2> {
     /// The [`StepStart`]s of two elements at their poses, written into
     /// `out`, their rotation pieces two at a time where the pair arithmetic
     /// takes them (`frames_pair`): the same bits as [`Self::step_start`] of
-    /// each. (In place: a step start is 520 bytes, and moving them by value
-    /// took calls to `memcpy` of the order of the pieces' own cost.)
+    /// each. (In place: moved by value, the 520-byte starts were copied
+    /// with `memcpy` several times over at every step.)
     pub fn step_start_pair_into(e: [&Self; 2], poses: [&Pose<f64>; 2], out: [&mut StepStart; 2]) {
         let [a, b] = out;
         frames_of_pair_into(e, poses, [&mut a.frames, &mut b.frames]);
