@@ -16,7 +16,7 @@
 set -e
 source "$(dirname "$0")/env.sh"
 OUT="${1:-results}"
-cargo build --release --bin flexmech
+cargo build --release -p flexmech --bin flexmech
 FLEXMECH="${CARGO_TARGET_DIR:-target}/release/flexmech"
 "$FLEXMECH" reproduce --out "$OUT"
 "$FLEXMECH" reproduce --benchmarks --out "$OUT"

@@ -89,6 +89,9 @@ pub(super) struct Layout {
     pub(super) y_area: f64,
     /// Plot rectangle: left, top, right, bottom.
     pub(super) plot: (f64, f64, f64, f64),
+    /// The axis descriptions' font size in pixels: [`DESC_FONT`], smaller
+    /// where a description would not fit along its axis.
+    pub(super) desc_font: f64,
     /// Row (0 = nearest the plot) of each marker label.
     pub(super) marker_rows: Vec<usize>,
 }

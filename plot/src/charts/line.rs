@@ -469,7 +469,7 @@ impl Figure {
             .configure_mesh()
             .x_desc(self.x_label.as_str())
             .y_desc(self.y_label.as_str())
-            .axis_desc_style(font::text(DESC_FONT * s))
+            .axis_desc_style(font::text(lay.desc_font))
             .label_style(font::text(TICK_FONT * s))
             .x_label_formatter(&x_fmt)
             .y_label_formatter(&y_fmt)
@@ -637,6 +637,29 @@ impl Curve {
     }
 }
 
+/// The axis descriptions' font size at `scale`: [`DESC_FONT`], scaled down
+/// where a description `(label, room)` is longer than its axis (a long y
+/// label ran past both ends of the plot), to [`DESC_FIT`] of the axis.
+fn desc_font_fitting(axes: &[(&String, f64)], scale: f64) -> f64 {
+    let size = DESC_FONT * scale;
+    let shrink = axes
+        .iter()
+        .map(|(label, room)| {
+            let width = text_width(label, size);
+            if width <= *room {
+                1.0
+            } else {
+                DESC_FIT * room.max(0.0) / width
+            }
+        })
+        .fold(1.0, f64::min);
+    size * shrink
+}
+
+/// The share of its axis a description scaled down to fit takes: glyph
+/// widths do not scale exactly with the size.
+const DESC_FIT: f64 = 0.95;
+
 impl Layout {
     fn compute(figure: &Figure, scale: f64) -> Self {
         let s = scale;
@@ -707,7 +730,12 @@ impl Layout {
         };
         let top = (MARGIN + title_h + used_rows * NOTE_ROW + TICK_FONT / 2.0 + 6.0) * s;
         let bottom = f64::from(HEIGHT) * s - bottom_margin - x_area;
+        let axes = [
+            (&figure.x_label, right - left),
+            (&figure.y_label, bottom - top),
+        ];
         Self {
+            desc_font: desc_font_fitting(&axes, s),
             scale,
             x,
             y,

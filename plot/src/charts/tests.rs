@@ -195,3 +195,30 @@ fn the_tex_has_the_pngs_labels_legend_entries_and_legend_corner() {
     );
     assert!(t.contains("forget plot"));
 }
+
+/// A description longer than its axis is set smaller, to fit along it; one
+/// that fits keeps the usual size.
+#[test]
+fn a_long_axis_description_is_set_to_fit_its_axis() {
+    use super::figure::{Figure, DESC_FONT};
+    use super::font::text_width;
+    let dir = scratch("long-label");
+    let long = "released translation r_R in the master frame, x (m), of the cam's follower";
+    let mut c = LineChart::new("long", "time (s)", long);
+    c.series = vec![wave("a", 0.0)];
+    let figure = Figure::prepare(&c, &dir.join("long.png")).unwrap();
+    let lay = figure.layout(1.0);
+    let (_, top, _, bottom) = lay.plot;
+    assert!(
+        text_width(long, DESC_FONT) > bottom - top,
+        "the label is longer than the axis"
+    );
+    assert!(lay.desc_font < DESC_FONT);
+    assert!(text_width(long, lay.desc_font) <= bottom - top);
+    let short = Figure::prepare(
+        &chart("short", vec![wave("a", 0.0)]),
+        &dir.join("short.png"),
+    );
+    assert_eq!(short.unwrap().layout(1.0).desc_font, DESC_FONT);
+    c.render(&dir.join("long")).unwrap();
+}
