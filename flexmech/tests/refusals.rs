@@ -224,3 +224,52 @@ fn a_drive_that_does_not_start_at_the_joints_angle_is_refused() {
         "{e}"
     );
 }
+
+/// An arm hinged to a post about its own axis spins freely: the refusal
+/// names the arm (the beam whose nodes move), the hinge and the fix, not
+/// only node labels.
+#[test]
+fn a_beam_free_to_spin_about_its_axis_is_refused_naming_the_beam() {
+    use flexmech::model::{BeamGeometry, Model, SectionValues};
+    use flexmech::results::Memory;
+    use nalgebra::Vector3;
+    let rod = SectionValues {
+        ea: 1e7,
+        ga: [1e6; 2],
+        gj: 1e3,
+        ei: [1e3; 2],
+        rho_a: 0.0,
+        rho_j: [0.0; 3],
+    };
+    let straight = |start: Vector3<f64>, end: Vector3<f64>| BeamGeometry::Straight {
+        start,
+        end,
+        e2: Vector3::y(),
+    };
+    let top = Vector3::new(0.0, 0.0, 1.0);
+    let model = Model::new("spinning-arm")
+        .section("rod", rod)
+        .beam("post", "rod", straight(Vector3::zeros(), top), 2)
+        .beam("arm", "rod", straight(top, top + Vector3::x()), 4)
+        .support("post.start", "all")
+        .joint(
+            "hinge",
+            "revolute",
+            "post.end",
+            "arm.start",
+            "axis = [1, 0, 0]",
+        )
+        .load("arm.end", [0.0, 0.0, -1.0], [0.0; 3])
+        .statics(2)
+        .build()
+        .unwrap();
+    let err = flexmech::results::run(&model, &mut Memory::default())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("not held"), "{err}");
+    assert!(err.contains("of beam(s) \"arm\""), "{err}");
+    assert!(!err.contains("\"post\""), "the post is held: {err}");
+    assert!(err.contains("\"hinge\""), "{err}");
+    // A run kept in memory has no result file to point to.
+    assert!(!err.contains("steps computed so far"), "{err}");
+}

@@ -50,6 +50,9 @@ pub struct FreeMotion {
     pub labels: Vec<String>,
     /// Names of the joints whose released coordinates it moves.
     pub joints: Vec<String>,
+    /// Names of the beams ([`Mechanism::names`]) with a node it moves, in
+    /// the model's order.
+    pub beams: Vec<String>,
 }
 
 impl FreeMotion {
@@ -84,6 +87,7 @@ impl FreeMotion {
         let top = sizes.iter().fold(0.0f64, |m, &s| m.max(s));
         let mut nodes: Vec<usize> = (0..p.len()).filter(|&n| sizes[n] > MOVES * top).collect();
         motion.moving = nodes.len();
+        motion.beams = beams_moved(mech, &nodes);
         nodes.sort_by(|&a, &b| sizes[b].total_cmp(&sizes[a]).then(a.cmp(&b)));
         nodes.truncate(NAMED);
         if !mech.names.nodes.is_empty() {
@@ -172,6 +176,29 @@ impl FreeMotion {
             .map(|l| format!("\"{l}\""))
             .unwrap_or_else(|| format!("node {}", self.nodes[k]))
     }
+}
+
+/// The names of the beams with an element on one of the `moving` nodes, in
+/// the model's order.
+fn beams_moved(mech: &Mechanism, moving: &[usize]) -> Vec<String> {
+    let mut moved = vec![false; mech.mesh.node_count()];
+    for &n in moving {
+        if let Some(m) = moved.get_mut(n) {
+            *m = true;
+        }
+    }
+    let elements = &mech.mesh.elements;
+    let moves = |e: usize| {
+        elements
+            .get(e)
+            .is_some_and(|el| el.nodes().iter().any(|&n| moved.get(n) == Some(&true)))
+    };
+    mech.names
+        .beams
+        .iter()
+        .filter(|(_, range)| range.clone().any(moves))
+        .map(|(name, _)| name.clone())
+        .collect()
 }
 
 /// The rigid-body motions (columns `(a, ω)` about `centre`) that the
@@ -317,6 +344,10 @@ impl fmt::Display for FreeMotion {
             if more > 0 {
                 write!(f, " and {more} more node(s)")?;
             }
+        }
+        if !self.beams.is_empty() {
+            let b: Vec<String> = self.beams.iter().map(|b| format!("\"{b}\"")).collect();
+            write!(f, " of beam(s) {}", b.join(", "))?;
         }
         if !self.joints.is_empty() {
             let j: Vec<String> = self.joints.iter().map(|j| format!("\"{j}\"")).collect();

@@ -16,6 +16,15 @@ use faer::{Conj, MatMut, Par};
 use crate::band_lu::{equilibrating_scale, BandLu, BandStructure};
 use crate::band_split::{SplitBandLu, SPLIT_MIN_UNKNOWNS};
 
+/// Shift `σ`, relative to the equilibrated tangent's norm `‖B‖∞`, of the
+/// inverse iteration that finds the null direction of an exactly singular
+/// tangent ([`SparseLu::condition_estimate`]): `B + σI` is regular (`σ` is
+/// far above round-off), and two steps of the iteration grow the null
+/// direction by `1/σ` each against `1/(λ + σ)` for a direction of
+/// eigenvalue `λ`, so the null direction dominates wherever the held parts'
+/// stiffness is above `σ`.
+pub const NULL_SHIFT: f64 = 1e-10;
+
 /// A matrix in a solver's pattern: its values with the pattern.
 #[derive(Clone, Copy)]
 pub struct TangentRef<'a> {
@@ -267,18 +276,32 @@ impl SparseLu {
     /// dominates — which is what a mechanism (an unsupported rigid motion, a
     /// DOF with neither stiffness nor mass) gives: `κ ≳ 1/ε`. Returns
     /// `(κ, x)` with `x` the direction in the original unknowns, scaled to
-    /// `‖x‖∞ = 1`; `κ = ∞` when a solve is not finite.
+    /// `‖x‖∞ = 1`; `κ = ∞` when a solve is not finite (an exactly zero
+    /// pivot), and `x` then the direction the same iteration finds on
+    /// `B + σI`, `σ` = [`NULL_SHIFT`] `‖B‖∞` (`shifted_null_direction`;
+    /// zero where that fails too).
     pub fn condition_estimate(&mut self, values: &[f64]) -> (f64, Vec<f64>) {
-        let n = self.pattern.nrows();
         let tangent = TangentRef {
             pattern: &self.pattern,
             values,
         };
         let d = tangent.equilibration();
         let norm = tangent.scaled_norm(&d);
+        match self.inverse_iteration(&d) {
+            Some((growth, x)) => (norm * growth, x),
+            None => (f64::INFINITY, self.shifted_null_direction(values, &d, norm)),
+        }
+    }
+
+    /// Two steps of inverse iteration with the factorisation at hand on
+    /// `B = D A D` (`d` the diagonal of `D`): the growth `‖B⁻¹y‖∞` of the
+    /// last step and the direction `D B⁻¹y` in the original unknowns,
+    /// scaled to `‖x‖∞ = 1` (see [`Self::condition_estimate`]); `None`
+    /// where a solve is not finite.
+    fn inverse_iteration(&mut self, d: &[f64]) -> Option<(f64, Vec<f64>)> {
         // A fixed start with components of both signs and unequal sizes.
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut y: Vec<f64> = (0..n)
+        let mut y: Vec<f64> = (0..d.len())
             .map(|_| {
                 seed = seed
                     .wrapping_mul(6_364_136_223_846_793_005)
@@ -290,19 +313,44 @@ impl SparseLu {
         for _ in 0..2 {
             let top = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             // B⁻¹ y = D⁻¹ A⁻¹ D⁻¹ y (with y scaled to ‖y‖∞ = 1).
-            let mut z: Vec<f64> = y.iter().zip(&d).map(|(v, di)| v / top / di).collect();
-            if self.solve(&mut z).is_err() {
-                return (f64::INFINITY, vec![0.0; n]);
-            }
-            y = z.iter().zip(&d).map(|(v, di)| v / di).collect();
+            let mut z: Vec<f64> = y.iter().zip(d).map(|(v, di)| v / top / di).collect();
+            self.solve(&mut z).ok()?;
+            y = z.iter().zip(d).map(|(v, di)| v / di).collect();
             growth = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         }
         // B v = D A D v ≈ 0 ⇒ A (D v) ≈ 0: the direction in the unknowns.
-        let mut x: Vec<f64> = y.iter().zip(&d).map(|(v, di)| v * di).collect();
+        let mut x: Vec<f64> = y.iter().zip(d).map(|(v, di)| v * di).collect();
         let top = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         if top > 0.0 && top.is_finite() {
             x.iter_mut().for_each(|v| *v /= top);
         }
-        (norm * growth, x)
+        Some((growth, x))
+    }
+
+    /// The null direction of an exactly singular `values` (equilibrating
+    /// scale `d`, `‖B‖∞ = norm`): the inverse iteration on `B + σI`,
+    /// `σ = NULL_SHIFT · norm`, which a zero pivot does not stop and which
+    /// still draws the start towards the null space by `1/σ` against at
+    /// most `1/(λ + σ)` for any other direction. The shifted factors are
+    /// dropped: the solver holds no factorisation afterwards. Zeros where
+    /// the shifted matrix cannot be factorised either.
+    fn shifted_null_direction(&mut self, values: &[f64], d: &[f64], norm: f64) -> Vec<f64> {
+        let n = d.len();
+        let mut shifted = values.to_vec();
+        let (col_ptr, row_idx) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        for (j, dj) in d.iter().enumerate() {
+            let range = col_ptr[j]..col_ptr[j + 1];
+            if let Some(k) = row_idx[range.clone()].iter().position(|&r| r == j) {
+                shifted[range.start + k] += NULL_SHIFT * norm / (dj * dj);
+            }
+        }
+        let found = match self.factor(&shifted) {
+            Ok(()) => self.inverse_iteration(d).map(|(_, x)| x),
+            Err(_) => None,
+        };
+        self.factored = false;
+        found
+            .filter(|x| x.iter().all(|v| v.is_finite()))
+            .unwrap_or_else(|| vec![0.0; n])
     }
 }

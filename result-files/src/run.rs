@@ -91,11 +91,12 @@ pub enum RunError {
         /// What differs, and what to do.
         why: String,
     },
-    /// The solver stopped; `file` holds the steps computed before.
+    /// The solver stopped; `file` holds the steps computed before (empty
+    /// for a run kept in memory, whose sink holds them).
     #[error(
-        "{}: model \"{model}\": {error} (steps computed so far are in {})",
+        "{}: model \"{model}\": {error}{}",
         path.display(),
-        file.display()
+        kept_in(file)
     )]
     Solve {
         /// The model's name.
@@ -107,6 +108,16 @@ pub enum RunError {
         /// The result file holding the steps computed before.
         file: PathBuf,
     },
+}
+
+/// Where the steps computed before a failure are, for its message: the
+/// result file, or nothing for a run kept in memory.
+fn kept_in(file: &Path) -> String {
+    if file.as_os_str().is_empty() {
+        String::new()
+    } else {
+        format!(" (steps computed so far are in {})", file.display())
+    }
 }
 
 /// What a completed run reports.
