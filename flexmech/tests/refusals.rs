@@ -152,23 +152,28 @@ fn static_step_control_stops_instead_of_creeping() {
     }
 }
 
-/// A static run whose loads vanish — a beam turned rigidly by a driven
-/// joint, no load, no gravity — converges at round-off; its recorded
-/// residual must read as converged (the force scale is round-off itself,
-/// which once recorded ≈ 0.8 per step).
-#[test]
-fn a_static_run_without_loads_records_a_converged_residual() {
-    use flexmech::model::{BeamGeometry, Model, SectionValues};
-    use flexmech::results::Memory;
-    use nalgebra::Vector3;
-    let rod = SectionValues {
+/// A stiff rod's section without mass (statics).
+fn massless_rod() -> flexmech::model::SectionValues {
+    flexmech::model::SectionValues {
         ea: 1e7,
         ga: [1e6; 2],
         gj: 1e3,
         ei: [1e3; 2],
         rho_a: 0.0,
         rho_j: [0.0; 3],
-    };
+    }
+}
+
+/// A static run whose loads vanish — a beam turned rigidly by a driven
+/// joint, no load, no gravity — converges at round-off; its recorded
+/// residual must read as converged (the force scale is round-off itself,
+/// which once recorded ≈ 0.8 per step).
+#[test]
+fn a_static_run_without_loads_records_a_converged_residual() {
+    use flexmech::model::{BeamGeometry, Model};
+    use flexmech::results::Memory;
+    use nalgebra::Vector3;
+    let rod = massless_rod();
     let arm = BeamGeometry::Straight {
         start: Vector3::zeros(),
         end: Vector3::x(),
@@ -230,17 +235,10 @@ fn a_drive_that_does_not_start_at_the_joints_angle_is_refused() {
 /// only node labels.
 #[test]
 fn a_beam_free_to_spin_about_its_axis_is_refused_naming_the_beam() {
-    use flexmech::model::{BeamGeometry, Model, SectionValues};
+    use flexmech::model::{BeamGeometry, Model};
     use flexmech::results::Memory;
     use nalgebra::Vector3;
-    let rod = SectionValues {
-        ea: 1e7,
-        ga: [1e6; 2],
-        gj: 1e3,
-        ei: [1e3; 2],
-        rho_a: 0.0,
-        rho_j: [0.0; 3],
-    };
+    let rod = massless_rod();
     let straight = |start: Vector3<f64>, end: Vector3<f64>| BeamGeometry::Straight {
         start,
         end,
