@@ -59,12 +59,9 @@ impl StepStart {
 impl BeamElement<2> {
     /// The element's [`StepStart`] at `pose`.
     pub fn step_start(&self, pose: &Pose<f64>) -> StepStart {
-        let frames = self.frames(pose);
-        StepStart {
-            pose: *pose,
-            resultants: self.frame_resultants(&frames),
-            frames,
-        }
+        let mut start = StepStart::unset();
+        self.step_start_into(pose, &mut start);
+        start
     }
 
     /// [`Self::step_start`] at `pose`, written into `out`.
