@@ -322,6 +322,28 @@ impl Mechanism {
         4.0 * f64::EPSILON * sum.sqrt()
     }
 
+    /// The round-off floor the Kelvin–Voigt damping forces ([`Self::damping`])
+    /// add over a step of `dt` with the nodes at `positions`:
+    /// `4·eps·‖(η/Δt · force scale of each damped element)‖₂`. A damped
+    /// element's force is `η/Δt` times that of the element whose strains are
+    /// the step's change `ε − εₙ` (FORMULATION §4.7); the difference is
+    /// small, but it carries the rounding of the strains themselves, so its
+    /// noise is `η/Δt` times the elastic force's however little the element
+    /// moves in the step (a 3-node cantilever with `η/Δt = 10` stalled at
+    /// twice the undamped floor without it). Zero without damping.
+    pub fn damping_round_off_floor_at(&self, positions: &[Vector3<f64>], dt: f64) -> f64 {
+        let damped = self.damped_elements();
+        if damped.is_empty() {
+            return 0.0;
+        }
+        let radius = self.size_at(positions);
+        let sum: f64 = damped
+            .iter()
+            .map(|&(e, eta)| (eta / dt * self.mesh.elements[e].force_scale(radius)).powi(2))
+            .sum();
+        4.0 * f64::EPSILON * sum.sqrt()
+    }
+
     /// Adds `weight ×` the follower loads at time `t` with the nodes turned
     /// by `rot` to `out` (6 per node, force then spatial moment).
     pub fn add_follower_forces(&self, t: f64, rot: &[Matrix3<f64>], weight: f64, out: &mut [f64]) {

@@ -426,8 +426,10 @@ impl<S: TimeScheme> Stepping for Stepper<'_, S> {
             let mech = sys.mech;
             sys.load_time = sys.terms.load_time(t, dt);
             mech.external_forces(sys.load_time, &mut sys.fext);
-            sys.floor = mech.round_off_floor_at(&sys.start.config.x)
-                + inertia_round_off_floor(mech, sys.terms.mass(), &sys.start.config.x, dt);
+            let x = &sys.start.config.x;
+            sys.floor = mech.round_off_floor_at(x)
+                + inertia_round_off_floor(mech, sys.terms.mass(), x, dt)
+                + mech.damping_round_off_floor_at(x, dt);
             let outcome = S::solve(
                 sys,
                 &mut self.lu,
