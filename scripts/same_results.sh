@@ -18,7 +18,7 @@
 # that exceeds WITHIN (or where the runs stored different times: the load
 # factors of an arc-length path, solved for, within WITHIN of the largest).
 set -euo pipefail
-[ $# -ge 2 ] || { sed -n '2,11p' "$0"; exit 2; }
+[ $# -ge 2 ] || { sed -n '2,19p' "$0"; exit 2; }
 a="$1"; b="$2"; shift 2
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="$(mktemp -d)"
