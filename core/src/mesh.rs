@@ -262,19 +262,31 @@ impl Element {
         2.0 * psi
     }
 
-    /// The energy Kelvin–Voigt damping dissipates over a step from `start`
-    /// to `end` with `c = η/Δt`: `2ψ` of [`BeamElement::damping_potential`]
-    /// (the value alone, no derivatives).
-    pub fn damping_dissipation(
+    /// The Kelvin–Voigt damping force alone (`6N`, into `r`) over a step from
+    /// `start` to `end` with `c = η/Δt`: the force of
+    /// [`Self::damping_residual_tangent`] without its tangent.
+    pub fn damping_force(
         &self,
         start: (&[Vector3<f64>], &[Matrix3<f64>]),
         end: (&[Vector3<f64>], &[Matrix3<f64>]),
         c: f64,
-    ) -> f64 {
-        match self {
-            Element::Linear(e) => dissipation_of(e, start, end, c),
-            Element::Quadratic(e) => dissipation_of(e, start, end, c),
-        }
+        r: &mut [f64],
+    ) {
+        // The same element as the force and tangent's (see there).
+        let strains0 = match self {
+            Element::Linear(e) => {
+                let (xs, rs) = gather(&e.nodes, start.0, start.1);
+                e.strains(&xs, &rs)
+            }
+            Element::Quadratic(e) => {
+                let (xs, rs) = gather(&e.nodes, start.0, start.1);
+                e.strains(&xs, &rs)
+            }
+        };
+        let lowered: Vec<Strains<f64>> = strains0.iter().map(|s| (-s.0, -s.1)).collect();
+        self.prestrained(&lowered)
+            .internal_force_into(end.0, end.1, r);
+        r.iter_mut().for_each(|v| *v *= c);
     }
 
     /// `∂Π/∂σ` and its gradient `∂f/∂σ` (`6N`) for the element's length
@@ -361,19 +373,6 @@ fn damping_of_ad<const N: usize>(
         r.copy_from_slice(g.as_slice());
         k.copy_from_slice(h.as_slice());
     }
-}
-
-/// [`Element::damping_dissipation`] for an element of `N` nodes.
-fn dissipation_of<const N: usize>(
-    e: &BeamElement<N>,
-    start: (&[Vector3<f64>], &[Matrix3<f64>]),
-    end: (&[Vector3<f64>], &[Matrix3<f64>]),
-    c: f64,
-) -> f64 {
-    let (xs, rs) = gather(&e.nodes, start.0, start.1);
-    let (xe, re) = gather(&e.nodes, end.0, end.1);
-    let psi: f64 = e.damping_potential(&xe, &re, &e.strains(&xs, &rs), c);
-    2.0 * psi
 }
 
 #[inline(always)]

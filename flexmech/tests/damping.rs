@@ -56,7 +56,26 @@ fn the_damped_oscillator_decays_and_reports_its_dissipation() {
         assert!(worst < 4e-3 * v0 / omega, "{integrator}: {worst:e}");
         // e^{−2ζωt} over 1 s leaves e^{−1} of the energy: most dissipated.
         assert!(*dissipated.last().unwrap() > 0.6 * e0, "{dissipated:?}");
-        assert!(dissipated.windows(2).all(|w| w[1] >= w[0]));
+        // The work of the damping forces in the scheme's own balance (the
+        // trapezoidal rule on both ends of each step): what the motion
+        // lost. Each step's share is the physical `η ε̇ C ε̇ Δt ≥ 0` up to the
+        // rule's O(Δt³), which shows only at the velocity's reversals
+        // (−5e-9 where a step's share reaches 1e-3).
+        let (k, s) = (
+            r.values("/energy/kinetic").unwrap(),
+            r.values("/energy/strain").unwrap(),
+        );
+        let lost = e0 - k.last().unwrap() - s.last().unwrap();
+        let last = *dissipated.last().unwrap();
+        assert!(
+            (last - lost).abs() < 1e-4 * e0,
+            "{integrator}: {last} against {lost}"
+        );
+        let largest = dissipated
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .fold(0.0, f64::max);
+        assert!(dissipated.windows(2).all(|w| w[1] >= w[0] - 1e-5 * largest));
         let drift = r.energy_drift().unwrap();
         assert!(drift < 2e-3, "{integrator}: energy drift {drift:e}");
     }
