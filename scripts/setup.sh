@@ -2,7 +2,7 @@
 # Installs what flexmech needs from the system: the HDF5 C library (headers and
 # pkg-config file) and pkg-config itself. Safe to run repeatedly: it does nothing
 # when the library is already found. Needs root (or sudo) on Debian/Ubuntu; users
-# without root can build with `--features hdf5-static` instead (see README).
+# without root can build with `--features hdf5-static` instead (docs/book/without-root.md).
 set -euo pipefail
 
 have_hdf5() {
