@@ -251,12 +251,12 @@ impl Element {
         // Δε): the damping force and tangent are c times that element's
         // internal force and tangent, in closed form (the hyper-dual
         // Hessian of ψ is their oracle in the tests).
-        let (psi, strains0) = match self {
-            Element::Linear(e) => damping_value(e, start, end, c),
-            Element::Quadratic(e) => damping_value(e, start, end, c),
+        let strains0 = self.strains_at(start);
+        let psi = match self {
+            Element::Linear(e) => damping_value(e, &strains0, end, c),
+            Element::Quadratic(e) => damping_value(e, &strains0, end, c),
         };
-        let lowered: Vec<Strains<f64>> = strains0.iter().map(|s| (-s.0, -s.1)).collect();
-        self.prestrained(&lowered)
+        self.step_element(&strains0)
             .residual_tangent(end.0, end.1, r, k);
         r.iter_mut().chain(k.iter_mut()).for_each(|v| *v *= c);
         2.0 * psi
@@ -272,21 +272,31 @@ impl Element {
         c: f64,
         r: &mut [f64],
     ) {
-        // The same element as the force and tangent's (see there).
-        let strains0 = match self {
-            Element::Linear(e) => {
-                let (xs, rs) = gather(&e.nodes, start.0, start.1);
-                e.strains(&xs, &rs)
-            }
-            Element::Quadratic(e) => {
-                let (xs, rs) = gather(&e.nodes, start.0, start.1);
-                e.strains(&xs, &rs)
-            }
-        };
-        let lowered: Vec<Strains<f64>> = strains0.iter().map(|s| (-s.0, -s.1)).collect();
-        self.prestrained(&lowered)
+        self.step_element(&self.strains_at(start))
             .internal_force_into(end.0, end.1, r);
         r.iter_mut().for_each(|v| *v *= c);
+    }
+
+    /// The element's strains at its Gauss points in the configuration `at`.
+    fn strains_at(&self, at: (&[Vector3<f64>], &[Matrix3<f64>])) -> [Strains<f64>; 2] {
+        match self {
+            Element::Linear(e) => {
+                let (x, rot) = gather(&e.nodes, at.0, at.1);
+                e.strains(&x, &rot)
+            }
+            Element::Quadratic(e) => {
+                let (x, rot) = gather(&e.nodes, at.0, at.1);
+                e.strains(&x, &rot)
+            }
+        }
+    }
+
+    /// The element whose stress-free strains are `strains0` (a step
+    /// start's): its strains are the change since then, and `c` times its
+    /// force and tangent are the damping's.
+    fn step_element(&self, strains0: &[Strains<f64>]) -> Element {
+        let lowered: Vec<Strains<f64>> = strains0.iter().map(|s| (-s.0, -s.1)).collect();
+        self.prestrained(&lowered)
     }
 
     /// `∂Π/∂σ` and its gradient `∂f/∂σ` (`6N`) for the element's length
@@ -332,19 +342,17 @@ impl Element {
     }
 }
 
-/// The damping pseudo-potential `ψ` of an `N`-node element over the step
-/// `start → end` (see [`BeamElement::damping_potential`]) and the step
-/// start's strains.
+/// The damping pseudo-potential `ψ` of an `N`-node element over a step from
+/// the strains `strains0` to the configuration `end` (see
+/// [`BeamElement::damping_potential`]).
 fn damping_value<const N: usize>(
     e: &BeamElement<N>,
-    start: (&[Vector3<f64>], &[Matrix3<f64>]),
+    strains0: &[Strains<f64>; 2],
     end: (&[Vector3<f64>], &[Matrix3<f64>]),
     c: f64,
-) -> (f64, [Strains<f64>; 2]) {
-    let (xs, rs) = gather(&e.nodes, start.0, start.1);
-    let strains0 = e.strains(&xs, &rs);
+) -> f64 {
     let (xe, re) = gather(&e.nodes, end.0, end.1);
-    (e.damping_potential(&xe, &re, &strains0, c), strains0)
+    e.damping_potential(&xe, &re, strains0, c)
 }
 
 /// [`Element::damping_residual_tangent`]'s force and tangent by the
